@@ -1,0 +1,58 @@
+#pragma once
+/// @file Dock profiles: the dock's outline as the lidar sees it, a polyline in the dock frame.
+///
+/// Dock frame: origin at the centre of the charging contacts, x forward out of the dock face (towards an approaching
+/// robot), y to the left of x. Vertices run from the dock's -y side to its +y side, so the outward normal of the
+/// segment a->b is (b-a) rotated by -90°: n = (dy, -dx)/|b-a|. A lidar sees a segment only from its outward side.
+
+#include <cstddef>
+#include <cstdint>
+
+#include "dockcore/geometry.hpp"
+
+namespace dockcore {
+
+/// Most vertices a profile may have; 32 covers every built-in with room for custom steps and notches.
+constexpr std::size_t kMaxProfileVertices = 32;
+
+/// Why a profile was refused.
+enum class ProfileError : std::uint8_t {
+  kOk = 0,
+  kTooFewVertices,   ///< Fewer than 2 vertices.
+  kTooManyVertices,  ///< More than kMaxProfileVertices.
+  kDegenerateSegment,///< Two consecutive vertices closer than 1 mm.
+  kNotFinite,        ///< A coordinate is NaN or inf.
+  kUnknownName,      ///< No built-in profile by that name.
+};
+
+/// Human-readable name of a ProfileError, for messages. Never null.
+const char* to_string(ProfileError e);
+
+/// A dock outline. Trivially copyable, fixed size.
+struct DockProfile {
+  Vec2 vertices_m[kMaxProfileVertices] = {};
+  std::size_t vertex_count = 0;
+  char name[24] = {};
+
+  std::size_t segment_count() const { return vertex_count > 0 ? vertex_count - 1 : 0; }
+  /// Length of the polyline in metres. O(vertices).
+  Real length_m() const;
+  /// Outward unit normal of segment i (precondition i < segment_count()). O(1).
+  Vec2 normal(std::size_t i) const;
+  /// Width across y (max y - min y) in metres. O(vertices).
+  Real width_m() const;
+};
+
+/// Builds a profile from vertices given in a frame where the contacts' centre lies at (contact_offset_m, 0):
+/// every vertex is shifted by -contact_offset_m in x so the result is in the dock frame. Validates as documented by
+/// ProfileError; on error `out` is untouched. O(n).
+ProfileError make_profile(const Vec2* vertices_m, std::size_t n, Real contact_offset_m, const char* name,
+                          DockProfile& out);
+
+/// Names of the built-in profiles, null-terminated list: "breakpoint", "v-marker", "plate-v". Dimensions in docs/docks.md.
+extern const char* const kBuiltinProfileNames[];
+
+/// Fills `out` with the built-in profile called `name`. Returns kUnknownName (out untouched) otherwise. O(1).
+ProfileError builtin_profile(const char* name, DockProfile& out);
+
+}  // namespace dockcore

@@ -1,0 +1,69 @@
+#pragma once
+/// @file Scalar type, 2D vectors and SE(2) poses shared by every core module.
+/// Units: metres and radians, right-handed frames, x forward, y left, yaw counter-clockwise.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+
+namespace dockcore {
+
+#if defined(DOCKCORE_REAL_FLOAT) && DOCKCORE_REAL_FLOAT
+using Real = float;  ///< Core scalar: float for MCUs with a single-precision FPU.
+#else
+using Real = double;  ///< Core scalar: double by default.
+#endif
+
+using Vec2 = Eigen::Matrix<Real, 2, 1>;
+using Vec3 = Eigen::Matrix<Real, 3, 1>;
+using Mat2 = Eigen::Matrix<Real, 2, 2>;
+using Mat3 = Eigen::Matrix<Real, 3, 3>;
+
+constexpr Real kPi = static_cast<Real>(3.14159265358979323846);
+constexpr Real kTwoPi = static_cast<Real>(6.28318530717958647692);
+
+/// Degrees to radians. O(1).
+constexpr Real deg_to_rad(Real deg) { return deg * kPi / static_cast<Real>(180); }
+/// Radians to degrees. O(1).
+constexpr Real rad_to_deg(Real rad) { return rad * static_cast<Real>(180) / kPi; }
+
+/// Wraps an angle to (-pi, pi]. Finite input required; O(1) for any magnitude (uses remainder, no loop).
+inline Real wrap_angle(Real angle_rad) {
+  Real a = std::remainder(angle_rad, kTwoPi);  // [-pi, pi]
+  if (a <= -kPi) a += kTwoPi;
+  return a;
+}
+
+/// A pose in SE(2): position of a frame's origin and the heading of its x axis, expressed in a parent frame.
+struct Pose2 {
+  Real x_m = 0;
+  Real y_m = 0;
+  Real yaw_rad = 0;
+
+  /// Maps a point given in this pose's frame to the parent frame. O(1).
+  Vec2 transform(const Vec2& p) const {
+    const Real c = std::cos(yaw_rad);
+    const Real s = std::sin(yaw_rad);
+    return Vec2(x_m + c * p.x() - s * p.y(), y_m + s * p.x() + c * p.y());
+  }
+  /// Maps a point given in the parent frame into this pose's frame. O(1).
+  Vec2 inverse_transform(const Vec2& p) const {
+    const Real c = std::cos(yaw_rad);
+    const Real s = std::sin(yaw_rad);
+    const Real dx = p.x() - x_m;
+    const Real dy = p.y() - y_m;
+    return Vec2(c * dx + s * dy, -s * dx + c * dy);
+  }
+  /// Composition this ∘ b: b is expressed in this pose's frame; the result is in the parent frame. O(1).
+  Pose2 compose(const Pose2& b) const {
+    const Vec2 t = transform(Vec2(b.x_m, b.y_m));
+    return Pose2{t.x(), t.y(), wrap_angle(yaw_rad + b.yaw_rad)};
+  }
+  /// Inverse pose: the parent frame expressed in this frame. O(1).
+  Pose2 inverse() const {
+    const Vec2 t = inverse_transform(Vec2(0, 0));
+    return Pose2{t.x(), t.y(), wrap_angle(-yaw_rad)};
+  }
+};
+
+}  // namespace dockcore

@@ -1,0 +1,102 @@
+#include "dockcore/dock_profile.hpp"
+#include "dockcore/geometry.hpp"
+#include "dockcore/laser_scan.hpp"
+
+#include <CppUTest/TestHarness.h>
+
+using namespace dockcore;
+
+TEST_GROUP(Geometry){};
+
+TEST(Geometry, WrapAngleStaysInHalfOpenInterval) {
+  DOUBLES_EQUAL(kPi, wrap_angle(kPi), 1e-12);
+  DOUBLES_EQUAL(kPi, wrap_angle(-kPi), 1e-12);
+  DOUBLES_EQUAL(0.5, wrap_angle(0.5 + 10 * kTwoPi), 1e-9);
+  DOUBLES_EQUAL(-0.5, wrap_angle(-0.5 - 3 * kTwoPi), 1e-9);
+}
+
+TEST(Geometry, ComposeWithInverseIsIdentity) {
+  const Pose2 a{1.0, -2.0, 2.5};
+  const Pose2 b{-0.3, 0.7, -3.0};
+  const Pose2 ab = a.compose(b);
+  const Pose2 back = a.inverse().compose(ab);
+  DOUBLES_EQUAL(b.x_m, back.x_m, 1e-12);
+  DOUBLES_EQUAL(b.y_m, back.y_m, 1e-12);
+  DOUBLES_EQUAL(b.yaw_rad, back.yaw_rad, 1e-12);
+  const Vec2 p(0.4, -0.1);
+  const Vec2 q = a.inverse_transform(a.transform(p));
+  DOUBLES_EQUAL(p.x(), q.x(), 1e-12);
+  DOUBLES_EQUAL(p.y(), q.y(), 1e-12);
+}
+
+TEST_GROUP(Scan){};
+
+TEST(Scan, PointsSkipInvalidAndApplyMount) {
+  LaserScanN<8> s;
+  CHECK_TRUE(s.reset(4, -kPi / 2, kPi / 2, 7));
+  s.ranges_m[0] = 1.0;
+  s.ranges_m[1] = 0.0;
+  s.ranges_m[2] = 2.0;
+  s.ranges_m[3] = std::numeric_limits<Real>::infinity();
+  ScanPoints pts;
+  std::size_t dropped = 99;
+  CHECK_EQUAL(2u, scan_to_points(s.view(), Pose2{0.1, 0.0, kPi / 2}, 0.0, 10.0, pts, &dropped));
+  CHECK_EQUAL(0u, dropped);
+  // Beam at -90° in a lidar turned +90° points along robot +x.
+  DOUBLES_EQUAL(1.1, pts[0].p_m.x(), 1e-12);
+  DOUBLES_EQUAL(0.0, pts[0].p_m.y(), 1e-12);
+  CHECK_EQUAL(2u, pts[1].index);
+  // Beam at +90° turned by +90° points along robot -x.
+  DOUBLES_EQUAL(-1.9, pts[1].p_m.x(), 1e-12);
+  DOUBLES_EQUAL(0.0, pts[1].p_m.y(), 1e-12);
+}
+
+TEST(Scan, ResetRefusesOversizedScan) {
+  LaserScanN<8> s;
+  CHECK_FALSE(s.reset(9, 0, 0.1, 0));
+  CHECK_EQUAL(0u, s.count);
+}
+
+TEST(Scan, FullTurnWraps) {
+  LaserScanN<360> s;
+  s.reset(360, -kPi, kTwoPi / 360, 0);
+  CHECK_TRUE(s.view().wraps());
+  s.reset(180, -kPi / 2, kTwoPi / 360, 0);
+  CHECK_FALSE(s.view().wraps());
+}
+
+TEST_GROUP(Profile){};
+
+TEST(Profile, BuiltinsExistAndFaceOutwards) {
+  for (std::size_t k = 0; kBuiltinProfileNames[k] != nullptr; ++k) {
+    DockProfile p;
+    CHECK_EQUAL(static_cast<int>(ProfileError::kOk), static_cast<int>(builtin_profile(kBuiltinProfileNames[k], p)));
+    STRCMP_EQUAL(kBuiltinProfileNames[k], p.name);
+    DOUBLES_EQUAL(0.30, p.width_m(), 0.15);
+  }
+  DockProfile plate;
+  builtin_profile("plate-v", plate);
+  CHECK_EQUAL(4u, plate.vertex_count);
+  DOUBLES_EQUAL(1.0, plate.normal(1).x(), 1e-12);  // the face looks along +x
+  DOUBLES_EQUAL(0.30 + 0.20, plate.length_m(), 1e-9);
+}
+
+TEST(Profile, BadProfilesAreRefusedAndLeaveOutputAlone) {
+  DockProfile p;
+  builtin_profile("plate-v", p);
+  const Vec2 one[] = {Vec2(0, 0)};
+  CHECK_EQUAL(static_cast<int>(ProfileError::kTooFewVertices), static_cast<int>(make_profile(one, 1, 0, "x", p)));
+  const Vec2 dup[] = {Vec2(0, 0), Vec2(0, 0.0005)};
+  CHECK_EQUAL(static_cast<int>(ProfileError::kDegenerateSegment), static_cast<int>(make_profile(dup, 2, 0, "x", p)));
+  const Vec2 nan[] = {Vec2(0, 0), Vec2(std::nan(""), 1)};
+  CHECK_EQUAL(static_cast<int>(ProfileError::kNotFinite), static_cast<int>(make_profile(nan, 2, 0, "x", p)));
+  CHECK_EQUAL(static_cast<int>(ProfileError::kUnknownName), static_cast<int>(builtin_profile("nope", p)));
+  STRCMP_EQUAL("plate-v", p.name);
+}
+
+TEST(Profile, ContactOffsetShiftsOrigin) {
+  const Vec2 v[] = {Vec2(0.05, -0.1), Vec2(0.05, 0.1)};
+  DockProfile p;
+  CHECK_EQUAL(static_cast<int>(ProfileError::kOk), static_cast<int>(make_profile(v, 2, 0.05, "flat", p)));
+  DOUBLES_EQUAL(0.0, p.vertices_m[0].x(), 1e-12);
+}

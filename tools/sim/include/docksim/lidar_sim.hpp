@@ -1,0 +1,74 @@
+#pragma once
+// 2D lidar simulator: raycasts a world of polylines from a lidar pose and applies a lidar model's sampling and noise.
+// Host-side (tools/), not core: uses std::vector freely. Deterministic for a given Rng seed.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "dockcore/dock_profile.hpp"
+#include "dockcore/geometry.hpp"
+#include "dockcore/laser_scan.hpp"
+#include "docksim/rng.hpp"
+
+namespace docksim {
+
+using dockcore::Pose2;
+using dockcore::Real;
+using dockcore::Vec2;
+
+/// One straight wall piece in world coordinates. Two-sided unless one_sided (then only hit from the side its
+/// outward normal (dy, -dx) faces, like a dock profile segment).
+struct Segment {
+  Vec2 a;
+  Vec2 b;
+  double reflectivity = 0.5;  ///< 0..1, scales the simulated intensity.
+  bool one_sided = false;
+};
+
+/// A 2D world: a bag of segments. Helpers add common objects.
+struct World {
+  std::vector<Segment> segments;
+
+  /// Adds the profile's polyline placed at dock_pose (dock frame -> world); segments are two-sided so the dock's
+  /// back and sides block rays like a solid object.
+  void add_dock(const dockcore::DockProfile& profile, const Pose2& dock_pose, double reflectivity = 0.8);
+  void add_polyline(const std::vector<Vec2>& pts, bool closed = false, double reflectivity = 0.5);
+  /// Axis-aligned in its own frame, rotated by yaw about its centre.
+  void add_box(const Vec2& centre, double size_x, double size_y, double yaw_rad, double reflectivity = 0.5);
+  /// A table leg / pole: a regular polygon approximating a circle.
+  void add_circle(const Vec2& centre, double radius, int sides = 12, double reflectivity = 0.5);
+
+  /// Nearest hit of the ray origin + t*dir (dir unit), t in (0, max_range]; returns false when nothing is hit.
+  bool raycast(const Vec2& origin, const Vec2& dir, double max_range, double* range_out,
+               double* reflectivity_out = nullptr) const;
+};
+
+/// How a lidar samples and what its errors look like.
+struct LidarModel {
+  std::string name = "ld06";
+  double rate_hz = 10.0;                 ///< Scan rate.
+  double angle_min_rad = -dockcore::kPi; ///< First beam.
+  double angle_increment_rad = 0.8 * dockcore::kPi / 180.0;
+  std::size_t beams = 450;               ///< Samples per scan (<= dockcore::kMaxScanPoints).
+  double min_range_m = 0.02;             ///< Blind zone: closer hits read as "no return" (0).
+  double max_range_m = 12.0;             ///< Farther hits read as 0.
+  double sigma_const_m = 0.010;          ///< Range noise, constant part (1 sigma).
+  double sigma_prop = 0.0;               ///< Range noise proportional to range (1 sigma per metre).
+  double dropout_prob = 0.0;             ///< Chance a valid return is lost.
+  double angular_jitter_rad = 0.0;       ///< 1-sigma error of the true beam angle (the reported angle stays nominal).
+  bool mixed_pixels = true;              ///< Beams straddling a depth edge may return a range between the two.
+  double beam_divergence_rad = 0.3 * dockcore::kPi / 180.0;  ///< Footprint width used for mixed pixels.
+};
+
+/// Built-in models: "ld06" (LD06/LD19: 4500 pts/s, 10 Hz, 0.8°), "rplidar-a1" (~1°, 5.5 Hz, 360 pts), "industrial"
+/// (0.25°, 25 Hz, 270° field of view). Returns false for an unknown name.
+bool lidar_model(const std::string& name, LidarModel* out);
+/// Names of the built-in models.
+std::vector<std::string> lidar_model_names();
+
+/// Simulates one scan of `world` from `lidar_pose` (lidar frame in world). Beam i has nominal angle
+/// angle_min + i*increment in the lidar frame. Ranges outside [min,max] or dropped are 0.
+void simulate_scan(const World& world, const Pose2& lidar_pose, const LidarModel& model, Rng& rng,
+                   dockcore::LaserScan* out, std::uint64_t stamp_us = 0);
+
+}  // namespace docksim
