@@ -39,8 +39,13 @@ struct World {
   void add_circle(const Vec2& centre, double radius, int sides = 12, double reflectivity = 0.5);
 
   /// Nearest hit of the ray origin + t*dir (dir unit), t in (0, max_range]; returns false when nothing is hit.
+  /// One-sided segments are skipped when the ray meets them from behind (dot(dir, outward normal) >= 0).
+  /// Cost O(segments) with a two-cross-product rejection per segment.
   bool raycast(const Vec2& origin, const Vec2& dir, double max_range, double* range_out,
                double* reflectivity_out = nullptr) const;
+  /// As raycast, also reporting the hit segment's index (into segments) when segment_out is not null.
+  bool raycast_segment(const Vec2& origin, const Vec2& dir, double max_range, double* range_out,
+                       std::size_t* segment_out) const;
 };
 
 /// How a lidar samples and what its errors look like.
@@ -58,6 +63,17 @@ struct LidarModel {
   double angular_jitter_rad = 0.0;       ///< 1-sigma error of the true beam angle (the reported angle stays nominal).
   bool mixed_pixels = true;              ///< Beams straddling a depth edge may return a range between the two.
   double beam_divergence_rad = 0.3 * dockcore::kPi / 180.0;  ///< Footprint width used for mixed pixels.
+  /// Mixed pixels: three sub-rays at -div/2, 0, +div/2 around the true beam angle. When all three hit, their
+  /// ranges span more than mixed_pixel_threshold_m and they straddle a depth discontinuity (two of them hit
+  /// segments that are neither the same nor share an endpoint, so an oblique wall or a corner does not count), then
+  /// with probability mixed_pixel_prob the beam returns near + u*(far - near), u uniform in [0,1); otherwise (and
+  /// always when a sub-ray misses) the centre ray's range.
+  double mixed_pixel_threshold_m = 0.03;
+  double mixed_pixel_prob = 0.5;          ///< See mixed_pixel_threshold_m.
+  /// Intensity = intensity_scale * reflectivity * |cos(incidence)| / (1 + (range / intensity_ref_range_m)^2),
+  /// 0 for no return. A plain falloff model: detectors should only rely on "brighter surface -> larger value".
+  double intensity_scale = 255.0;
+  double intensity_ref_range_m = 4.0;     ///< Range at which the intensity falls to half its near value.
 };
 
 /// Built-in models: "ld06" (LD06/LD19: 4500 pts/s, 10 Hz, 0.8°), "rplidar-a1" (~1°, 5.5 Hz, 360 pts), "industrial"
@@ -68,6 +84,11 @@ std::vector<std::string> lidar_model_names();
 
 /// Simulates one scan of `world` from `lidar_pose` (lidar frame in world). Beam i has nominal angle
 /// angle_min + i*increment in the lidar frame. Ranges outside [min,max] or dropped are 0.
+/// Per beam, in this order: true angle = nominal + angular_jitter * N(0,1); ray cast (with mixed pixels, see
+/// LidarModel); range noise N(0, sqrt(sigma_const^2 + (sigma_prop*range)^2)) (independent sources add in
+/// quadrature); the noisy range is then 0 when < min_range_m or > max_range_m; then dropout. Intensities as
+/// documented on LidarModel. model.beams above dockcore::kMaxScanPoints are truncated to it.
+/// Cost O(beams * segments near each beam): segments are transformed once per scan and bucketed by bearing.
 void simulate_scan(const World& world, const Pose2& lidar_pose, const LidarModel& model, Rng& rng,
                    dockcore::LaserScan* out, std::uint64_t stamp_us = 0);
 
