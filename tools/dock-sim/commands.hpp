@@ -1,0 +1,14 @@
+#pragma once
+// dock-sim subcommands. Each lives in its own file and registers itself on the CLI11 app; main.cpp only wires them.
+#include <CLI/CLI.hpp>
+
+namespace docksim_cli {
+
+/// `dock-sim perception`: detector accuracy / false-positive / cost benchmark (perception.cpp).
+void register_perception(CLI::App& app);
+/// `dock-sim detect`: run the detectors on recorded scans (detect.cpp).
+void register_detect(CLI::App& app);
+/// `dock-sim scene`: simulate one scene, detect the dock, print the pose and draw an SVG (scene.cpp).
+void register_scene(CLI::App& app);
+
+}  // namespace docksim_cli
