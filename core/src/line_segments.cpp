@@ -23,6 +23,18 @@ struct Moments {
     sxy += d.x() * d.y() * w;
     syy += d.y() * d.y() * w;
   }
+  /// Inverse of add_point for a point known to be in the set (n >= 2).
+  void remove_point(const Vec2& p) {
+    const Real n_new = static_cast<Real>(n - 1);
+    const Vec2 c_new = (c * static_cast<Real>(n) - p) / n_new;
+    const Vec2 d = p - c_new;
+    const Real w = n_new / static_cast<Real>(n);
+    sxx -= d.x() * d.x() * w;
+    sxy -= d.x() * d.y() * w;
+    syy -= d.y() * d.y() * w;
+    c = c_new;
+    --n;
+  }
 };
 
 Moments combine(const Moments& a, const Moments& b) {
@@ -51,6 +63,14 @@ void principal_axis(const Moments& m, Vec2& dir, Real& mean_sq_residual) {
   mean_sq_residual = m.n > 0 && lambda_min > 0 ? lambda_min / static_cast<Real>(m.n) : static_cast<Real>(0);
   const Real theta = static_cast<Real>(0.5) * std::atan2(static_cast<Real>(2) * m.sxy, m.sxx - m.syy);
   dir = Vec2(std::cos(theta), std::sin(theta));
+}
+
+/// Orthogonal distance of p from the TLS line of m.
+Real distance_to_fit(const Moments& m, const Vec2& p) {
+  Vec2 dir;
+  Real msr = 0;
+  principal_axis(m, dir, msr);
+  return std::fabs(dir.x() * (p.y() - m.c.y()) - dir.y() * (p.x() - m.c.x()));
 }
 
 Real rms_of(const Moments& m) {
@@ -88,13 +108,6 @@ Moments moments_over(const RotatedPoints& rp, std::size_t lo, std::size_t hi) {
     m.syy += d.y() * d.y();
   }
   return m;
-}
-
-Real angle_between_lines(const Vec2& a, const Vec2& b) {
-  // Lines, not rays: directions a and -a are the same line.
-  const Real cross = std::fabs(a.x() * b.y() - a.y() * b.x());
-  const Real dot = std::fabs(a.dot(b));
-  return std::atan2(cross, dot);
 }
 
 /// A run of positions [lo, hi] with the moments of the points that its fit uses.
@@ -175,27 +188,45 @@ class Extractor {
       ++stats_.rejected_short;
       return;
     }
-    // A piece that starts on the previous piece's last point (a split corner) shares it; keep the exclusive
-    // moments for merging so the shared point is not counted twice, and add it back for a standalone fit.
+    // A piece that starts on the previous piece's last point (a split corner) shares it. Merging uses the piece's
+    // exclusive moments so the point is not counted twice.
     const bool shared = has_pending_ && lo == pending_.hi;
-    Piece p;
-    p.lo = lo;
-    p.hi = hi;
+    const Vec2 corner = rp_.at(lo);
     const Moments excl = moments_over(rp_, shared ? lo + 1 : lo, hi);
-    p.m = excl;
-    if (shared) p.m.add_point(rp_.at(lo));
 
     if (has_pending_ && lo <= pending_.hi + params_.merge_max_skipped_points + 1) {
-      Vec2 dir_a;
-      Vec2 dir_b;
-      Real msr = 0;
-      principal_axis(pending_.m, dir_a, msr);
-      principal_axis(p.m, dir_b, msr);
+      // Collinear = the combined fit explains both pieces as well as noise allows. No angle test: pieces that
+      // IEPF cuts out of a noisy wall (3-5 points between two spikes) zig-zag by up to ~70°, yet belong to it.
       const Moments merged = combine(pending_.m, excl);
-      if (angle_between_lines(dir_a, dir_b) <= params_.merge_angle_rad && rms_of(merged) <= params_.merge_max_rms_m) {
+      if (rms_of(merged) <= params_.merge_max_rms_m) {
         pending_.m = merged;
         pending_.hi = hi;
         return;
+      }
+    }
+    Piece p;
+    p.lo = lo;
+    p.hi = hi;
+    p.m = excl;
+    if (shared) {
+      // Not merged: give the corner point to the side whose line (fitted without it) it lies closer to, so a
+      // corner sample does not bend the other side's fit. It stays shared only when a side would drop below
+      // min_points without it (a surface seen with 3 returns at grazing incidence keeps its corner).
+      const std::uint32_t min_n = params_.min_points;
+      Moments pend_excl = pending_.m;
+      const bool pend_can_lose = pend_excl.n > min_n && pend_excl.n >= 3;
+      if (pend_can_lose) pend_excl.remove_point(corner);
+      const bool leaf_can_lose = excl.n >= min_n && excl.n >= 2;
+      const bool to_leaf = pend_can_lose && (!leaf_can_lose || (excl.n >= 2 && distance_to_fit(excl, corner) <
+                                                                                   distance_to_fit(pend_excl, corner)));
+      if (to_leaf) {
+        pending_.m = pend_excl;
+        pending_.hi = lo - 1;
+        p.m.add_point(corner);
+      } else if (leaf_can_lose) {
+        p.lo = lo + 1;
+      } else {
+        p.m.add_point(corner);  // both keep it
       }
     }
     flush();
@@ -256,6 +287,31 @@ bool is_break(const ScanPoint& a, const ScanPoint& b, Real inc_abs, const Segmen
   return (b.p_m - a.p_m).squaredNorm() > thr * thr;
 }
 
+/// Clusters the points in rotated order from `start` and extracts each cluster's segments into `out`.
+void run_clusters(const ScanPoints& points, std::size_t start, Real angle_increment_rad, const SegmentParams& params,
+                  LineSegments& out, SegmentStats& stats) {
+  const std::size_t n = points.size();
+  const Real inc_abs = std::fabs(angle_increment_rad);
+  const RotatedPoints rp{points, start, n};
+  Extractor ex(rp, angle_increment_rad, params, out, stats);
+  std::size_t cluster_lo = 0;
+  for (std::size_t pos = 1; pos <= n; ++pos) {
+    const bool end_here = pos == n || is_break(points[rp.index(pos - 1)], points[rp.index(pos)], inc_abs, params);
+    if (!end_here) continue;
+    if (stats.clusters >= params.max_clusters) {
+      ++stats.clusters_dropped;
+    } else {
+      const std::uint32_t id = stats.clusters++;
+      if (pos - cluster_lo >= params.min_points) {
+        ex.process_cluster(cluster_lo, pos - 1, id);
+      } else {
+        ++stats.rejected_short;
+      }
+    }
+    cluster_lo = pos;
+  }
+}
+
 }  // namespace
 
 bool fit_line_tls(const Vec2* points_m, std::size_t count, LineFit& fit) {
@@ -294,6 +350,7 @@ SegmentStats extract_line_segments(const ScanPoints& points, Real angle_incremen
   // points, start right after some gap so that no cluster is cut at index 0; a contour with no gap at all (a closed
   // room) is cut at its widest step.
   std::size_t start = 0;
+  bool closed = false;
   if (wraps && !is_break(points[n - 1], points[0], inc_abs, params)) {
     stats.wrapped = true;
     bool found_gap = false;
@@ -304,6 +361,7 @@ SegmentStats extract_line_segments(const ScanPoints& points, Real angle_incremen
         break;
       }
     }
+    closed = !found_gap;
     if (!found_gap) {
       Real widest = -1;
       for (std::size_t i = 0; i < n; ++i) {
@@ -317,23 +375,16 @@ SegmentStats extract_line_segments(const ScanPoints& points, Real angle_incremen
     }
   }
 
-  const RotatedPoints rp{points, start, n};
-  Extractor ex(rp, angle_increment_rad, params, out, stats);
-  std::size_t cluster_lo = 0;
-  for (std::size_t pos = 1; pos <= n; ++pos) {
-    const bool end_here = pos == n || is_break(points[rp.index(pos - 1)], points[rp.index(pos)], inc_abs, params);
-    if (!end_here) continue;
-    if (stats.clusters >= params.max_clusters) {
-      ++stats.clusters_dropped;
-    } else {
-      const std::uint32_t id = stats.clusters++;
-      if (pos - cluster_lo >= params.min_points) {
-        ex.process_cluster(cluster_lo, pos - 1, id);
-      } else {
-        ++stats.rejected_short;
-      }
-    }
-    cluster_lo = pos;
+  run_clusters(points, start, angle_increment_rad, params, out, stats);
+  if (closed && out.size() >= 2) {
+    // A closed contour (no gap anywhere) was cut at its widest step, which may fall inside a wall and leave that wall
+    // in two pieces at the ends of the list. The first piece ends at a split point — a corner — so cut just after it instead.
+    const std::size_t corner = out[0].last + 1 == n ? 0 : out[0].last + 1;
+    out.clear();
+    const bool wrapped = stats.wrapped;
+    stats = SegmentStats{};
+    stats.wrapped = wrapped;
+    run_clusters(points, corner, angle_increment_rad, params, out, stats);
   }
   return stats;
 }

@@ -9,7 +9,7 @@
 ///  2. Split (iterative end-point fit) inside each cluster, driven by an explicit fixed-capacity stack (no recursion):
 ///     a range is split at the point farthest from its end-to-end chord while that distance exceeds split_threshold_m.
 ///  3. Each resulting range is refit by total least squares (orthogonal regression, closed-form 2x2 eigen solution).
-///  4. Adjacent collinear pieces of the same cluster are merged (angle and combined-fit RMS tests) and refit.
+///  4. Adjacent pieces of the same cluster that one line fits within noise (combined-fit RMS) are merged.
 ///
 /// Used by the V-marker detector and as generic features by the dock pose estimator; nothing here is dock-specific.
 
@@ -41,7 +41,9 @@ struct LineSegment {
   std::uint32_t first = 0;       ///< Index into the point set of the first point. When the segment straddles index 0
                                  ///< of a wrapping scan, first > last and the points are first..n-1, 0..last.
   std::uint32_t last = 0;        ///< Index into the point set of the last point (inclusive).
-  std::uint32_t point_count = 0; ///< Points used in the fit. Neighbouring segments split at a corner share it.
+  std::uint32_t point_count = 0; ///< Points used in the fit (skipped spikes between merged pieces excluded). A
+                                 ///< corner sample goes to the side it fits best; it is shared by both neighbours
+                                 ///< only when one would otherwise have fewer than min_points.
   std::uint32_t cluster = 0;     ///< Cluster ordinal (0, 1, ... in output order); segments of one cluster are
                                  ///< contiguous in the scan with no range gap between them.
 
@@ -80,9 +82,9 @@ struct SegmentParams {
   std::uint32_t min_points = 3;
   /// Shortest segment kept (after merging). Shorter pieces are usually noise around corners or mixed pixels.
   Real min_length_m = static_cast<Real>(0.04);
-  /// Merge two adjacent pieces of a cluster only if their fitted directions differ by at most this much...
-  Real merge_angle_rad = deg_to_rad(static_cast<Real>(10));
-  /// ...and the combined fit's RMS is at most this (1.5σ): catches splits caused by a single noisy point.
+  /// Merge two adjacent pieces of a cluster when one line fits both with an RMS of at most this (1.5σ). This is the
+  /// collinearity test: a corner between two 0.2 m pieces bent by more than ~17° (1 m pieces: ~3.5°) exceeds it.
+  /// There is deliberately no angle test: the short pieces that noise spikes cut out of a wall point anywhere.
   Real merge_max_rms_m = static_cast<Real>(0.015);
   /// Pieces may merge across this many skipped points (pieces too small to keep): a single noise spike or a mixed
   /// pixel splits a wall into two pieces and two 2-point crumbs; the merged fit leaves the skipped points out.
@@ -113,8 +115,11 @@ struct SegmentStats {
 /// scan covers a full turn (ScanView::wraps()), so the last and first points may be neighbours.
 /// Output: `out` is cleared, then filled in circular scan order — consecutive segments are consecutive in the scan;
 /// on a wrapping scan the list starts at the first cluster after a gap. Never fails; caps are reported in the result.
-/// Cost: O(n) clustering + O(n · d) splitting (d = split depth, ≤ log-ish for real contours, capped by
-/// max_split_iterations) + O(n) fitting and merging. Stack use ~1.5 KB besides `out`.
+/// A contour with no gap at all (a full turn inside a closed room) is first cut at its widest step, then processed
+/// again cut at the first corner found, so no wall is split by the cut; that case costs two passes.
+/// Cost: O(n) clustering + O(n · d) splitting (d = split nesting depth, ~log(segments) for real contours, at most
+/// max_split_iterations pops in all) + O(n) fitting and merging; ×2 for a closed contour. Stack use ~1 KB besides
+/// `out`.
 SegmentStats extract_line_segments(const ScanPoints& points, Real angle_increment_rad, bool wraps,
                                    const SegmentParams& params, LineSegments& out);
 
