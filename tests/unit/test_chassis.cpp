@@ -95,7 +95,9 @@ Pose2 pose_for_pad(const Pose2& dock, double press, double lateral, double yaw_e
   const double pad_wy = static_cast<double>(dock.y_m) + std::sin(static_cast<double>(dock.yaw_rad)) * -press +
                         std::cos(static_cast<double>(dock.yaw_rad)) * lateral;
   const double yaw = static_cast<double>(dock.yaw_rad) + kPi + yaw_err;
-  return Pose2{pad_wx - std::cos(yaw) * pad_x_body, pad_wy - std::sin(yaw) * pad_x_body, yaw};
+  using dockcore::Real;
+  return Pose2{static_cast<Real>(pad_wx - std::cos(yaw) * pad_x_body),
+               static_cast<Real>(pad_wy - std::sin(yaw) * pad_x_body), static_cast<Real>(yaw)};
 }
 
 }  // namespace

@@ -170,7 +170,6 @@ Chassis::Chassis(const ChassisParams& params, std::uint64_t seed) : p_(params), 
   for (std::size_t i = 0; i < kMaxWheels; ++i) odom_last_counts_[i] = p_.noise.encoder_initial_count;
   state_.wheel_count = n_;
   publish_reported();
-  state_.battery_soc = battery_.soc();
 }
 
 void Chassis::command_wheels(const WheelRadps& wheel_radps) {

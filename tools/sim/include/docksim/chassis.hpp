@@ -134,6 +134,13 @@ struct ContactParams {
 };
 
 /// Where the dock is. The dock face is the line x = 0 of the dock frame, |y| <= face_half_width_m.
+///
+/// Contact model: only the pads' centre point touches the dock (the rest of the footprint is assumed to fit the
+/// dock's recess). Coming from the front within the face width, the pads may travel press_limit_m past x = 0 (spring
+/// contacts); a step that would take them further is cut short exactly at that stop, and while pressed the robot
+/// neither slides along the face nor turns (friction, pads seated in the contacts) — only motion that takes the pads
+/// back off the face is free. So a robot that arrives misaligned stays misaligned until it backs off.
+/// Outside the face width the robot passes by (the dock's sides are not modelled).
 struct DockPlacement {
   Pose2 pose_world;                ///< Dock frame in the world.
   double face_half_width_m = 0.15; ///< Half-width of the face that stops the robot.
@@ -179,12 +186,14 @@ struct ChassisState {
 
   // Ground truth.
   Pose2 true_pose;                   ///< Body frame in the world.
-  BodyTwist true_twist;              ///< Actual body velocity over the last step (after slip and contact).
+  BodyTwist true_twist;              ///< Mean body velocity over the last step (after slip and the hard stop).
   WheelRadps wheel_target_radps{};   ///< Command in force this step (after latency, timeout, deadband, saturation).
   WheelRadps wheel_true_radps{};     ///< Actual wheel angular velocity at the end of the step.
-  bool stalled = false;              ///< Pushing against the dock's hard stop; wheels blocked.
-  bool at_hard_stop = false;         ///< The dock face constrained the motion this step.
-  double press_m = 0;                ///< Pad penetration past the contact plane (dock x < 0 → positive); 0 if no dock.
+  bool stalled = false;              ///< Pushing against the dock's hard stop; wheels blocked (measured ω ≈ 0).
+  bool at_hard_stop = false;         ///< The dock face cut this step's motion short.
+  /// Pad travel past the contact plane, m: −(pad x in the dock frame). Negative = still this far in front of the
+  /// contacts; at most press_limit_m while the hard stop holds. 0 without a dock.
+  double press_m = 0;
   double pad_lateral_m = 0;          ///< Pad centre's y in the dock frame.
   double pad_yaw_error_rad = 0;      ///< Pad heading versus facing the dock squarely, wrapped.
   bool contact = false;              ///< Charging contacts closed (within every tolerance).
