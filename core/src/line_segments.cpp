@@ -65,14 +65,6 @@ void principal_axis(const Moments& m, Vec2& dir, Real& mean_sq_residual) {
   dir = Vec2(std::cos(theta), std::sin(theta));
 }
 
-/// Orthogonal distance of p from the TLS line of m.
-Real distance_to_fit(const Moments& m, const Vec2& p) {
-  Vec2 dir;
-  Real msr = 0;
-  principal_axis(m, dir, msr);
-  return std::fabs(dir.x() * (p.y() - m.c.y()) - dir.y() * (p.x() - m.c.x()));
-}
-
 Real rms_of(const Moments& m) {
   Vec2 dir;
   Real msr = 0;
@@ -114,6 +106,7 @@ Moments moments_over(const RotatedPoints& rp, std::size_t lo, std::size_t hi) {
 struct Piece {
   std::size_t lo = 0;
   std::size_t hi = 0;
+  std::size_t contig_lo = 0;  // [contig_lo, hi] are all in m (merges across skipped points break contiguity)
   Moments m;
 };
 
@@ -189,9 +182,8 @@ class Extractor {
       return;
     }
     // A piece that starts on the previous piece's last point (a split corner) shares it. Merging uses the piece's
-    // exclusive moments so the point is not counted twice.
+    // exclusive moments so the point is not counted twice; otherwise place_corner decides where the boundary goes.
     const bool shared = has_pending_ && lo == pending_.hi;
-    const Vec2 corner = rp_.at(lo);
     const Moments excl = moments_over(rp_, shared ? lo + 1 : lo, hi);
 
     if (has_pending_ && lo <= pending_.hi + params_.merge_max_skipped_points + 1) {
@@ -199,6 +191,9 @@ class Extractor {
       // IEPF cuts out of a noisy wall (3-5 points between two spikes) zig-zag by up to ~70°, yet belong to it.
       const Moments merged = combine(pending_.m, excl);
       if (rms_of(merged) <= params_.merge_max_rms_m) {
+        // Points strictly between the pieces (skipped crumbs) are not in the moments, so only the new piece's
+        // part is a contiguous tail that corner refinement may later move.
+        if (lo > pending_.hi + 1) pending_.contig_lo = lo;
         pending_.m = merged;
         pending_.hi = hi;
         return;
@@ -208,30 +203,78 @@ class Extractor {
     p.lo = lo;
     p.hi = hi;
     p.m = excl;
-    if (shared) {
-      // Not merged: give the corner point to the side whose line (fitted without it) it lies closer to, so a
-      // corner sample does not bend the other side's fit. It stays shared only when a side would drop below
-      // min_points without it (a surface seen with 3 returns at grazing incidence keeps its corner).
-      const std::uint32_t min_n = params_.min_points;
-      Moments pend_excl = pending_.m;
-      const bool pend_can_lose = pend_excl.n > min_n && pend_excl.n >= 3;
-      if (pend_can_lose) pend_excl.remove_point(corner);
-      const bool leaf_can_lose = excl.n >= min_n && excl.n >= 2;
-      const bool to_leaf = pend_can_lose && (!leaf_can_lose || (excl.n >= 2 && distance_to_fit(excl, corner) <
-                                                                                   distance_to_fit(pend_excl, corner)));
-      if (to_leaf) {
-        pending_.m = pend_excl;
-        pending_.hi = lo - 1;
-        p.m.add_point(corner);
-      } else if (leaf_can_lose) {
-        p.lo = lo + 1;
-      } else {
-        p.m.add_point(corner);  // both keep it
-      }
-    }
+    p.contig_lo = shared ? lo + 1 : lo;
+    if (shared) place_corner(lo, p);
     flush();
+    if (p.contig_lo > p.lo) p.contig_lo = p.lo;
     pending_ = p;
     has_pending_ = true;
+  }
+
+  /// Places the boundary between the pending piece (which ends on split point k) and the new piece `p` (holding
+  /// k+1..hi). The split point is only the sample farthest from a chord; with noise it is often a neighbour of the
+  /// true corner, and a sample of one side left in the other's fit tilts it by ~(spacing·lever)/(n·L²/12) — degrees
+  /// for a 0.2 m side. So try every boundary within corner_refine_points of k and keep the one with the smallest
+  /// total squared residual; moments are moved one point at a time, O(1) each. Both sides must keep min_points; if
+  /// no boundary allows that, k is shared by both (a side seen with min_points returns at grazing incidence).
+  void place_corner(std::size_t k, Piece& p) {
+    const std::size_t min_n = params_.min_points > 2 ? params_.min_points : 2;
+    const std::size_t reach = params_.corner_refine_points;
+    const auto cost = [](const Moments& a, const Moments& b) {
+      Vec2 dir;
+      Real msr_a = 0;
+      Real msr_b = 0;
+      principal_axis(a, dir, msr_a);
+      principal_axis(b, dir, msr_b);
+      return msr_a * static_cast<Real>(a.n) + msr_b * static_cast<Real>(b.n);
+    };
+    bool have = false;
+    Real best_cost = 0;
+    std::size_t best_e = k;  // last position of the pending piece
+    // Boundary at k and further left: pending gives up its tail to p.
+    Moments a = pending_.m;
+    Moments b = p.m;
+    for (std::size_t e = k;; --e) {
+      if (a.n >= min_n && b.n >= min_n) {
+        const Real c = cost(a, b);
+        if (!have || c < best_cost) {
+          have = true;
+          best_cost = c;
+          best_e = e;
+        }
+      }
+      if (k - e >= reach || e <= pending_.contig_lo || e <= pending_.lo || a.n <= min_n) break;
+      a.remove_point(rp_.at(e));
+      b.add_point(rp_.at(e));
+    }
+    // Boundary right of k: p gives up its head to pending.
+    a = pending_.m;
+    b = p.m;
+    for (std::size_t e = k + 1; e - k <= reach && e < p.hi && b.n > min_n; ++e) {
+      b.remove_point(rp_.at(e));
+      a.add_point(rp_.at(e));
+      const Real c = cost(a, b);
+      if (!have || c < best_cost) {
+        have = true;
+        best_cost = c;
+        best_e = e;
+      }
+    }
+    if (!have) {
+      p.m.add_point(rp_.at(k));  // k shared by both
+      p.lo = k;
+      return;
+    }
+    for (std::size_t e = k; e > best_e; --e) {
+      pending_.m.remove_point(rp_.at(e));
+      p.m.add_point(rp_.at(e));
+    }
+    for (std::size_t e = k + 1; e <= best_e; ++e) {
+      p.m.remove_point(rp_.at(e));
+      pending_.m.add_point(rp_.at(e));
+    }
+    pending_.hi = best_e;
+    p.lo = best_e + 1;
   }
 
   /// Emits the pending piece as a segment if it is long enough.

@@ -50,6 +50,18 @@ Arm make_arm(const LineSegment& s, const Vec2& apex) {
   return a;
 }
 
+/// Mean distance between an arm's samples along its line.
+Real mean_spacing(const LineSegment& s) {
+  return s.point_count > 1 ? s.length_m() / static_cast<Real>(s.point_count - 1) : static_cast<Real>(0);
+}
+
+/// Fisher information of an arm's direction, up to a constant: spread along the line (n·L²/12 for evenly spaced
+/// points) over the residual variance.
+Real arm_information(const LineSegment& s, Real length_m, Real rms_floor_m) {
+  const Real rms = s.rms_m > rms_floor_m ? s.rms_m : rms_floor_m;
+  return static_cast<Real>(s.point_count) * length_m * length_m / (rms * rms);
+}
+
 }  // namespace
 
 const char* to_string(VMarkerError e) {
@@ -117,8 +129,9 @@ VMarkerError VMarkerDetector::configure(const VMarkerParams& params) {
   if (e == VMarkerError::kOk) {
     const bool ok = finite_pos(params.angle_tolerance_rad) && finite_nonneg(params.arm_length_tolerance_m) &&
                     finite_nonneg(params.min_arm_fraction) && params.min_arm_fraction <= 1 &&
-                    finite_pos(params.max_apex_gap_m) && finite_pos(params.max_arm_rms_m) && params.pair_span >= 1 &&
-                    finite_pos(params.hint_gate_m);
+                    finite_pos(params.max_apex_gap_m) && finite_nonneg(params.apex_gap_spacing_factor) && finite_pos(params.max_arm_rms_m) && params.pair_span >= 1 &&
+                    finite_pos(params.hint_gate_m) && finite_pos(params.max_apex_distance_m) &&
+                    std::isfinite(params.min_score) && params.min_score <= 1;
     if (!ok) e = VMarkerError::kBadParams;
   }
   error_ = e;
@@ -161,19 +174,26 @@ VMarkerDetection VMarkerDetector::detect(const LineSegment* segments, std::size_
       if (std::fabs(det) < min_sin) continue;
       const Vec2 apex((sa.offset_m * sb.normal.y() - sb.offset_m * sa.normal.y()) / det,
                       (sa.normal.x() * sb.offset_m - sb.normal.x() * sa.offset_m) / det);
+      if (apex.norm() > p.max_apex_distance_m) continue;
       const Arm a = make_arm(sa, apex);
       const Arm b = make_arm(sb, apex);
       if (a.length_m <= 0 || b.length_m <= 0) continue;
-      const Real gap = a.gap_m > b.gap_m ? a.gap_m : b.gap_m;
-      if (gap > p.max_apex_gap_m) continue;
+      // The true corner lies between samples: an arm's nearest sample can be up to one sample spacing short of it
+      // (8 cm on a 75°-incidence arm at 1.5 m with 0.8° steps), so each arm is allowed its own spacing on top.
+      const Real allow_a = p.max_apex_gap_m + p.apex_gap_spacing_factor * mean_spacing(sa);
+      const Real allow_b = p.max_apex_gap_m + p.apex_gap_spacing_factor * mean_spacing(sb);
+      if (a.gap_m > allow_a || b.gap_m > allow_b) continue;
+      const Real gap_ratio_a = a.gap_m / allow_a;
+      const Real gap_ratio_b = b.gap_m / allow_b;
+      const Real gap_ratio = gap_ratio_a > gap_ratio_b ? gap_ratio_a : gap_ratio_b;
       // Concave from the viewer: each arm's visible face (its normal) looks at the other arm. A convex box corner
       // has the faces looking away from each other.
       if (!(sa.normal.dot(b.u) > 0) || !(sb.normal.dot(a.u) > 0)) continue;
       const Real angle = angle_between(a.u, b.u);
       const Real angle_err = std::fabs(angle - g.notch_angle_rad);
       if (angle_err > p.angle_tolerance_rad) continue;
-      const Vec2 bis = (a.u + b.u).normalized();
-      const bool a_right = cross2(bis, a.u) < 0;
+      const Vec2 plain_bis = (a.u + b.u).normalized();
+      const bool a_right = cross2(plain_bis, a.u) < 0;
       const Arm& right = a_right ? a : b;
       const Arm& left = a_right ? b : a;
       const LineSegment& s_right = a_right ? sa : sb;
@@ -189,9 +209,23 @@ VMarkerDetection VMarkerDetector::detect(const LineSegment* segments, std::size_
       }
       if (!lengths_ok) continue;
       const Real rms_max = s_right.rms_m > s_left.rms_m ? s_right.rms_m : s_left.rms_m;
-      const Real e_sum = clamp01(angle_err / p.angle_tolerance_rad) + clamp01(gap / p.max_apex_gap_m) +
+      const Real e_sum = clamp01(angle_err / p.angle_tolerance_rad) + clamp01(gap_ratio) +
                          clamp01(rms_max / p.max_arm_rms_m);
       const Real score = visibility * (1 - e_sum / static_cast<Real>(3));
+      if (score < p.min_score) continue;
+      Vec2 bis = plain_bis;
+      if (p.weight_arms_by_information) {
+        // Right arm = bisector turned clockwise by half the notch: turning it back gives a bisector estimate.
+        const Real half = g.notch_angle_rad * static_cast<Real>(0.5);
+        const Real c = std::cos(half);
+        const Real sn = std::sin(half);
+        const Vec2 from_right(c * right.u.x() - sn * right.u.y(), sn * right.u.x() + c * right.u.y());
+        const Vec2 from_left(c * left.u.x() + sn * left.u.y(), -sn * left.u.x() + c * left.u.y());
+        const Real w_right = arm_information(s_right, right.length_m, p.weight_rms_floor_m);
+        const Real w_left = arm_information(s_left, left.length_m, p.weight_rms_floor_m);
+        const Vec2 sum = from_right * w_right + from_left * w_left;
+        if (sum.norm() > 0) bis = sum.normalized();
+      }
 
       VMarkerDetection c;
       c.found = true;

@@ -41,9 +41,10 @@ struct LineSegment {
   std::uint32_t first = 0;       ///< Index into the point set of the first point. When the segment straddles index 0
                                  ///< of a wrapping scan, first > last and the points are first..n-1, 0..last.
   std::uint32_t last = 0;        ///< Index into the point set of the last point (inclusive).
-  std::uint32_t point_count = 0; ///< Points used in the fit (skipped spikes between merged pieces excluded). A
-                                 ///< corner sample goes to the side it fits best; it is shared by both neighbours
-                                 ///< only when one would otherwise have fewer than min_points.
+  std::uint32_t point_count = 0; ///< Points used in the fit (skipped spikes between merged pieces excluded).
+                                 ///< Neighbours are disjoint (corner refinement puts the boundary where the fits
+                                 ///< are best) except when a side would have fewer than min_points: then they share
+                                 ///< the corner sample.
   std::uint32_t cluster = 0;     ///< Cluster ordinal (0, 1, ... in output order); segments of one cluster are
                                  ///< contiguous in the scan with no range gap between them.
 
@@ -77,6 +78,10 @@ struct SegmentParams {
   /// Split a range while some point is farther than this from its chord. 0.03 m = 3σ of LD06 noise: a straight
   /// wall of ~100 points is rarely split by noise, and corners whose sides are longer than ~6 cm are found.
   Real split_threshold_m = static_cast<Real>(0.03);
+  /// After a split, the boundary between the two sides may move this many samples either way to where the two line
+  /// fits leave the least squared residual (the split sample is only the one farthest from a chord; with noise it is
+  /// often the true corner's neighbour, and one foreign sample tilts a 0.2 m side by degrees). O(1) per step.
+  std::uint32_t corner_refine_points = 2;
   /// Fewest points a segment may have. 3: at 0.8° a 0.2 m surface at 1.5 m and 75° incidence only gets 3 returns;
   /// consumers that need more weight should filter on point_count / rms_m.
   std::uint32_t min_points = 3;

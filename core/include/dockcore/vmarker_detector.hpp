@@ -55,15 +55,20 @@ VMarkerGeometry symmetric_vmarker_geometry(Real notch_angle_rad, Real arm_length
 /// Detector thresholds. Defaults suit an LD06-class lidar (0.8°, σ ≈ 10 mm) at 0.3-2 m from the marker.
 struct VMarkerParams {
   VMarkerGeometry geometry;
-  /// |measured notch angle - expected| must not exceed this. 10°: two noisy arm fits at 1.5 m disagree by a few
-  /// degrees; a room corner that is 90° ± 10° is stopped by arm length, not angle.
-  Real angle_tolerance_rad = deg_to_rad(static_cast<Real>(10));
+  /// |measured notch angle - expected| must not exceed this. 15°: at 1.5 m an LD06 gives an arm 5-8 points, whose
+  /// direction alone has σ ≈ 2-3° (σ 5-10 mm), so the notch angle has σ ≈ 3-4°; 15° keeps misses rare. Angle is a
+  /// weak discriminator anyway: room corners are stopped by arm length, box corners by concavity.
+  Real angle_tolerance_rad = deg_to_rad(static_cast<Real>(15));
   /// An arm may be at most this much longer than expected (mixed pixels at the mouth and fit noise add length).
   Real arm_length_tolerance_m = static_cast<Real>(0.05);
   /// An arm must show at least this fraction of its expected length (occlusion and grazing incidence shorten it).
   Real min_arm_fraction = static_cast<Real>(0.4);
-  /// The arms' nearest ends must lie within this distance of the fitted apex (the lines' intersection).
-  Real max_apex_gap_m = static_cast<Real>(0.05);
+  /// Each arm's nearest end must lie within max_apex_gap_m + apex_gap_spacing_factor · (that arm's mean sample
+  /// spacing, length / (n-1)) of the fitted apex (the lines' intersection). The corner falls between samples, up to
+  /// one spacing from an arm seen at grazing incidence, and range noise moves grazing samples along the arm by
+  /// σ/cos(incidence) (2 cm at 75°), hence 1.5 spacings. 0.03 m covers noise and a mixed pixel at the apex.
+  Real max_apex_gap_m = static_cast<Real>(0.03);
+  Real apex_gap_spacing_factor = static_cast<Real>(1.5);
   /// Each arm's fit RMS must not exceed this (2.5σ of LD06 noise).
   Real max_arm_rms_m = static_cast<Real>(0.025);
   /// Fewest points per arm.
@@ -71,6 +76,20 @@ struct VMarkerParams {
   /// Segments paired with each segment: the next `pair_span` segments in scan order (1 = immediate neighbours only;
   /// 2 also bridges one small spurious piece at the apex). Pairing cost is O(segments · pair_span).
   std::uint32_t pair_span = 2;
+  /// Bisector estimate. true: each arm's fitted direction, turned by half the *expected* notch angle, is one estimate
+  /// of the bisector; the two are averaged weighted by their information (points · length² / rms²), so a short,
+  /// occluded or noisy arm counts less. false: the plain bisector of the two measured directions (unbiased if the
+  /// real notch angle differs from the expected one, but an occluded arm drags it as much as a clean one).
+  bool weight_arms_by_information = true;
+  /// Floor on an arm's RMS in the weighting above: a 3-point arm can fit with ~0 RMS by chance, which would give it
+  /// all the weight. 3 mm is below LD06 noise at any incidence that gives a usable arm.
+  Real weight_rms_floor_m = static_cast<Real>(0.003);
+  /// Candidates whose apex is farther than this from the frame origin are ignored. Seed 004 looks within 1.5 m; beyond
+  /// ~2 m an LD06 puts 3-4 points on a 0.2 m arm, too few to tell the V from clutter.
+  Real max_apex_distance_m = 2;
+  /// Candidates scoring below this are ignored. 0.3 drops Vs made of two barely-half-visible, ragged arms (clutter
+  /// such as table legs against a box) while a clean V with one half-occluded arm still scores ~0.6.
+  Real min_score = static_cast<Real>(0.3);
   /// With a pose hint, candidates whose dock origin is farther than this from the hint are ignored.
   Real hint_gate_m = static_cast<Real>(0.5);
 };
@@ -92,7 +111,8 @@ struct VMarkerDetection {
   bool found = false;
   VMarkerStatus status = VMarkerStatus::kNoCandidate;
   Vec2 apex_m = Vec2::Zero();       ///< Intersection of the two fitted arm lines.
-  Real bisector_yaw_rad = 0;        ///< Direction out of the notch (towards the viewer): the V frame's +x.
+  Real bisector_yaw_rad = 0;        ///< Direction out of the notch (towards the viewer): the V frame's +x
+                                    ///< (see VMarkerParams::weight_arms_by_information).
   Pose2 dock_pose;                  ///< Dock frame in the segments' frame: V pose ∘ geometry.dock_in_v.
   Real notch_angle_rad = 0;         ///< Measured interior angle.
   Real arm_length_m[2] = {0, 0};    ///< Visible arm lengths apex -> far end, [0] right arm, [1] left arm.
@@ -118,7 +138,7 @@ class VMarkerDetector {
 
   /// Searches `segments` (scan order, as from extract_line_segments) for the V. Every pair (i, i+1..i+pair_span)
   /// (circularly) is tested: lines not near-parallel; concave (each arm's normal faces the other arm); notch angle
-  /// within tolerance; nearest ends within max_apex_gap_m of the lines' intersection; each arm between
+  /// within tolerance; nearest ends within max_apex_gap_m (+ sample spacing) of the lines' intersection; each arm between
   /// min_arm_fraction·expected and expected + arm_length_tolerance_m long, with enough points and small RMS.
   /// Score of a candidate = visibility · (1 - (e_angle + e_gap + e_rms) / 3), where visibility is the mean visible
   /// fraction of the two arms (capped at 1) and each e is the error divided by its tolerance (in [0, 1]).
