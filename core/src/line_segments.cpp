@@ -325,7 +325,7 @@ bool is_break(const ScanPoint& a, const ScanPoint& b, Real inc_abs, const Segmen
     return true;
   }
   const Real r = a.range_m < b.range_m ? a.range_m : b.range_m;
-  const Real range_term = params.cluster_gap_k * r * dtheta;
+  const Real range_term = params.cluster_gap_k * r * dtheta + params.cluster_noise_margin_m;
   const Real thr = range_term > params.cluster_abs_gap_m ? range_term : params.cluster_abs_gap_m;
   return (b.p_m - a.p_m).squaredNorm() > thr * thr;
 }

@@ -2,8 +2,8 @@
 /// @file Line segments from a 2D scan: range-gap clustering, split-and-merge, total-least-squares refinement.
 ///
 /// Pipeline (all in one call, bounded cost, no heap):
-///  1. Clusters: consecutive points (scan order) are split where their distance exceeds
-///     max(cluster_abs_gap_m, cluster_gap_k * range * angular step) or more than cluster_max_missing_beams samples are
+///  1. Clusters: consecutive points (scan order) are split where their distance exceeds max(cluster_abs_gap_m,
+///     cluster_gap_k * range * angular step + cluster_noise_margin_m) or more than cluster_max_missing_beams samples are
 ///     missing between them. On a full-turn scan the last and first points are neighbours; the processing start is
 ///     rotated to a gap so a cluster that straddles index 0 comes out whole.
 ///  2. Split (iterative end-point fit) inside each cluster, driven by an explicit fixed-capacity stack (no recursion):
@@ -72,6 +72,10 @@ struct SegmentParams {
   /// Range-proportional term: neighbours on one surface are range·Δθ/cos(incidence) apart, so k = 5 keeps a surface
   /// whole up to ~78° incidence (an 0.212 m V arm at 75° incidence, 1.5 m away, still clusters with its apex).
   Real cluster_gap_k = 5;
+  /// Added to the range-proportional term: range noise changes the distance between neighbours by up to ~3σ·√2, so
+  /// a surface sampled exactly at the k·r·Δθ limit would otherwise break on noise. 0.03 m ≈ 2σ·√2 for LD06 (σ 10 mm).
+  /// The break distance is max(cluster_abs_gap_m, cluster_gap_k · r · Δθ + cluster_noise_margin_m).
+  Real cluster_noise_margin_m = static_cast<Real>(0.03);
   /// Missing (invalid / filtered) samples tolerated inside a cluster. A real surface loses the odd return (dark
   /// spots, dropouts); more than 2 in a row usually means an edge.
   std::uint32_t cluster_max_missing_beams = 2;

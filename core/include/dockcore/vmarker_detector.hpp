@@ -66,8 +66,9 @@ struct VMarkerParams {
   /// Each arm's nearest end must lie within max_apex_gap_m + apex_gap_spacing_factor · (that arm's mean sample
   /// spacing, length / (n-1)) of the fitted apex (the lines' intersection). The corner falls between samples, up to
   /// one spacing from an arm seen at grazing incidence, and range noise moves grazing samples along the arm by
-  /// σ/cos(incidence) (2 cm at 75°), hence 1.5 spacings. 0.03 m covers noise and a mixed pixel at the apex.
-  Real max_apex_gap_m = static_cast<Real>(0.03);
+  /// σ/cos(incidence) (2 cm at 75°), hence 1.5 spacings. 0.04 m (4σ of LD06 range noise) covers noise and a mixed
+  /// pixel at the apex.
+  Real max_apex_gap_m = static_cast<Real>(0.04);
   Real apex_gap_spacing_factor = static_cast<Real>(1.5);
   /// Each arm's fit RMS must not exceed this (2.5σ of LD06 noise).
   Real max_arm_rms_m = static_cast<Real>(0.025);
