@@ -274,10 +274,16 @@ std::string SvgCanvas::str() const {
     s += "<text x=\"" + num(margin_px_) + "\" y=\"" + num(kTitlePx - 6) + "\" font-size=\"16.00\" fill=\"black\">" +
          escape(title_) + "</text>\n";
   }
-  // Shapes are stored in plot coordinates (to_px); the group shifts them below the title.
-  s += "<g transform=\"translate(0," + num(top_px()) + ")\">\n";
+  // Shapes are stored in plot coordinates (to_px); the group shifts them below the title, and the clip keeps shapes
+  // reaching past the shown world rectangle out of the margins and the legend.
+  const double pw = (world_.x_max - world_.x_min) * px_per_m_;
+  const double ph = (world_.y_max - world_.y_min) * px_per_m_;
+  s += "<defs><clipPath id=\"plot-area\"><rect x=\"" + num(margin_px_) + "\" y=\"" + num(margin_px_) + "\" width=\"" +
+       num(pw) + "\" height=\"" + num(ph) + "\"/></clipPath></defs>\n";
+  s += "<g transform=\"translate(0," + num(top_px()) + ")\">\n<g clip-path=\"url(#plot-area)\">\n";
   for (const std::string& e : body_) s += e + "\n";
-  s += "</g>\n";
+  s += "</g>\n<rect x=\"" + num(margin_px_) + "\" y=\"" + num(margin_px_) + "\" width=\"" + num(pw) + "\" height=\"" +
+       num(ph) + "\" fill=\"none\" stroke=\"#bbbbbb\" stroke-width=\"1.00\"/>\n</g>\n";
   if (!legend_.empty()) {
     const double x0 = 2 * margin_px_ + (world_.x_max - world_.x_min) * px_per_m_;
     const double y0 = top_px() + margin_px_;

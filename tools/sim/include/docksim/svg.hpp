@@ -3,7 +3,8 @@
 //
 // The canvas shows the world rectangle [x_min, x_max] x [y_min, y_max] (metres) at px_per_m pixels per metre with a
 // margin around it; world y points up (SVG's y points down, the writer flips it). Shapes are buffered in call order
-// (later shapes draw on top) and rendered by str(). An optional legend panel is drawn to the right of the plot.
+// (later shapes draw on top) and rendered by str(), clipped to the world rectangle, inside a thin frame. An optional
+// legend panel is drawn to the right of the plot.
 // Host-side; no dependencies beyond the standard library and dockcore's geometry types.
 #include <string>
 #include <vector>
