@@ -26,8 +26,8 @@ namespace dockcore {
 constexpr std::size_t kMaxLineSegments = 256;
 
 /// Depth of the split stack. With the left-first order used here the stack holds one pending right-hand range per
-/// nesting level; 64 levels is far beyond what a real scan needs (each level at least halves nothing, but real
-/// contours nest < 20 deep). A full stack leaves the range unsplit and is counted (SegmentStats::unsplit_ranges).
+/// nesting level; real contours nest < 20 deep, 64 leaves a wide margin (512 bytes). A full stack leaves the range
+/// unsplit and is counted (SegmentStats::unsplit_ranges).
 constexpr std::size_t kSegmentSplitStackDepth = 64;
 
 /// One straight piece of a scan contour, fitted by total least squares to points[first..last] (scan order).
