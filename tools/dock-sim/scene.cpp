@@ -469,7 +469,7 @@ int run_profile(const ProfileOptions& o) {
       if (i + 1 < p.vertex_count) {
         const Vec2 n = p.normal(i);
         std::printf("   %.1f, (%.3f, %.3f)", static_cast<double>((p.vertices_m[i + 1] - p.vertices_m[i]).norm()) * 1e3,
-                    static_cast<double>(n.x()), static_cast<double>(n.y()));
+                    static_cast<double>(n.x()) + 0.0, static_cast<double>(n.y()) + 0.0);  // no "-0.000"
       }
       std::printf("\n");
     }
