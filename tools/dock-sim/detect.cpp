@@ -267,7 +267,7 @@ int run_detect(const DetectOptions& o) {
     if (st == docksim::ScanReader::Status::kEnd) break;
     if (st == docksim::ScanReader::Status::kError || !rec.to_laser_scan(scan.get())) {
       if (st != docksim::ScanReader::Status::kError) error = "line " + std::to_string(reader.line_number()) + ": too many ranges";
-      std::cerr << o.scans_path << ": " << error << " (skipped)\n";
+      std::cerr << (o.scans_path == "-" ? std::string("<stdin>") : o.scans_path) << ": " << error << " (skipped)\n";
       ++bad;
       continue;
     }
