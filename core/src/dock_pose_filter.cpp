@@ -1,6 +1,5 @@
 #include "dockcore/dock_pose_filter.hpp"
 
-#include <Eigen/Cholesky>
 
 namespace dockcore {
 namespace {
@@ -72,8 +71,9 @@ FilterUpdate DockPoseFilter::update(const Pose2& dock_in_robot, const Mat3& cov_
   }
   Vec3 nu(z.x_m - dock_odom_.x_m, z.y_m - dock_odom_.y_m, wrap_angle(z.yaw_rad - dock_odom_.yaw_rad));
   const Mat3 s = cov_odom_ + rz;
-  const Eigen::LDLT<Mat3> s_ldlt = s.ldlt();
-  last_d2_ = nu.dot(s_ldlt.solve(nu));
+  Mat3 s_inv;
+  if (!invert_sym3(s, &s_inv)) return FilterUpdate::kInvalid;
+  last_d2_ = nu.dot(s_inv * nu);
   if (!(last_d2_ <= params_.gate_chi2)) {
     if (++consecutive_gated_ >= params_.reinit_after) {
       ++reinits_;
@@ -83,8 +83,7 @@ FilterUpdate DockPoseFilter::update(const Pose2& dock_in_robot, const Mat3& cov_
     ++gated_;
     return FilterUpdate::kGated;
   }
-  // K = P S^-1 (S symmetric): solve S K^T = P.
-  const Mat3 k = s_ldlt.solve(cov_odom_).transpose();
+  const Mat3 k = cov_odom_ * s_inv;
   const Vec3 dx = k * nu;
   dock_odom_.x_m += dx.x();
   dock_odom_.y_m += dx.y();

@@ -48,24 +48,28 @@ bool PlacedProfile::raycast(const Vec2& dir, Real* range_m, std::size_t* segment
   return hit;
 }
 
-bool PlacedProfile::nearest(const Vec2& p, std::size_t* segment, Real* distance_m, Real* signed_line_distance_m) const {
+bool PlacedProfile::nearest(const Vec2& p, std::size_t* segment, Real* distance_m, Real* signed_line_distance_m,
+                            Real* overhang_m) const {
   bool any = false;
   Real best_sq = 0;
+  Real best_over = 0;
   for (std::size_t i = 0; i < segments; ++i) {
     if (!visible[i]) continue;
     const Vec2 d = v_m[i + 1] - v_m[i];
     const Vec2 w = p - v_m[i];
-    Real u = w.dot(d) / d.squaredNorm();
-    u = u < 0 ? 0 : (u > 1 ? 1 : u);
+    const Real u_raw = w.dot(d) / d.squaredNorm();
+    const Real u = u_raw < 0 ? 0 : (u_raw > 1 ? 1 : u_raw);
     const Real dist_sq = (w - u * d).squaredNorm();
     if (!any || dist_sq < best_sq) {
       any = true;
       best_sq = dist_sq;
+      best_over = std::fabs(u_raw - u) * d.norm();
       *segment = i;
     }
   }
   if (any) {
     *distance_m = std::sqrt(best_sq);
+    *overhang_m = best_over;
     *signed_line_distance_m = n[*segment].dot(p) - c_m[*segment];
   }
   return any;

@@ -34,6 +34,30 @@ inline Real wrap_angle(Real angle_rad) {
   return a;
 }
 
+/// Inverse of a symmetric 3x3 matrix by cofactors (closed form: no pivoting loops, no Eigen decompositions, whose
+/// generic code paths reference malloc). Returns false, leaving `out` alone, when |det| is not above
+/// `min_abs_det` or not finite. O(1).
+inline bool invert_sym3(const Mat3& a, Mat3* out, Real min_abs_det = 0) {
+  const Real c00 = a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1);
+  const Real c01 = a(1, 2) * a(2, 0) - a(1, 0) * a(2, 2);
+  const Real c02 = a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0);
+  const Real det = a(0, 0) * c00 + a(0, 1) * c01 + a(0, 2) * c02;
+  if (!std::isfinite(det) || !(std::fabs(det) > min_abs_det)) return false;
+  const Real inv_det = static_cast<Real>(1) / det;
+  Mat3 r;
+  r(0, 0) = c00 * inv_det;
+  r(1, 0) = c01 * inv_det;
+  r(2, 0) = c02 * inv_det;
+  r(0, 1) = (a(0, 2) * a(2, 1) - a(0, 1) * a(2, 2)) * inv_det;
+  r(1, 1) = (a(0, 0) * a(2, 2) - a(0, 2) * a(2, 0)) * inv_det;
+  r(2, 1) = (a(0, 1) * a(2, 0) - a(0, 0) * a(2, 1)) * inv_det;
+  r(0, 2) = (a(0, 1) * a(1, 2) - a(0, 2) * a(1, 1)) * inv_det;
+  r(1, 2) = (a(0, 2) * a(1, 0) - a(0, 0) * a(1, 2)) * inv_det;
+  r(2, 2) = (a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0)) * inv_det;
+  *out = r;
+  return true;
+}
+
 /// A pose in SE(2): position of a frame's origin and the heading of its x axis, expressed in a parent frame.
 struct Pose2 {
   Real x_m = 0;

@@ -25,9 +25,11 @@ struct PlacedProfile {
   bool raycast(const Vec2& dir, Real* range_m, std::size_t* segment) const;
 
   /// Nearest visible segment to point p (clamped to the segment's ends). Returns false when no segment is visible;
-  /// otherwise writes the index, the Euclidean distance and the signed distance to the segment's line (positive on
-  /// the outward side). Cost O(segments).
-  bool nearest(const Vec2& p, std::size_t* segment, Real* distance_m, Real* signed_line_distance_m) const;
+  /// otherwise writes the index, the Euclidean distance, the signed distance to the segment's line (positive on
+  /// the outward side) and the overhang: how far p's projection lies beyond the segment's nearer end (0 inside).
+  /// Cost O(segments).
+  bool nearest(const Vec2& p, std::size_t* segment, Real* distance_m, Real* signed_line_distance_m,
+               Real* overhang_m) const;
 
   /// Angular interval [lo, hi] (lo may be < -pi, hi may exceed pi; hi - lo < 2pi) in which the profile's vertices lie
   /// as seen from the sensor origin, relative to no wrap: centre + half widths. Cost O(vertices) atan2 calls.

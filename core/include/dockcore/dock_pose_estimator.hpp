@@ -1,0 +1,242 @@
+#pragma once
+/// @file DockPoseEstimator: the product's dock detector. Full dock pose (x, y, yaw) in the robot frame with a quality
+/// report, for any DockProfile.
+///
+/// Pipeline per scan (all in the lidar frame, converted to the robot frame at the end):
+///  1. Candidates. With a pose hint (the tracker's prediction, or a configured dock pose) the hint is tried first.
+///     Otherwise (or when the hint fails) line segments of the scan are matched to the profile's long segments: each
+///     pairing of a scan segment with a profile segment of similar length, facing the lidar, gives up to three pose
+///     hypotheses (centres aligned, or either end aligned for a partly hidden segment).
+///  2. Registration. Point-to-segment Gauss-Newton on (x, y, yaw) with Huber then Tukey weights, over the beams inside the dock's
+///     angular span (plus a margin), associating each point with the nearest visible profile segment.
+///  3. Verification. The expected scan of the profile at the refined pose is compared beam by beam with the measured
+///     one: inliers (within the gate), occluded (measured well in front — allowed, that is partial occlusion) and
+///     violations (measured farther, no return where the dock should be, or a surface just in front of where the
+///     dock should be — evidence that the dock is not there; this is what rejects look-alike clutter such as a flat
+///     board or wall for a winged dock).
+///  4. Selection among verified candidates: nearest to the lidar, or nearest to the hint.
+///
+/// Cost: O(B) to read the scan (B beams, no trig per beam), O(B) segmentation, then per candidate
+/// O(I · W · S) with I <= max_iterations, W beams in the dock's span, S visible profile segments; at most
+/// max_candidates candidates are refined. No heap; the object holds its working buffers (~100 kB with double, so keep
+/// it static or a member, not on a small stack).
+
+#include <cstddef>
+#include <cstdint>
+
+#include "dockcore/dock_profile.hpp"
+#include "dockcore/geometry.hpp"
+#include "dockcore/laser_scan.hpp"
+#include "dockcore/line_segments.hpp"
+#include "dockcore/profile_geometry.hpp"
+
+namespace dockcore {
+
+/// How to pick one dock when several verify.
+enum class DockSelect : std::uint8_t {
+  kNearest = 0,  ///< Smallest distance from the lidar.
+  kHint = 1,     ///< Closest to the pose hint (falls back to nearest when no hint is given).
+};
+
+/// Why an estimate was not produced (or kOk).
+enum class EstimateStatus : std::uint8_t {
+  kOk = 0,
+  kNoProfile,         ///< configure() was not called with a valid profile.
+  kNoPoints,          ///< No valid returns within range.
+  kNoCandidates,      ///< No scan feature resembles the profile.
+  kNotVerified,       ///< Candidates existed but none passed verification (too few inliers, violations, RMS).
+  kBadScan,           ///< Scan geometry invalid (count 0 or > capacity, zero increment, non-finite angles).
+};
+
+/// Why verification refused a candidate (the rejection rules, in the order they are applied).
+enum class RejectReason : std::uint8_t {
+  kNone = 0,
+  kNoConvergence,      ///< Registration found too few points or diverged.
+  kSegmentUnsupported, ///< A long dock surface expected on >= 3 beams has too few inliers.
+  kTooFewInliers,      ///< Fewer than min_inliers.
+  kLowInlierFraction,  ///< Inliers / unoccluded expected beams below min_inlier_fraction.
+  kMostlyHidden,       ///< Inliers / expected beams below min_visible_fraction.
+  kSeeThrough,         ///< Violations above max_violation_fraction.
+  kHighRms,            ///< Inlier RMS above max_rms_m.
+  kSurfaceContinues,   ///< More than max_extension_points returns continue a dock surface past its end.
+  kOblique,            ///< Face seen beyond max_view_angle_rad.
+  kOutOfRange,         ///< Farther than max_range_m.
+  kUncertain,          ///< Position 1-σ from the covariance above max_sigma_m.
+  kFarFromHint,        ///< Farther than hint_radius_m from the hint.
+  kNoWallBehind,       ///< require_wall_behind is set and the beams past the dock's ends see beyond its back plane.
+  kCount,
+};
+
+/// Human-readable name of a RejectReason. Never null.
+const char* to_string(RejectReason r);
+
+/// Human-readable name of an EstimateStatus. Never null.
+const char* to_string(EstimateStatus s);
+
+/// Tuning of the estimator. Defaults suit LD06-class lidars (0.8°, σ 10 mm) and docks 0.2–0.5 m wide.
+struct EstimatorParams {
+  Real min_range_m = static_cast<Real>(0.05);     ///< Closer returns are ignored (lidar blind zone).
+  Real max_range_m = static_cast<Real>(3.0);      ///< Farther returns are ignored; docks are sought within this.
+  Real range_sigma_m = static_cast<Real>(0.01);   ///< Expected 1-σ range noise; scales the gates and covariance.
+  Real huber_k = static_cast<Real>(1.5);          ///< Huber threshold in units of range_sigma_m (first 3 iterations).
+  Real tukey_c = static_cast<Real>(3.0);          ///< Tukey biweight cut-off in units of range_sigma_m (after).
+  Real association_gate_m = static_cast<Real>(0.08);  ///< Points farther from every visible segment are ignored.
+  Real inlier_gate_m = static_cast<Real>(0.03);   ///< |measured − expected| below this is an inlier.
+  std::uint8_t max_iterations = 10;               ///< Gauss-Newton cap per candidate.
+  std::uint8_t max_candidates = 24;               ///< Hypotheses refined per scan at most (nearest first).
+  Real min_feature_length_m = static_cast<Real>(0.08);  ///< Profile segments shorter than this seed no hypotheses.
+  Real min_inlier_fraction = static_cast<Real>(0.6);    ///< Inliers / unoccluded beams expected on the dock, at least.
+  Real max_violation_fraction = static_cast<Real>(0.1); ///< See-through beams / expected beams, at most.
+  /// Returns this close in front of the expected surface count as violations, not occlusion: the space just in front
+  /// of a dock is empty (a robot docks there), so a surface there means the hypothesis is wrong — e.g. a flat wall
+  /// "explaining" a winged dock's face while hiding its wings.
+  Real free_space_m = static_cast<Real>(0.15);
+  std::uint16_t min_inliers = 10;  ///< Absolute floor on inliers (a 0.3 m dock 2 m away gives ~13 with LD06).
+  /// Inliers / all beams expected on the dock (occluded included), at least: how much of the dock may be hidden.
+  Real min_visible_fraction = static_cast<Real>(0.5);
+  /// Returns allowed on the line of a long profile segment 4-12 cm past its end. A real dock's surfaces stop at its
+  /// edges; a wall or box face matched as the dock's face carries on.
+  std::uint16_t max_extension_points = 2;
+  /// Distance from a segment's line within which a return past its end counts as an extension. Narrower than the
+  /// inlier gate: a wall meeting a 45° wing at its tip stays ~overhang away from the wing's line.
+  Real extension_band_m = static_cast<Real>(0.02);
+  /// Each long profile segment expected on >= 3 unoccluded beams needs this fraction of them as inliers (one
+  /// missing beam is always allowed).
+  Real min_segment_support = static_cast<Real>(0.7);                  ///< Absolute floor on inliers.
+  /// Shape RMS (every unoccluded beam on the dock, residuals clamped at inlier_gate_m), at most. The dock's whole
+  /// outline must match to about the noise level, which is what separates it from look-alikes.
+  Real max_shape_rms_m = static_cast<Real>(0.015);
+  Real max_rms_m = static_cast<Real>(0.015);      ///< Inlier fit RMS, at most (1.5 range_sigma: a wrong pose that
+                                                  ///< still lands most beams inside the gate shows up here).
+  Real max_sigma_m = static_cast<Real>(0.05);     ///< Reject when the position 1-σ (covariance) exceeds this.
+  Real max_view_angle_rad = static_cast<Real>(1.2);     ///< Dock face seen more obliquely than this is rejected.
+  Real hint_gate_m = static_cast<Real>(0.3);      ///< A verified pose farther than this from the hint ignores it.
+  /// With a hint, only docks within this distance of it are accepted (0: anywhere). Set it when the dock's pose is
+  /// known roughly (a dock database, a staging pose): clutter elsewhere can then never be taken for the dock.
+  Real hint_radius_m = 0;
+  /// The dock is mounted against a wall flush with its back (the profile's smallest x), as charging docks are: beams
+  /// just past the dock's ends must meet that wall (or an occluder well in front of it). This is what separates a dock from
+  /// free-standing look-alikes (boxes, boards, table legs). Turn it off for a free-standing dock.
+  bool require_wall_behind = true;
+  Real wall_tolerance_m = static_cast<Real>(0.04);  ///< How far the wall may lie from the back plane (either way).
+  DockSelect select = DockSelect::kNearest;
+  SegmentParams segments{};                       ///< Line extraction used for candidate generation.
+};
+
+/// Parameters for a lidar whose 1-σ range noise is `range_sigma_m`: the noise-dependent gates (inlier gate 3σ,
+/// inlier and shape RMS 1.5σ, extension band 2σ, association gate 6σ, each with a floor for very clean lidars) scaled from
+/// the defaults, which are this function's result for 10 mm. O(1).
+EstimatorParams estimator_params_for_noise(Real range_sigma_m);
+
+/// Result of one scan. Pose and covariance in the robot frame (the frame of the lidar mount pose).
+struct DockEstimate {
+  bool found = false;
+  EstimateStatus status = EstimateStatus::kNoProfile;
+  Pose2 pose{};                 ///< Dock frame (origin at the contacts, x out of the face) in the robot frame.
+  Mat3 covariance = Mat3::Zero();  ///< Of (x_m, y_m, yaw_rad), m² / rad².
+  Real rms_m = 0;               ///< RMS of inlier residuals.
+  Real shape_rms_m = 0;         ///< RMS over all unoccluded dock beams, residuals clamped at the inlier gate.
+  std::uint16_t inliers = 0;    ///< Beams within the inlier gate.
+  std::uint16_t expected = 0;   ///< Beams predicted to hit the dock.
+  std::uint16_t violations = 0; ///< Beams that see through where the dock should be.
+  std::uint16_t occluded = 0;   ///< Beams blocked by something in front of the dock.
+  std::uint16_t extensions = 0; ///< Returns continuing a long dock surface past its end (evidence against).
+  std::uint8_t iterations = 0;  ///< Gauss-Newton iterations of the winning candidate.
+  std::uint16_t candidates = 0; ///< Hypotheses refined this scan.
+  std::uint16_t verified = 0;   ///< Of which passed verification.
+  bool from_hint = false;       ///< The winner came from the hint (tracking) rather than a global search.
+};
+
+/// Counters since configure(); never reset by estimate().
+struct EstimatorCounters {
+  std::uint32_t scans = 0;
+  std::uint32_t found = 0;
+  std::uint32_t bad_scans = 0;
+  std::uint32_t candidates = 0;
+  std::uint32_t rejected = 0;       ///< Candidates refused by verification.
+  std::uint32_t rejected_by[static_cast<std::size_t>(RejectReason::kCount)] = {};  ///< Refusals by reason.
+  std::uint32_t truncated_candidates = 0;  ///< Hypotheses skipped because max_candidates was reached.
+  std::uint32_t truncated_segments = 0;    ///< Scans whose line extraction hit a cap.
+};
+
+class DockPoseEstimator {
+ public:
+  /// Sets the profile and parameters; returns false (estimator unusable until a good call) for a profile with no
+  /// segments. O(vertices).
+  bool configure(const DockProfile& profile, const EstimatorParams& params);
+
+  /// Estimates the dock pose in one scan. `lidar_mount` is the lidar's pose in the robot frame. `hint`, if not null,
+  /// is an expected dock pose in the robot frame (tracker prediction or configured pose). Cost: see file comment.
+  DockEstimate estimate(const ScanView& scan, const Pose2& lidar_mount, const Pose2* hint = nullptr);
+
+  const EstimatorCounters& counters() const { return counters_; }
+  const EstimatorParams& params() const { return params_; }
+  const DockProfile& profile() const { return profile_; }
+
+ private:
+  struct Refined {
+    Pose2 pose;      // dock in lidar frame
+    Mat3 h;          // Gauss-Newton normal matrix at the solution
+    Real rms_m;
+    Real shape_rms_m;
+    std::uint16_t inliers, expected, violations, occluded, extensions;
+    std::uint8_t iterations;
+    bool ok;
+    RejectReason reject;
+  };
+  bool load_scan(const ScanView& scan);
+  Refined refine(const Pose2& initial);
+  void verify(Refined& r);
+  /// Signed index of the beam nearest angle_rad (may lie outside [0, beams) for a partial scan).
+  long first_beam(Real angle_rad) const;
+  /// Index of beam first+k, wrapped on full-turn scans; false when outside a partial scan.
+  bool beam_at(long first, std::size_t k, std::size_t* index) const;
+  /// Fills hyps_ with ranked pose hypotheses from scan line segments and sliding-window line fits; returns how many
+  /// to refine.
+  std::size_t generate_candidates();
+  /// Appends the hypothesis that puts profile segment `profile_segment` (normal facing the lidar along n_scan) with
+  /// its point anchor_dock (dock frame) onto anchor_scan (lidar frame). Counts truncation at kMaxHypotheses.
+  void push_hypothesis(const Vec2& n_scan, const Vec2& anchor_scan, const Vec2& anchor_dock, std::size_t profile_segment,
+                       std::size_t* n);
+  /// Hypotheses from windows of each long profile segment's length slid along contiguous runs of points: a window
+  /// that is flat to the noise level, spans the segment's length and ends (a bend or a gap) on one side at least.
+  /// Robust where split-and-merge merges a short wing into the face. O(points · long profile segments).
+  void add_window_hypotheses(std::size_t* n);
+  /// Rough support of a hypothesis: +1 per matching beam, -2 per beam seeing through the dock (every other beam).
+  Real prescore(const Pose2& pose);
+  /// The wall-behind test of verify(): beams just outside [k_first_hit, k_last_hit] (offsets from `first`).
+  bool wall_behind(const Pose2& pose, long first, std::size_t k_first_hit, std::size_t k_last_hit) const;
+  /// Score to choose between poses of one object: inliers discounted by fit, minus see-through beams.
+  Real quality(const Refined& r) const;
+  /// True when p lies on the line of a long visible segment of placed_, 4-12 cm past its end.
+  bool continues_past_end(const Vec2& p) const;
+
+  /// Hypotheses collected per scan before ranking; beyond this they are counted as truncated.
+  static constexpr std::size_t kMaxHypotheses = 128;
+  struct Hypothesis {
+    Pose2 pose;   // dock in lidar frame
+    Real prescore;
+  };
+
+  DockProfile profile_{};
+  EstimatorParams params_{};
+  bool configured_ = false;
+  Real profile_radius_m_ = 0;  // largest vertex distance from the dock origin
+  Real back_x_m_ = 0;          // the profile's back plane: its smallest x
+  Real half_width_m_ = 0;      // largest |y| of the profile
+  EstimatorCounters counters_{};
+
+  // Working buffers for the current scan, in the lidar frame. Beam i: unit direction and range (0 = none).
+  Vec2 dir_[kMaxScanPoints];
+  Real range_m_[kMaxScanPoints];
+  std::size_t beams_ = 0;
+  Real angle_min_rad_ = 0;
+  Real angle_inc_rad_ = 0;
+  bool wraps_ = false;
+  ScanPoints points_{};
+  LineSegments segs_{};
+  PlacedProfile placed_{};
+  Hypothesis hyps_[kMaxHypotheses];
+};
+
+}  // namespace dockcore

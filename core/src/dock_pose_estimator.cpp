@@ -1,0 +1,713 @@
+#include "dockcore/dock_pose_estimator.hpp"
+
+#include <limits>
+
+
+namespace dockcore {
+namespace {
+
+constexpr Real R(double v) { return static_cast<Real>(v); }
+
+// Largest distance past a segment's end at which a point is still associated with it: about one beam footprint.
+// Larger lets the surface adjoining the dock (a wall flush with its back) drag the fit.
+constexpr Real kOverhangM = static_cast<Real>(0.002);
+
+// Gauss-Newton iterations that use Huber weights before switching to Tukey's biweight.
+constexpr std::uint8_t kHuberIterations = 3;
+
+// A return on the line of a long profile segment, this far past its end, means that surface carries on where the
+// dock ends: a wall or a box face, not the dock. Closer than the minimum is ambiguous: a 45° wing is only 4 cm
+// behind the face's line 4 cm past the face's end.
+constexpr Real kExtensionMinM = static_cast<Real>(0.04);
+constexpr Real kExtensionMaxM = static_cast<Real>(0.12);
+
+Real dist2(const Pose2& a, const Pose2& b) {
+  const Real dx = a.x_m - b.x_m;
+  const Real dy = a.y_m - b.y_m;
+  return dx * dx + dy * dy;
+}
+
+}  // namespace
+
+const char* to_string(RejectReason r) {
+  switch (r) {
+    case RejectReason::kNone: return "none";
+    case RejectReason::kNoConvergence: return "registration failed";
+    case RejectReason::kTooFewInliers: return "too few inliers";
+    case RejectReason::kLowInlierFraction: return "too few of the visible beams fit";
+    case RejectReason::kMostlyHidden: return "mostly hidden";
+    case RejectReason::kSeeThrough: return "beams see through the dock";
+    case RejectReason::kHighRms: return "fit RMS too high";
+    case RejectReason::kSurfaceContinues: return "a surface continues past the dock's edge";
+    case RejectReason::kSegmentUnsupported: return "a dock surface is missing";
+    case RejectReason::kOblique: return "face seen too obliquely";
+    case RejectReason::kOutOfRange: return "out of range";
+    case RejectReason::kUncertain: return "pose too uncertain";
+    case RejectReason::kFarFromHint: return "too far from the hint";
+    case RejectReason::kNoWallBehind: return "no wall behind the dock";
+    case RejectReason::kCount: break;
+  }
+  return "unknown reason";
+}
+
+const char* to_string(EstimateStatus s) {
+  switch (s) {
+    case EstimateStatus::kOk: return "ok";
+    case EstimateStatus::kNoProfile: return "no profile configured";
+    case EstimateStatus::kNoPoints: return "no valid returns in range";
+    case EstimateStatus::kNoCandidates: return "nothing in the scan resembles the dock";
+    case EstimateStatus::kNotVerified: return "dock-like features found but none verified";
+    case EstimateStatus::kBadScan: return "scan geometry invalid";
+  }
+  return "unknown status";
+}
+
+EstimatorParams estimator_params_for_noise(Real range_sigma_m) {
+  EstimatorParams p;
+  const Real s = range_sigma_m > 0 ? range_sigma_m : p.range_sigma_m;
+  auto at_least = [](Real v, Real floor) { return v > floor ? v : floor; };
+  p.range_sigma_m = s;
+  p.inlier_gate_m = at_least(3 * s, R(0.015));
+  p.max_rms_m = at_least(R(1.5) * s, R(0.006));
+  p.max_shape_rms_m = at_least(R(1.5) * s, R(0.006));
+  p.extension_band_m = at_least(2 * s, R(0.01));
+  p.association_gate_m = at_least(6 * s, R(0.06));
+  return p;
+}
+
+bool DockPoseEstimator::configure(const DockProfile& profile, const EstimatorParams& params) {
+  counters_ = EstimatorCounters{};
+  configured_ = false;
+  if (profile.segment_count() < 1) return false;
+  profile_ = profile;
+  params_ = params;
+  profile_radius_m_ = 0;
+  back_x_m_ = profile.vertices_m[0].x();
+  half_width_m_ = 0;
+  for (std::size_t i = 0; i < profile.vertex_count; ++i) {
+    back_x_m_ = profile.vertices_m[i].x() < back_x_m_ ? profile.vertices_m[i].x() : back_x_m_;
+    const Real ay = std::fabs(profile.vertices_m[i].y());
+    half_width_m_ = ay > half_width_m_ ? ay : half_width_m_;
+    const Real r = profile.vertices_m[i].norm();
+    profile_radius_m_ = r > profile_radius_m_ ? r : profile_radius_m_;
+  }
+  configured_ = true;
+  return true;
+}
+
+bool DockPoseEstimator::load_scan(const ScanView& scan) {
+  if (scan.count == 0 || scan.count > kMaxScanPoints || scan.ranges_m == nullptr || !(scan.angle_increment_rad > 0) ||
+      !std::isfinite(scan.angle_min_rad) || static_cast<Real>(scan.count) * scan.angle_increment_rad > kTwoPi + scan.angle_increment_rad) {
+    return false;
+  }
+  beams_ = scan.count;
+  angle_min_rad_ = scan.angle_min_rad;
+  angle_inc_rad_ = scan.angle_increment_rad;
+  wraps_ = scan.wraps();
+  // Beam directions by rotating a unit vector: one sin/cos pair per 64 beams instead of one per beam. The
+  // periodic re-seed bounds the recurrence's rounding drift (matters for the float build).
+  const Real ci = std::cos(angle_inc_rad_);
+  const Real si = std::sin(angle_inc_rad_);
+  Vec2 d(0, 0);
+  points_.clear();
+  for (std::size_t i = 0; i < beams_; ++i) {
+    if ((i & 63u) == 0) {
+      const Real a = scan.angle_rad(i);
+      d = Vec2(std::cos(a), std::sin(a));
+    } else {
+      d = Vec2(ci * d.x() - si * d.y(), si * d.x() + ci * d.y());
+    }
+    dir_[i] = d;
+    const Real r = scan.ranges_m[i];
+    const bool ok = is_valid_range(r) && r >= params_.min_range_m && r <= params_.max_range_m;
+    range_m_[i] = ok ? r : 0;
+    if (ok) {
+      ScanPoint sp;
+      sp.p_m = r * d;
+      sp.range_m = r;
+      sp.angle_rad = scan.angle_rad(i);
+      sp.index = static_cast<std::uint32_t>(i);
+      points_.push_back(sp);
+    }
+  }
+  return true;
+}
+
+bool DockPoseEstimator::wall_behind(const Pose2& pose, long first, std::size_t k_first_hit,
+                                    std::size_t k_last_hit) const {
+  // The dock's back plane (dock frame x = back_x_m_) seen from the lidar: beams just past either end of the dock
+  // must land on it (or on an occluder well in front); landing beyond it, or nowhere, means a free-standing object.
+  const Vec2 nd(std::cos(pose.yaw_rad), std::sin(pose.yaw_rad));
+  const Real plane_c = nd.dot(Vec2(pose.x_m, pose.y_m)) + back_x_m_;
+  const Real tol = params_.wall_tolerance_m;
+  for (int side = 0; side < 2; ++side) {
+    int unbacked = 0;
+    int looked = 0;
+    for (std::size_t step = 1; step <= 3; ++step) {
+      const long k = side == 0 ? static_cast<long>(k_first_hit) - static_cast<long>(step)
+                               : static_cast<long>(k_last_hit) + static_cast<long>(step);
+      std::size_t i = 0;
+      if (!beam_at(first + k, 0, &i)) break;
+      const Real denom = nd.dot(dir_[i]);
+      if (denom >= 0) continue;  // the plane faces away along this beam
+      const Real wall_m = plane_c / denom;
+      if (wall_m <= 0) continue;
+      ++looked;
+      const Real m = range_m_[i];
+      // On the plane (within tol) or well in front of it (an occluder, as in the free-space rule) is consistent with
+      // a wall; beyond it, nothing, or a surface just in front of it (the dock placed inside a wall) is not.
+      const bool on_wall = m != 0 && std::fabs(m - wall_m) <= tol;
+      const bool occluder = m != 0 && m < wall_m - params_.free_space_m;
+      if (!on_wall && !occluder) ++unbacked;
+    }
+    if (looked >= 2 && unbacked * 2 > looked) return false;
+  }
+  return true;
+}
+
+Real DockPoseEstimator::quality(const Refined& r) const {
+  // Inliers discounted by how badly they fit, minus see-through beams: a log-likelihood-like score.
+  const Real gate_sq = params_.inlier_gate_m * params_.inlier_gate_m;
+  return static_cast<Real>(r.inliers) * (1 - r.rms_m * r.rms_m / gate_sq) - 2 * static_cast<Real>(r.violations);
+}
+
+bool DockPoseEstimator::continues_past_end(const Vec2& p) const {
+  // A point on the dock itself (e.g. the breakpoint dock's end blocks, in line with its face) is not an extension.
+  std::size_t near_seg = 0;
+  Real near_dist = 0;
+  Real line_dist = 0;
+  Real overhang_m = 0;
+  if (placed_.nearest(p, &near_seg, &near_dist, &line_dist, &overhang_m) && near_dist <= params_.inlier_gate_m) {
+    return false;
+  }
+  for (std::size_t j = 0; j < placed_.segments; ++j) {
+    if (!placed_.visible[j]) continue;
+    const Vec2 d = placed_.v_m[j + 1] - placed_.v_m[j];
+    const Real len = d.norm();
+    if (len < params_.min_feature_length_m) continue;
+    if (std::fabs(placed_.n[j].dot(p) - placed_.c_m[j]) > params_.extension_band_m) continue;
+    const Real u = (p - placed_.v_m[j]).dot(d) / len;
+    const Real overhang = u < 0 ? -u : u - len;
+    if (overhang >= kExtensionMinM && overhang <= kExtensionMaxM) return true;
+  }
+  return false;
+}
+
+long DockPoseEstimator::first_beam(Real angle_rad) const {
+  // Express the angle within ±pi of the scan's centre so a non-wrapping scan gets the unambiguous index.
+  const Real half_span = static_cast<Real>(beams_) * angle_inc_rad_ * R(0.5);
+  const Real rel = wrap_angle(angle_rad - angle_min_rad_ - half_span) + half_span;
+  return static_cast<long>(std::floor(rel / angle_inc_rad_ + R(0.5)));
+}
+
+bool DockPoseEstimator::beam_at(long first, std::size_t k, std::size_t* index) const {
+  long i = first + static_cast<long>(k);
+  const long n = static_cast<long>(beams_);
+  if (wraps_) {
+    i %= n;
+    if (i < 0) i += n;
+  } else if (i < 0 || i >= n) {
+    return false;
+  }
+  *index = static_cast<std::size_t>(i);
+  return true;
+}
+
+DockPoseEstimator::Refined DockPoseEstimator::refine(const Pose2& initial) {
+  Refined out{};
+  out.pose = initial;
+  out.ok = false;
+  const Real k_huber = params_.huber_k * params_.range_sigma_m;
+  const Real c_tukey = params_.tukey_c * params_.range_sigma_m;
+  Pose2 pose = initial;
+  for (std::uint8_t it = 0; it < params_.max_iterations; ++it) {
+    placed_.place(profile_, pose);
+    Real lo = 0;
+    Real hi = 0;
+    placed_.angular_span(&lo, &hi);
+    const Real dist_m = std::sqrt(pose.x_m * pose.x_m + pose.y_m * pose.y_m);
+    if (!(dist_m > params_.min_range_m) || dist_m > params_.max_range_m + profile_radius_m_) return out;
+    // The association gate shrinks as the fit converges so neighbours of the dock stop pulling on it.
+    const Real shrink = static_cast<Real>(1u << (it < 4 ? it : 4));
+    const Real gate = params_.association_gate_m / shrink > params_.inlier_gate_m ? params_.association_gate_m / shrink
+                                                                                   : params_.inlier_gate_m;
+    const Real margin = std::atan2(params_.association_gate_m, dist_m);
+    lo -= margin;
+    hi += margin;
+    const std::size_t n_beams = static_cast<std::size_t>((hi - lo) / angle_inc_rad_) + 2;
+    const long first = first_beam(lo);
+    Mat3 h = Mat3::Zero();
+    Vec3 g = Vec3::Zero();
+    std::uint16_t used = 0;
+    Real sum_sq = 0;
+    const Vec2 t(pose.x_m, pose.y_m);
+    const Vec2 nd(std::cos(pose.yaw_rad), std::sin(pose.yaw_rad));
+    for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
+      std::size_t i = 0;
+      if (!beam_at(first, k, &i)) continue;
+      const Real r = range_m_[i];
+      if (r == 0) continue;
+      const Vec2 p = r * dir_[i];
+      if (params_.require_wall_behind) {
+        // Wall points beside the dock are explained by the wall, not by the dock's sides that meet it.
+        const Vec2 q(nd.dot(p - t), nd.x() * (p - t).y() - nd.y() * (p - t).x());
+        if (std::fabs(q.x() - back_x_m_) < params_.inlier_gate_m && std::fabs(q.y()) > half_width_m_) continue;
+      }
+      std::size_t seg = 0;
+      Real dist = 0;
+      Real e = 0;
+      // A point beyond a segment's end (overhang) belongs to whatever adjoins the dock, e.g. the wall behind it.
+      Real overhang = 0;
+      if (!placed_.nearest(p, &seg, &dist, &e, &overhang) || dist > gate || overhang > kOverhangM) continue;
+      const Vec2& n = placed_.n[seg];
+      const Vec3 jac(-n.x(), -n.y(), Vec2(-n.y(), n.x()).dot(p - t));
+      const Real ae = std::fabs(e);
+      // Huber while the pose is rough (convex, pulls in from afar); Tukey's biweight once it is close, so points
+      // from depth edges (mixed pixels, jitter at a slot wall) stop pulling the fit at all.
+      Real w = 0;
+      if (it < kHuberIterations) {
+        w = ae <= k_huber ? R(1) : k_huber / ae;
+      } else if (ae < c_tukey) {
+        const Real u = ae / c_tukey;
+        w = (1 - u * u) * (1 - u * u);
+      }
+      if (w <= 0) continue;
+      h.noalias() += w * jac * jac.transpose();
+      g.noalias() += w * e * jac;
+      sum_sq += e * e;
+      ++used;
+    }
+    if (used < 3) return out;
+    // A whisper of damping keeps a nearly degenerate view (one flat face) solvable; it does not bias a good fit.
+    const Real damping = h.trace() * R(1e-9);
+    const Mat3 hd = h + damping * Mat3::Identity();
+    Mat3 hinv;
+    if (!invert_sym3(hd, &hinv)) return out;
+    const Vec3 delta = -(hinv * g);
+    if (!delta.allFinite()) return out;
+    pose.x_m += delta.x();
+    pose.y_m += delta.y();
+    pose.yaw_rad = wrap_angle(pose.yaw_rad + delta.z());
+    out.h = h;
+    out.rms_m = std::sqrt(sum_sq / static_cast<Real>(used));
+    out.iterations = static_cast<std::uint8_t>(it + 1);
+    if (std::fabs(delta.x()) + std::fabs(delta.y()) < R(1e-5) && std::fabs(delta.z()) < R(1e-5)) break;
+  }
+  out.pose = pose;
+  out.ok = out.iterations > 0;
+  return out;
+}
+
+void DockPoseEstimator::verify(Refined& r) {
+  r.inliers = r.expected = r.violations = r.occluded = r.extensions = 0;
+  r.shape_rms_m = 0;
+  if (!r.ok) {
+    r.reject = RejectReason::kNoConvergence;
+    return;
+  }
+  r.ok = false;
+  placed_.place(profile_, r.pose);
+  Real lo = 0;
+  Real hi = 0;
+  placed_.angular_span(&lo, &hi);
+  const Real dist_to_dock = std::sqrt(r.pose.x_m * r.pose.x_m + r.pose.y_m * r.pose.y_m);
+  // Look a little past the dock's ends as well: a surface that carries straight on past a dock edge is not a dock.
+  const Real margin = std::atan2(kExtensionMaxM, dist_to_dock > R(0.05) ? dist_to_dock : R(0.05));
+  const long first = first_beam(lo - margin);
+  const std::size_t n_beams = static_cast<std::size_t>((hi - lo + 2 * margin) / angle_inc_rad_) + 2;
+  std::size_t k_first_hit = 0;
+  std::size_t k_last_hit = 0;
+  Real sum_sq = 0;
+  // Shape test over every unoccluded beam: residuals clamped at the inlier gate, so a look-alike whose shape
+  // departs from the dock's by less than the gate still pays for it, and a see-through beam costs a full gate.
+  Real sum_clamped = 0;
+  const Real clamp_sq = params_.inlier_gate_m * params_.inlier_gate_m;
+  // Per-segment tallies: every surface the dock shows must be there, not just most beams overall (a box face
+  // explains a winged dock's face and half of each wing).
+  std::uint16_t seg_expected[kMaxProfileVertices] = {};
+  std::uint16_t seg_inliers[kMaxProfileVertices] = {};
+  for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
+    std::size_t i = 0;
+    if (!beam_at(first, k, &i)) continue;
+    const Real m = range_m_[i];
+    Real expected_m = 0;
+    std::size_t seg = 0;
+    if (placed_.raycast(dir_[i], &expected_m, &seg)) {
+      if (r.expected == 0) k_first_hit = k;
+      k_last_hit = k;
+      ++r.expected;
+      const Real diff = m - expected_m;
+      if (m != 0 && std::fabs(diff) <= params_.inlier_gate_m) {
+        ++r.inliers;
+        ++seg_expected[seg];
+        ++seg_inliers[seg];
+        sum_sq += diff * diff;
+        sum_clamped += diff * diff;
+      } else if (m != 0 && diff < -params_.free_space_m) {
+        // Something well in front of the dock hides it: partial occlusion, neither for nor against.
+        ++r.occluded;
+      } else {
+        ++r.violations;
+        ++seg_expected[seg];
+        sum_clamped += clamp_sq;
+      }
+    }
+    if (m != 0 && continues_past_end(m * dir_[i])) ++r.extensions;
+  }
+  if (params_.require_wall_behind && r.expected > 0 && !wall_behind(r.pose, first, k_first_hit, k_last_hit)) {
+    r.reject = RejectReason::kNoWallBehind;
+    return;
+  }
+  for (std::size_t j = 0; j < placed_.segments; ++j) {
+    // Short features (slots, steps) are left out: mixed pixels at their depth edges make their beams unreliable.
+    if ((placed_.v_m[j + 1] - placed_.v_m[j]).norm() < params_.min_feature_length_m) continue;
+    // One stray beam per surface is forgiven: a mixed pixel at an edge is enough to sink a 3-beam wing otherwise.
+    const Real missing = static_cast<Real>(seg_expected[j] - seg_inliers[j]);
+    const Real allowed = (1 - params_.min_segment_support) * static_cast<Real>(seg_expected[j]);
+    if (seg_expected[j] >= 3 && missing > (allowed > 1 ? allowed : 1)) {
+      r.reject = RejectReason::kSegmentUnsupported;
+      return;
+    }
+  }
+  if (r.inliers > 0) r.rms_m = std::sqrt(sum_sq / static_cast<Real>(r.inliers));
+  const std::uint16_t unoccluded_n = static_cast<std::uint16_t>(r.expected - r.occluded);
+  r.shape_rms_m = unoccluded_n > 0 ? std::sqrt(sum_clamped / static_cast<Real>(unoccluded_n)) : R(0);
+  const Real expected = static_cast<Real>(r.expected);
+  const Real unoccluded = static_cast<Real>(r.expected - r.occluded);
+  const Vec2 t(r.pose.x_m, r.pose.y_m);
+  const Real dist_m = t.norm();
+  const Vec2 face(std::cos(r.pose.yaw_rad), std::sin(r.pose.yaw_rad));
+  const Real cos_view = dist_m > 0 ? -face.dot(t) / dist_m : R(-1);
+  r.reject = RejectReason::kNone;
+  if (r.inliers < params_.min_inliers) {
+    r.reject = RejectReason::kTooFewInliers;
+  } else if (static_cast<Real>(r.inliers) < params_.min_inlier_fraction * unoccluded) {
+    r.reject = RejectReason::kLowInlierFraction;
+  } else if (static_cast<Real>(r.inliers) < params_.min_visible_fraction * expected) {
+    r.reject = RejectReason::kMostlyHidden;
+  } else if (static_cast<Real>(r.violations) > params_.max_violation_fraction * expected) {
+    r.reject = RejectReason::kSeeThrough;
+  } else if (r.rms_m > params_.max_rms_m || r.shape_rms_m > params_.max_shape_rms_m) {
+    r.reject = RejectReason::kHighRms;
+  } else if (r.extensions > params_.max_extension_points) {
+    r.reject = RejectReason::kSurfaceContinues;
+  } else if (cos_view < std::cos(params_.max_view_angle_rad)) {
+    r.reject = RejectReason::kOblique;
+  } else if (dist_m > params_.max_range_m) {
+    r.reject = RejectReason::kOutOfRange;
+  }
+  if (r.reject != RejectReason::kNone) return;
+  r.ok = true;
+}
+
+Real DockPoseEstimator::prescore(const Pose2& pose) {
+  placed_.place(profile_, pose);
+  Real lo = 0;
+  Real hi = 0;
+  placed_.angular_span(&lo, &hi);
+  const std::size_t n_beams = static_cast<std::size_t>((hi - lo) / angle_inc_rad_) + 2;
+  const long first = first_beam(lo);
+  const Real gate = 2 * params_.inlier_gate_m;
+  Real score = 0;
+  // Every other beam: ranking only needs a rough count, refinement and verification look at all of them.
+  for (std::size_t k = 0; k < n_beams && k < beams_; k += 2) {
+    std::size_t i = 0;
+    if (!beam_at(first, k, &i)) continue;
+    Real expected_m = 0;
+    std::size_t seg = 0;
+    if (!placed_.raycast(dir_[i], &expected_m, &seg)) continue;
+    const Real m = range_m_[i];
+    if (m != 0 && std::fabs(m - expected_m) <= gate) {
+      score += 1;
+    } else if (m == 0 || m > expected_m) {
+      score -= 2;  // seeing through the dock is strong evidence against it
+    }
+  }
+  return score;
+}
+
+void DockPoseEstimator::push_hypothesis(const Vec2& n_scan, const Vec2& anchor_scan, const Vec2& anchor_dock,
+                                        std::size_t profile_segment, std::size_t* n) {
+  const Vec2 n_j = profile_.normal(profile_segment);
+  const Real yaw = wrap_angle(std::atan2(n_scan.y(), n_scan.x()) - std::atan2(n_j.y(), n_j.x()));
+  const Real c = std::cos(yaw);
+  const Real s = std::sin(yaw);
+  const Vec2 t = anchor_scan - Vec2(c * anchor_dock.x() - s * anchor_dock.y(), s * anchor_dock.x() + c * anchor_dock.y());
+  if (*n >= kMaxHypotheses) {
+    ++counters_.truncated_candidates;
+    return;
+  }
+  hyps_[*n].pose = Pose2{t.x(), t.y(), yaw};
+  hyps_[*n].prescore = prescore(hyps_[*n].pose);
+  ++*n;
+}
+
+namespace {
+
+// Running first and second moments of a point set, relative to a local origin (keeps float builds accurate).
+struct RunningMoments {
+  Vec2 origin = Vec2::Zero();
+  Real n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+  void add(const Vec2& p, Real sign) {
+    const Vec2 d = p - origin;
+    n += sign;
+    sx += sign * d.x();
+    sy += sign * d.y();
+    sxx += sign * d.x() * d.x();
+    sxy += sign * d.x() * d.y();
+    syy += sign * d.y() * d.y();
+  }
+  // Total-least-squares line: centroid, unit normal and mean squared orthogonal residual.
+  void fit(Vec2* centroid, Vec2* normal, Real* msr) const {
+    const Real mx = sx / n;
+    const Real my = sy / n;
+    const Real cxx = sxx / n - mx * mx;
+    const Real cxy = sxy / n - mx * my;
+    const Real cyy = syy / n - my * my;
+    const Real half_diff = (cxx - cyy) * R(0.5);
+    const Real root = std::sqrt(half_diff * half_diff + cxy * cxy);
+    const Real theta = R(0.5) * std::atan2(2 * cxy, cxx - cyy);  // direction of the principal axis
+    *centroid = origin + Vec2(mx, my);
+    *normal = Vec2(-std::sin(theta), std::cos(theta));
+    const Real lo = (cxx + cyy) * R(0.5) - root;
+    *msr = lo > 0 ? lo : 0;
+  }
+};
+
+}  // namespace
+
+void DockPoseEstimator::add_window_hypotheses(std::size_t* n) {
+  // Split the points into contiguous runs (no range gap), in circular order on a full-turn scan.
+  const std::size_t np = points_.size();
+  if (np < 5) return;
+  auto gap_after = [this, np](std::size_t k) {
+    const ScanPoint& a = points_[k];
+    const ScanPoint& b = points_[(k + 1) % np];
+    const Real allowed = std::fmax(R(0.05), 5 * a.range_m * angle_inc_rad_);
+    return (b.p_m - a.p_m).norm() > allowed;
+  };
+  // Start just after a gap so no run is cut by the array's end (only matters when the scan wraps).
+  std::size_t start = 0;
+  if (wraps_) {
+    for (std::size_t k = 0; k < np; ++k) {
+      if (gap_after(k)) {
+        start = (k + 1) % np;
+        break;
+      }
+    }
+  }
+  const Real gate = R(1.5) * params_.range_sigma_m;       // a dock surface is flat to the noise level
+  const Real break_m = R(2.5) * params_.range_sigma_m;    // a neighbour this far off the line ends the surface
+  for (std::size_t j = 0; j < profile_.segment_count(); ++j) {
+    const Vec2& a_j = profile_.vertices_m[j];
+    const Vec2& b_j = profile_.vertices_m[j + 1];
+    const Real len_j = (b_j - a_j).norm();
+    if (len_j < params_.min_feature_length_m) continue;
+    const Vec2 mid_j = (a_j + b_j) * R(0.5);
+    const Real half = len_j * R(0.5);
+    std::size_t run_lo = 0;  // positions in circular order, relative to start
+    while (run_lo < np) {
+      std::size_t run_hi = run_lo;
+      while (run_hi + 1 < np && !gap_after((start + run_hi) % np)) ++run_hi;
+      auto at = [this, start, np](std::size_t pos) -> const Vec2& { return points_[(start + pos) % np].p_m; };
+      RunningMoments m;
+      m.origin = at(run_lo);
+      std::size_t lo = run_lo;
+      std::size_t hi = run_lo;
+      m.add(at(run_lo), 1);
+      Vec2 last_kept(std::numeric_limits<Real>::max(), 0);
+      for (std::size_t c = run_lo; c <= run_hi; ++c) {
+        const Vec2& pc = at(c);
+        while (hi + 1 <= run_hi && (at(hi + 1) - pc).norm() <= half) m.add(at(++hi), 1);
+        while (lo < c && (at(lo) - pc).norm() > half) m.add(at(lo++), -1);
+        if (m.n < 5 || (at(hi) - at(lo)).norm() < R(0.7) * len_j) continue;
+        Vec2 centroid;
+        Vec2 normal;
+        Real msr = 0;
+        m.fit(&centroid, &normal, &msr);
+        if (msr > gate * gate) continue;
+        // The surface must stop at one end at least: the middle of a wall is not a dock feature.
+        const bool lo_break = lo == run_lo || std::fabs(normal.dot(at(lo - 1) - centroid)) > break_m;
+        const bool hi_break = hi == run_hi || std::fabs(normal.dot(at(hi + 1) - centroid)) > break_m;
+        if (!lo_break && !hi_break) continue;
+        if ((centroid - last_kept).norm() < R(0.25) * len_j) continue;  // neighbours of a kept window add nothing
+        last_kept = centroid;
+        if (normal.dot(centroid) > 0) normal = -normal;  // face the lidar
+        push_hypothesis(normal, centroid, mid_j, j, n);
+      }
+      run_lo = run_hi + 1;
+    }
+  }
+}
+
+std::size_t DockPoseEstimator::generate_candidates() {
+  std::size_t n = 0;
+  add_window_hypotheses(&n);
+  const SegmentStats stats = extract_line_segments(points_, angle_inc_rad_, wraps_, params_.segments, segs_);
+  if (stats.truncated()) ++counters_.truncated_segments;
+  for (std::size_t j = 0; j < profile_.segment_count(); ++j) {
+    const Vec2& a_j = profile_.vertices_m[j];
+    const Vec2& b_j = profile_.vertices_m[j + 1];
+    const Real len_j = (b_j - a_j).norm();
+    if (len_j < params_.min_feature_length_m) continue;
+    const Vec2 mid_j = (a_j + b_j) * R(0.5);
+    for (std::size_t k = 0; k < segs_.size(); ++k) {
+      const LineSegment& seg = segs_[k];
+      const Real len_s = seg.length_m();
+      // A partly hidden feature may be short; one much longer than the profile's is something else.
+      if (len_s < R(0.35) * len_j || len_s > R(1.3) * len_j + 2 * params_.inlier_gate_m) continue;
+      if (seg.rms_m > 2 * params_.max_rms_m) continue;  // corners and mixed pixels inflate a feature's RMS
+      // Which end of the scan segment corresponds to the profile segment's first vertex: the rotation maps the
+      // profile segment's direction onto the scan segment's, up to sign, and the normals agree.
+      const Vec2 d_j = (b_j - a_j) / len_j;
+      const Vec2 n_j = profile_.normal(j);
+      const Vec2 d_s = seg.direction();
+      // Rotation taking n_j to seg.normal, applied to d_j, compared with the scan direction.
+      const Real yaw = std::atan2(seg.normal.y(), seg.normal.x()) - std::atan2(n_j.y(), n_j.x());
+      const Vec2 d_rot(std::cos(yaw) * d_j.x() - std::sin(yaw) * d_j.y(), std::sin(yaw) * d_j.x() + std::cos(yaw) * d_j.y());
+      const bool same_dir = d_rot.dot(d_s) > 0;
+      const Vec2& sa = same_dir ? seg.start_m : seg.end_m;
+      const Vec2& sb = same_dir ? seg.end_m : seg.start_m;
+      push_hypothesis(seg.normal, seg.midpoint_m(), mid_j, j, &n);
+      if (len_s < R(0.85) * len_j) {
+        push_hypothesis(seg.normal, sa, a_j, j, &n);
+        push_hypothesis(seg.normal, sb, b_j, j, &n);
+      }
+    }
+  }
+  // Best prescores first (selection sort over at most max_candidates slots: n is small and bounded).
+  const std::size_t keep = n < params_.max_candidates ? n : params_.max_candidates;
+  for (std::size_t i = 0; i < keep; ++i) {
+    std::size_t best = i;
+    for (std::size_t k = i + 1; k < n; ++k) {
+      if (hyps_[k].prescore > hyps_[best].prescore) best = k;
+    }
+    if (best != i) {
+      const Hypothesis tmp = hyps_[i];
+      hyps_[i] = hyps_[best];
+      hyps_[best] = tmp;
+    }
+  }
+  if (n > keep) counters_.truncated_candidates += static_cast<std::uint32_t>(n - keep);
+  return keep;
+}
+
+DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lidar_mount, const Pose2* hint) {
+  DockEstimate est;
+  ++counters_.scans;
+  if (!configured_) {
+    est.status = EstimateStatus::kNoProfile;
+    return est;
+  }
+  if (!load_scan(scan)) {
+    ++counters_.bad_scans;
+    est.status = EstimateStatus::kBadScan;
+    return est;
+  }
+  if (points_.size() < params_.min_inliers) {
+    est.status = EstimateStatus::kNoPoints;
+    return est;
+  }
+  const Pose2 mount_inv = lidar_mount.inverse();
+  Pose2 hint_lidar{};
+  if (hint != nullptr) hint_lidar = mount_inv.compose(*hint);
+
+  Refined best{};
+  best.ok = false;
+  bool best_from_hint = false;
+  Real best_key = 0;
+  auto consider = [&](Refined& r, bool from_hint) {
+    ++counters_.candidates;
+    ++est.candidates;
+    verify(r);
+    if (r.ok && hint != nullptr && params_.hint_radius_m > 0 &&
+        dist2(r.pose, hint_lidar) > params_.hint_radius_m * params_.hint_radius_m) {
+      r.ok = false;
+      r.reject = RejectReason::kFarFromHint;
+    }
+    if (!r.ok) {
+      ++counters_.rejected;
+      ++counters_.rejected_by[static_cast<std::size_t>(r.reject)];
+      return;
+    }
+    ++est.verified;
+    const bool by_hint = params_.select == DockSelect::kHint && hint != nullptr;
+    const Real key = by_hint ? dist2(r.pose, hint_lidar) : r.pose.x_m * r.pose.x_m + r.pose.y_m * r.pose.y_m;
+    // Two verified poses within the dock's own size explain the same object: keep the one that explains it better
+    // (a face placed on a wing can verify on the beams it predicts, with a worse fit). Otherwise select by key.
+    const bool same_object = best.ok && dist2(r.pose, best.pose) < profile_radius_m_ * profile_radius_m_;
+    const bool better = !best.ok || (same_object ? quality(r) > quality(best) : key < best_key);
+    if (better) {
+      best = r;
+      best_key = key;
+      best_from_hint = from_hint;
+    }
+  };
+
+  if (hint != nullptr) {
+    Refined r = refine(hint_lidar);
+    consider(r, true);
+  }
+  // Tracking: a hint that verifies and stays near the hint ends the search; a global search runs otherwise.
+  const bool tracked = best.ok && dist2(best.pose, hint_lidar) <= params_.hint_gate_m * params_.hint_gate_m;
+  if (!tracked) {
+    const std::size_t n = generate_candidates();
+    std::size_t done = 0;
+    Pose2 verified_poses[8];
+    for (std::size_t k = 0; k < n; ++k) {
+      // Hypotheses from the face and the wings of one dock converge to the same pose: refine each dock once.
+      bool duplicate = false;
+      for (std::size_t q = 0; q < done; ++q) {
+        duplicate = duplicate || (dist2(hyps_[k].pose, verified_poses[q]) < R(0.03 * 0.03) &&
+                                  std::fabs(wrap_angle(hyps_[k].pose.yaw_rad - verified_poses[q].yaw_rad)) < R(0.1));
+      }
+      if (duplicate) continue;
+      Refined r = refine(hyps_[k].pose);
+      consider(r, false);
+      if (r.ok && done < 8) verified_poses[done++] = r.pose;
+    }
+    if (n == 0 && !best.ok) {
+      est.status = EstimateStatus::kNoCandidates;
+      return est;
+    }
+  }
+  if (!best.ok) {
+    est.status = EstimateStatus::kNotVerified;
+    return est;
+  }
+  // Covariance in the lidar frame: residual variance times the inverse normal matrix.
+  const Real sigma = best.rms_m > params_.range_sigma_m ? best.rms_m : params_.range_sigma_m;
+  Mat3 h_inv = Mat3::Constant(std::numeric_limits<Real>::infinity());
+  invert_sym3(best.h, &h_inv);
+  const Mat3 cov_lidar = sigma * sigma * h_inv;
+  const Real c = std::cos(lidar_mount.yaw_rad);
+  const Real s = std::sin(lidar_mount.yaw_rad);
+  Mat3 rot = Mat3::Identity();
+  rot(0, 0) = c;
+  rot(0, 1) = -s;
+  rot(1, 0) = s;
+  rot(1, 1) = c;
+  est.covariance = rot * cov_lidar * rot.transpose();
+  if (!est.covariance.allFinite() || std::sqrt(est.covariance(0, 0) + est.covariance(1, 1)) > params_.max_sigma_m) {
+    ++counters_.rejected;
+    ++counters_.rejected_by[static_cast<std::size_t>(RejectReason::kUncertain)];
+    est.status = EstimateStatus::kNotVerified;
+    return est;
+  }
+  est.found = true;
+  est.status = EstimateStatus::kOk;
+  est.pose = lidar_mount.compose(best.pose);
+  est.rms_m = best.rms_m;
+  est.shape_rms_m = best.shape_rms_m;
+  est.inliers = best.inliers;
+  est.expected = best.expected;
+  est.violations = best.violations;
+  est.occluded = best.occluded;
+  est.extensions = best.extensions;
+  est.iterations = best.iterations;
+  est.from_hint = best_from_hint;
+  ++counters_.found;
+  return est;
+}
+
+}  // namespace dockcore
