@@ -1,0 +1,87 @@
+#pragma once
+/// @file Dockcore: the whole docking stack behind two calls, as dockd and dock-sim run it.
+///
+/// Owns a DockPoseEstimator (per-scan detection), a DockPoseFilter (the dock in the odometry frame, fed by the
+/// detections) and a TaskManager (states, safety, faults); drives a DockingController given by reference.
+/// - on_scan(): detection with the filter's prediction as the estimator's hint (tracking mode; global search when
+///   the filter has no dock or the hint fails), then the filter update. The scan is copied so the tick can run the
+///   obstacle check and give controllers (seed003) the latest ranges.
+/// - tick(): the filtered dock seen from the current odometry pose, the latest raw detection (for the push test),
+///   the latest scan and the host's flags go to the TaskManager; its twist and status come back.
+/// The filter is reset when a new dock task starts (the robot may have been carried since the last one).
+/// No heap; the object is large (estimator buffers plus one LaserScan copy, ~0.2 MB with double): keep it static or
+/// a member, never on a small stack.
+
+#include <cstdint>
+
+#include "dockcore/controller.hpp"
+#include "dockcore/dock_pose_estimator.hpp"
+#include "dockcore/dock_pose_filter.hpp"
+#include "dockcore/dock_profile.hpp"
+#include "dockcore/geometry.hpp"
+#include "dockcore/laser_scan.hpp"
+#include "dockcore/safety.hpp"
+#include "dockcore/task_manager.hpp"
+
+namespace dockcore {
+
+/// Everything Dockcore needs besides the profile and the controller.
+struct DockcoreConfig {
+  EstimatorParams estimator{};
+  DockFilterParams filter{};
+  TaskParams task{};
+  FootprintParams footprint{};
+  Pose2 lidar_mount{};                               ///< Lidar in the robot frame.
+  Real lidar_stale_s = static_cast<Real>(0.5);       ///< No scan for this long: lidar stale (fault 185 when moving).
+};
+
+/// Per-tick input from the chassis and the host.
+struct TickInput {
+  std::uint64_t now_us = 0;   ///< Monotonic time, same clock as the scan stamps.
+  HostCommand command{};      ///< Command arriving on this tick (edge).
+  Pose2 odom_pose{};
+  Twist2 odom_twist{};
+  CameraTarget camera{};
+  bool contact = false;
+  Real charge_current_a = 0;
+  bool chassis_ok = true;     ///< Chassis feedback fresh (host's judgement).
+  bool lidar_ok = true;       ///< Host's lidar health; Dockcore also checks scan age against lidar_stale_s.
+};
+
+using TickOutput = TaskOutput;
+
+class Dockcore {
+ public:
+  /// `controller` must outlive this object.
+  explicit Dockcore(DockingController& controller) : tasks_(controller) {}
+
+  /// Configures every part; false (unusable until a good call) when the profile has no segments. O(vertices).
+  bool configure(const DockProfile& profile, const DockcoreConfig& config);
+
+  /// One scan: detection (hint = the filter's prediction for `odom_pose`), filter update, scan copy.
+  /// `odom_pose`: robot odometry pose at the scan time; `stamp_us`: scan time. Cost: the estimator's plus O(count).
+  const DockEstimate& on_scan(const ScanView& scan, std::uint64_t stamp_us, const Pose2& odom_pose);
+
+  /// One control tick. Cost: TaskManager::tick.
+  TickOutput tick(const TickInput& in);
+
+  const DockEstimate& last_estimate() const { return last_estimate_; }
+  const DockPoseFilter& filter() const { return filter_; }
+  const DockPoseEstimator& estimator() const { return estimator_; }
+  const TaskManager& task_manager() const { return tasks_; }
+  const DockcoreConfig& config() const { return config_; }
+
+ private:
+  DockcoreConfig config_{};
+  DockPoseEstimator estimator_{};
+  DockPoseFilter filter_{};
+  TaskManager tasks_;
+  LaserScan scan_{};
+  bool have_scan_ = false;
+  std::uint64_t last_scan_us_ = 0;
+  DockEstimate last_estimate_{};
+  DetectionInput pending_{};
+  TaskState prev_state_ = TaskState::kNotTasking;
+};
+
+}  // namespace dockcore

@@ -1,0 +1,75 @@
+#include "dockcore/dockcore.hpp"
+
+namespace dockcore {
+
+bool Dockcore::configure(const DockProfile& profile, const DockcoreConfig& config) {
+  config_ = config;
+  filter_ = DockPoseFilter(config.filter);
+  tasks_.configure(config.task, config.footprint, profile);
+  have_scan_ = false;
+  pending_ = DetectionInput{};
+  last_estimate_ = DockEstimate{};
+  prev_state_ = TaskState::kNotTasking;
+  return estimator_.configure(profile, config.estimator);
+}
+
+const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_us, const Pose2& odom_pose) {
+  const std::size_t n = scan.count < LaserScan::kCapacity ? scan.count : LaserScan::kCapacity;
+  scan_.reset(n, scan.angle_min_rad, scan.angle_increment_rad, stamp_us);
+  for (std::size_t i = 0; i < n; ++i) {
+    scan_.ranges_m[i] = scan.ranges_m != nullptr ? scan.ranges_m[i] : static_cast<Real>(0);
+    scan_.intensities[i] = scan.intensities != nullptr ? scan.intensities[i] : static_cast<Real>(0);
+  }
+  have_scan_ = true;
+  last_scan_us_ = stamp_us;
+
+  Pose2 hint{};
+  const Pose2* hint_ptr = nullptr;
+  if (filter_.initialised()) {
+    hint = filter_.dock_in_robot(odom_pose);
+    hint_ptr = &hint;
+  }
+  last_estimate_ = estimator_.estimate(scan, config_.lidar_mount, hint_ptr);
+  if (last_estimate_.found) {
+    filter_.update(last_estimate_.pose, last_estimate_.covariance, odom_pose, stamp_us);
+    pending_.fresh = true;
+    pending_.dock_in_robot = last_estimate_.pose;
+    pending_.odom_at_scan = odom_pose;
+    pending_.stamp_us = stamp_us;
+  }
+  return last_estimate_;
+}
+
+TickOutput Dockcore::tick(const TickInput& in) {
+  TaskInput t;
+  t.now_us = in.now_us;
+  t.command = in.command;
+  t.odom_pose = in.odom_pose;
+  t.odom_twist = in.odom_twist;
+  t.camera = in.camera;
+  t.contact = in.contact;
+  t.charge_current_a = in.charge_current_a;
+  t.chassis_ok = in.chassis_ok;
+  const bool scan_recent = have_scan_ && (in.now_us <= last_scan_us_ ||
+      static_cast<Real>(in.now_us - last_scan_us_) * static_cast<Real>(1e-6) <= config_.lidar_stale_s);
+  t.lidar_ok = in.lidar_ok && scan_recent;
+  const ScanView view = scan_.view();
+  t.scan = have_scan_ ? &view : nullptr;
+  t.lidar_mount = config_.lidar_mount;
+  if (filter_.initialised()) {
+    t.dock.valid = true;
+    t.dock.pose = filter_.dock_in_robot(in.odom_pose, &t.dock.covariance);
+    t.dock.stamp_us = filter_.last_update_us();
+  }
+  t.detection = pending_;
+  pending_.fresh = false;
+
+  TickOutput out = tasks_.tick(t);
+  // A new dock task: forget the old dock (the robot may have been carried since), so the push test and the
+  // controller start from this task's own detections.
+  if (out.status.state == TaskState::kGetTaskingCmd && prev_state_ != TaskState::kGetTaskingCmd) filter_.reset();
+  prev_state_ = out.status.state;
+  return out;
+}
+
+}  // namespace dockcore
