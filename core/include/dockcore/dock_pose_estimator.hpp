@@ -76,7 +76,8 @@ const char* to_string(EstimateStatus s);
 /// Tuning of the estimator. Defaults suit LD06-class lidars (0.8°, σ 10 mm) and docks 0.2–0.5 m wide.
 struct EstimatorParams {
   Real min_range_m = static_cast<Real>(0.05);     ///< Closer returns are ignored (lidar blind zone).
-  Real max_range_m = static_cast<Real>(3.0);      ///< Farther returns are ignored; docks are sought within this.
+  Real max_range_m = static_cast<Real>(2.5);      ///< Farther returns are ignored; docks are sought within this
+                                                  ///< (seed 000 uses 2.1 m; beyond ~2.5 m a 0.3 m dock is < 15 beams).
   Real range_sigma_m = static_cast<Real>(0.01);   ///< Expected 1-σ range noise; scales the gates and covariance.
   Real huber_k = static_cast<Real>(1.5);          ///< Huber threshold in units of range_sigma_m (first 3 iterations).
   Real tukey_c = static_cast<Real>(3.0);          ///< Tukey biweight cut-off in units of range_sigma_m (after).
