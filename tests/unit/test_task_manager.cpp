@@ -1,0 +1,660 @@
+// TaskManager and Dockcore in closed loop with a scripted fake controller, a kinematic robot and the lidar simulator.
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "dockcore/dock_profile.hpp"
+#include "dockcore/dockcore.hpp"
+#include "dockcore/task_manager.hpp"
+#include "docksim/lidar_sim.hpp"
+#include "docksim/rng.hpp"
+
+#include <CppUTest/TestHarness.h>
+
+using namespace dockcore;
+
+namespace {
+
+constexpr double kHalfLength = 0.37;  // square footprint default: front edge 0.37 m ahead of the centre
+
+/// Drives straight at the dock origin and reports kArrived on contact; scriptable failure.
+class FakeController : public DockingController {
+ public:
+  const char* name() const override { return "fake"; }
+  const char* phase_name(std::uint8_t p) const override { return p == 1 ? "drive" : "idle"; }
+  void reset() override { ++resets; }
+  ControlOutput step(const ControlInput& in) override {
+    ++steps;
+    ControlOutput o;
+    if (in.contact) {
+      o.status = ControlStatus::kArrived;
+      return o;
+    }
+    if (fail) {
+      o.status = ControlStatus::kFailed;
+      return o;
+    }
+    if (!in.dock_valid) {
+      o.status = ControlStatus::kLost;
+      return o;
+    }
+    const double x = in.dock_in_robot.x_m, y = in.dock_in_robot.y_m;
+    const double bearing = std::atan2(y, x);
+    const double gap = std::sqrt(x * x + y * y) - kHalfLength;
+    o.phase = 1;
+    o.cmd.vx_mps = std::fmax(0.06, std::fmin(0.2, 0.5 * gap));
+    o.cmd.wz_radps = 1.5 * bearing;
+    return o;
+  }
+  bool fail = false;
+  int resets = 0;
+  int steps = 0;
+};
+
+bool moving_state(TaskState s) {
+  return s == TaskState::kReachTaskingPoint || s == TaskState::kAlign || s == TaskState::kRetry ||
+         s == TaskState::kUndocking;
+}
+
+/// World: dock at the origin facing +x, wall flush with its back, robot at 50 Hz, scans and detections at 10 Hz.
+struct Sim {
+  static constexpr std::uint64_t kTickUs = 20000;
+  FakeController ctrl;
+  TaskManager tm{ctrl};
+  TaskParams params;
+  DockProfile profile;
+  Pose2 dock{0, 0, 0};
+  Pose2 world{1.2, 0.1, kPi};  // truth
+  Pose2 odom{1.2, 0.1, kPi};   // odometry (equal until a push)
+  Pose2 dock_in_odom{0, 0, 0}; // what the (gating) filter believes
+  std::uint64_t now_us = 1000000;
+  std::uint64_t dock_stamp_us = 0;
+  bool dock_valid = false;
+  bool occluded = false;
+  bool visible_only_when_turned = false;  // detection only with |yaw - start| > 10°
+  double start_yaw = kPi;
+  bool charger_works = true;
+  int charger_fails_first = 0;  // contacts that get no current (attempts)
+  int contacts_made = 0;
+  bool contact = false;
+  bool prev_contact = false;
+  std::uint64_t contact_since_us = 0;
+  bool charge_enable = false;
+  bool current_stays_on = false;  // undock-failure script
+  bool chassis_ok = true, lidar_ok = true;
+  std::vector<Vec2> obstacles;   // box centres, 0.1 m boxes
+  TaskOutput out;
+  std::vector<TaskState> states;  // state changes in order
+  int ticks = 0;
+  int zero_violations = 0;
+  int wait_entries = 0;
+  docksim::LidarModel model;
+  docksim::Rng rng{1};
+  LaserScan scan;
+  bool have_scan = false;
+
+  Sim() {
+    builtin_profile("breakpoint", profile);
+    docksim::lidar_model("ld06", &model);
+    model.sigma_const_m = 0;
+    model.dropout_prob = 0;
+    model.mixed_pixels = false;
+    params.detect_wait_s = 0.3;
+    tm.configure(params, square_footprint(), profile);
+    states.push_back(TaskState::kNotTasking);
+  }
+  void reconfigure() { tm.configure(params, square_footprint(), profile); }
+
+  docksim::World world_model() const {
+    docksim::World w;
+    w.add_dock(profile, dock);
+    w.add_polyline({Vec2(-0.10, -3.0), Vec2(-0.10, 3.0)});
+    for (const Vec2& c : obstacles) w.add_box(c, 0.1, 0.1, 0);
+    return w;
+  }
+
+  bool detectable() const {
+    if (occluded) return false;
+    if (visible_only_when_turned && std::fabs(wrap_angle(world.yaw_rad - start_yaw)) < deg_to_rad(10)) return false;
+    return true;
+  }
+
+  TaskOutput step(HostCommand cmd = HostCommand{}) {
+    TaskInput in;
+    in.now_us = now_us;
+    in.command = cmd;
+    const bool scan_tick = ticks % 5 == 0;
+    if (scan_tick) {
+      simulate_scan(world_model(), world, model, rng, &scan, now_us);
+      have_scan = true;
+      if (detectable()) {
+        dock_valid = true;
+        dock_stamp_us = now_us;
+        in.detection.fresh = true;
+        in.detection.dock_in_robot = world.inverse().compose(dock);
+        in.detection.odom_at_scan = odom;
+        in.detection.stamp_us = now_us;
+      }
+    }
+    const ScanView view = scan.view();
+    in.scan = have_scan ? &view : nullptr;
+    in.dock.valid = dock_valid;
+    in.dock.pose = odom.inverse().compose(dock_in_odom);
+    in.dock.stamp_us = dock_stamp_us;
+    in.odom_pose = odom;
+    in.contact = contact;
+    const bool current = contact && charge_enable && charger_works && contacts_made > charger_fails_first &&
+                         now_us - contact_since_us >= 500000;
+    in.charge_current_a = (current || (current_stays_on && contact)) ? 2.0 : 0.0;
+    in.chassis_ok = chassis_ok;
+    in.lidar_ok = lidar_ok;
+    out = tm.tick(in);
+    charge_enable = out.status.charge_enable;
+    if (out.status.state != states.back()) {
+      states.push_back(out.status.state);
+      if (out.status.state == TaskState::kWaitForCharge) ++wait_entries;
+    }
+    const bool zero = out.cmd.vx_mps == 0 && out.cmd.vy_mps == 0 && out.cmd.wz_radps == 0;
+    if (!zero && (!moving_state(out.status.state) || out.blocked || out.target_lost)) ++zero_violations;
+    // Integrate the commanded body twist exactly (arc) for truth and odometry alike.
+    const double dt = kTickUs * 1e-6;
+    const Pose2 delta = arc(out.cmd, dt);
+    world = world.compose(delta);
+    odom = odom.compose(delta);
+    // The dock is a hard stop: the front edge may not pass the dock plane (x = 0 in the dock frame).
+    const Vec2 front = dock.inverse_transform(world.transform(Vec2(kHalfLength, 0)));
+    if (front.x() < 0 && std::fabs(front.y()) < 0.3) {
+      const double back = -front.x();
+      world.x_m += back;  // the dock faces +x
+      odom = odom.compose(Pose2{-back / std::fabs(std::cos(world.yaw_rad)), 0, 0});
+    }
+    const Vec2 f2 = dock.inverse_transform(world.transform(Vec2(kHalfLength, 0)));
+    contact = f2.x() <= 0.002 && std::fabs(f2.y()) < 0.05;
+    if (contact && !prev_contact) {
+      contact_since_us = now_us;
+      ++contacts_made;
+    }
+    prev_contact = contact;
+    now_us += kTickUs;
+    ++ticks;
+    return out;
+  }
+  static Pose2 arc(const Twist2& t, double dt) {
+    const double th = t.wz_radps * dt;
+    if (std::fabs(th) < 1e-12) return Pose2{t.vx_mps * dt, t.vy_mps * dt, 0};
+    const double r = t.vx_mps / t.wz_radps;
+    return Pose2{r * std::sin(th) - t.vy_mps * dt * 0, r * (1 - std::cos(th)) + t.vy_mps * dt, th};
+  }
+  /// Runs until `state` is reached or `max_s` passes; returns whether it was reached.
+  bool run_until(TaskState state, double max_s) {
+    const int n = static_cast<int>(max_s / (kTickUs * 1e-6));
+    for (int i = 0; i < n; ++i) {
+      if (step().status.state == state) return true;
+    }
+    return false;
+  }
+  void run_for(double s) {
+    const int n = static_cast<int>(s / (kTickUs * 1e-6));
+    for (int i = 0; i < n; ++i) step();
+  }
+  TaskOutput command(HostCommandType t, std::uint16_t id = 0) { return step(HostCommand{t, id}); }
+  double centre_to_dock() const { return std::hypot(world.x_m - dock.x_m, world.y_m - dock.y_m); }
+  bool saw(TaskState s) const {
+    for (TaskState x : states) if (x == s) return true;
+    return false;
+  }
+};
+
+std::unique_ptr<Sim> docked_sim() {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  s->run_until(TaskState::kFinishTasking, 30);
+  return s;
+}
+
+}  // namespace
+
+TEST_GROUP(TaskManager){};
+
+TEST(TaskManager, IdleCommandsZeroAndRejections) {
+  auto s = std::make_unique<Sim>();
+  s->run_for(1.0);
+  CHECK(s->out.status.state == TaskState::kNotTasking);
+  HostCommand bad;
+  bad.type = static_cast<HostCommandType>(99);
+  TaskOutput o = s->step(bad);
+  CHECK(o.command_result == CommandResult::kRejectedUnknown);
+  CHECK(o.status.state == TaskState::kNotTasking);
+  CHECK(o.status.last_command == CommandResult::kRejectedUnknown);
+  o = s->command(HostCommandType::kUndock);
+  CHECK(o.command_result == CommandResult::kRejectedNotDocked);
+  CHECK(o.status.state == TaskState::kNotTasking);
+  o = s->command(HostCommandType::kDock, 40);
+  CHECK(o.command_result == CommandResult::kRejectedDockId);
+  CHECK(o.status.state == TaskState::kNotTasking);
+  s->run_for(0.5);
+  DOUBLES_EQUAL(1.2, s->world.x_m, 1e-12);  // nothing moved
+  DOUBLES_EQUAL(0.1, s->world.y_m, 1e-12);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, HappyPathStateSequenceAndChargeRequest) {
+  auto s = std::make_unique<Sim>();
+  TaskOutput o = s->command(HostCommandType::kDock, 3);
+  CHECK(o.command_result == CommandResult::kAccepted);
+  CHECK(o.status.state == TaskState::kGetTaskingCmd);
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  const std::vector<TaskState> expect = {TaskState::kNotTasking, TaskState::kGetTaskingCmd,
+                                         TaskState::kReachTaskingPoint, TaskState::kAlign,
+                                         TaskState::kWaitForCharge, TaskState::kFinishTasking};
+  CHECK(s->states == expect);
+  CHECK(s->out.status.last_result == TaskResult::kDocked);
+  CHECK(s->out.status.charge_enable);
+  LONGS_EQUAL(3, s->out.status.dock_id);
+  LONGS_EQUAL(0, s->out.status.retries);
+  // Front edge at the dock plane, near the axis.
+  DOUBLES_EQUAL(kHalfLength, s->world.x_m, 0.003);
+  // The fake controller aims its centre line at the contacts: the front edge's middle lands on them.
+  const Vec2 front = s->world.transform(Vec2(kHalfLength, 0));
+  DOUBLES_EQUAL(0.0, front.x(), 0.003);
+  CHECK(std::fabs(front.y()) < 0.05);
+  s->run_for(5.0);  // stays docked, zero velocity throughout
+  CHECK(s->out.status.state == TaskState::kFinishTasking);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, DetectionSearchSwingsWithinAmplitudeThenFault177) {
+  auto s = std::make_unique<Sim>();
+  s->occluded = true;
+  s->command(HostCommandType::kDock);
+  double lo = 0, hi = 0;
+  for (int i = 0; i < 3000 && s->out.status.state != TaskState::kFault; ++i) {
+    s->step();
+    const double d = wrap_angle(s->world.yaw_rad - kPi);
+    lo = std::fmin(lo, d);
+    hi = std::fmax(hi, d);
+  }
+  CHECK(s->out.status.state == TaskState::kFault);
+  LONGS_EQUAL(177, static_cast<int>(s->out.status.fault));
+  const double a = s->params.swing_amplitude_rad;
+  // Reached both ends (within the 1° tolerance) and never overshot more than one tick of rotation past them.
+  CHECK(hi > a - deg_to_rad(1.01) && hi < a + 0.3 * 0.02 + 1e-9);
+  CHECK(lo < -a + deg_to_rad(1.01) && lo > -a - 0.3 * 0.02 - 1e-9);
+  const double yaw = s->world.yaw_rad;
+  s->run_for(2.0);
+  DOUBLES_EQUAL(yaw, s->world.yaw_rad, 0);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, DetectionDuringSwingStartsAlignment) {
+  auto s = std::make_unique<Sim>();
+  s->visible_only_when_turned = true;
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 10));
+  CHECK(std::fabs(wrap_angle(s->world.yaw_rad - kPi)) >= deg_to_rad(10));
+  s->visible_only_when_turned = false;
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+}
+
+TEST(TaskManager, PushSidewaysGives178OnTheFirstDetection) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(0.5);
+  s->world.y_m += 0.4;  // pushed: odometry does not see it
+  // The next scan tick is the first detection after the push: the fault must appear exactly then.
+  while (s->ticks % 5 != 0) {
+    s->step();
+    CHECK(s->out.status.state == TaskState::kAlign);
+  }
+  s->step();
+  CHECK(s->out.status.state == TaskState::kFault);
+  LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+  CHECK(s->out.cmd.vx_mps == 0 && s->out.cmd.wz_radps == 0);
+}
+
+TEST(TaskManager, TurnedByHandGives179OnTheFirstDetection) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(0.3);
+  // Turn about the dock origin by 35°: position relative to the dock keeps its distance, so only the yaw test fires.
+  const Pose2 turn{0, 0, deg_to_rad(35)};
+  s->world = turn.compose(s->world);
+  while (s->ticks % 5 != 0) s->step();
+  s->step();
+  CHECK(s->out.status.state == TaskState::kFault);
+  LONGS_EQUAL(179, static_cast<int>(s->out.status.fault));
+}
+
+TEST(TaskManager, SmallRotationBelowToleranceIsNotAFault) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  const Pose2 turn{0, 0, deg_to_rad(25)};  // under 30°, and the position stays on a circle about the dock
+  s->world = turn.compose(s->world);
+  s->run_for(0.2);
+  CHECK(s->out.status.state == TaskState::kAlign);
+}
+
+TEST(TaskManager, FarAwayDistanceTolerance178) {
+  auto s = std::make_unique<Sim>();
+  s->world = s->odom = Pose2{1.5, 0, kPi};
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  // Moved away along the line of sight, odometry seeing it (no push): beyond 2.0 m from the dock.
+  const double dx = 2.05 - s->world.x_m;
+  s->world.x_m += dx;
+  s->odom = s->odom.compose(Pose2{-dx, 0, 0});
+  while (s->ticks % 5 != 0) s->step();
+  s->step();
+  CHECK(s->out.status.state == TaskState::kFault);
+  LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+}
+
+TEST(TaskManager, StartingFartherThanTheToleranceIsAllowedButNotDrivingAway) {
+  auto s = std::make_unique<Sim>();
+  s->world = s->odom = Pose2{2.4, 0, kPi};  // the default scenario starts up to 2.5 m away
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(1.0);
+  CHECK(s->out.status.state == TaskState::kAlign);
+  const double dx = 2.75 - s->world.x_m;  // 0.35 m farther than at the start: beyond the 0.3 m growth margin
+  s->world.x_m += dx;
+  s->odom = s->odom.compose(Pose2{-dx, 0, 0});
+  while (s->ticks % 5 != 0) s->step();
+  s->step();
+  LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+}
+
+TEST(TaskManager, OneSecondOcclusionStopsAndRecovers) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(0.5);
+  s->occluded = true;
+  int lost_ticks = 0;
+  for (int i = 0; i < 50; ++i) {
+    s->step();
+    if (s->out.target_lost) {
+      ++lost_ticks;
+      CHECK(s->out.cmd.vx_mps == 0 && s->out.cmd.wz_radps == 0);
+    }
+    CHECK(s->out.status.state == TaskState::kAlign);
+  }
+  // Lost after 0.5 s without a detection (the last one may be up to 0.1 s before the occlusion).
+  CHECK(lost_ticks >= 20 && lost_ticks <= 30);
+  s->occluded = false;
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, TargetLostTimeout181) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->occluded = true;
+  const std::uint64_t t0 = s->now_us;
+  CHECK(s->run_until(TaskState::kFault, 10));
+  LONGS_EQUAL(181, static_cast<int>(s->out.status.fault));
+  const double waited = (s->now_us - t0) * 1e-6;
+  CHECK(waited > 5.0 && waited < 5.8);
+  s->run_for(1.0);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, ObstacleStopsAndResumes) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  // A box 0.15 m ahead of the front edge, on the way to the dock.
+  const Vec2 box = s->world.transform(Vec2(kHalfLength + 0.2, 0));
+  s->obstacles.push_back(box);
+  int blocked = 0;
+  for (int i = 0; i < 100; ++i) {
+    s->step();
+    if (s->out.blocked) ++blocked;
+  }
+  CHECK(blocked >= 90);
+  CHECK(s->out.status.state == TaskState::kAlign);
+  CHECK(s->out.obstacles.forward);
+  const double x = s->world.x_m;
+  s->run_for(0.5);
+  DOUBLES_EQUAL(x, s->world.x_m, 0);
+  s->obstacles.clear();
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, ObstacleTimeout180) {
+  auto s = std::make_unique<Sim>();
+  s->params.obstacle_timeout_s = 2.0;
+  s->reconfigure();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->obstacles.push_back(s->world.transform(Vec2(kHalfLength + 0.2, 0)));
+  CHECK(s->run_until(TaskState::kFault, 3.0));
+  LONGS_EQUAL(180, static_cast<int>(s->out.status.fault));
+}
+
+TEST(TaskManager, TheDockAndItsWallAreNotObstacles) {
+  auto s = docked_sim();
+  CHECK(s->out.status.state == TaskState::kFinishTasking);
+  // At the contacts the wall is 0.1 m ahead of the front edge: it must not have stopped the approach.
+  CHECK(s->saw(TaskState::kWaitForCharge));
+  CHECK(!s->saw(TaskState::kFault));
+}
+
+TEST(TaskManager, ChargingRetryThenSuccess) {
+  auto s = std::make_unique<Sim>();
+  s->charger_fails_first = 1;
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kRetry, 30));
+  CHECK(!s->out.status.charge_enable);
+  CHECK(s->run_until(TaskState::kReachTaskingPoint, 20));
+  // Backed off on odometry until the centre is at the staging distance.
+  DOUBLES_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.1 * 0.02 + 0.002);
+  LONGS_EQUAL(1, s->out.status.retries);
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  LONGS_EQUAL(2, s->wait_entries);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, ChargingExhaustionBacksOffThenFault182) {
+  auto s = std::make_unique<Sim>();
+  s->charger_works = false;
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kFault, 120));
+  LONGS_EQUAL(182, static_cast<int>(s->out.status.fault));
+  LONGS_EQUAL(s->params.max_retries + 1, s->wait_entries);
+  LONGS_EQUAL(s->params.max_retries, s->out.status.retries);
+  DOUBLES_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.004);  // a clean end: backed off
+  CHECK(!s->contact);
+  CHECK(!s->out.status.charge_enable);
+  const Pose2 p = s->world;
+  s->run_for(3.0);
+  DOUBLES_EQUAL(p.x_m, s->world.x_m, 0);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, ControllerFailureRetriesThenFault188) {
+  auto s = std::make_unique<Sim>();
+  s->ctrl.fail = true;
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kFault, 60));
+  LONGS_EQUAL(188, static_cast<int>(s->out.status.fault));
+  LONGS_EQUAL(s->params.max_retries, s->out.status.retries);
+}
+
+TEST(TaskManager, ContactsLostWhileCharging183) {
+  auto s = docked_sim();
+  CHECK(s->out.status.state == TaskState::kFinishTasking);
+  s->world.x_m += 0.05;  // pulled off the contacts
+  s->odom.x_m += 0.0;
+  s->step();
+  CHECK(!s->contact);
+  CHECK(s->run_until(TaskState::kFault, 1.0));
+  LONGS_EQUAL(183, static_cast<int>(s->out.status.fault));
+  CHECK(!s->out.status.charge_enable);
+}
+
+TEST(TaskManager, UndockBacksOffToStagingAndReportsDone) {
+  auto s = docked_sim();
+  TaskOutput o = s->command(HostCommandType::kUndock);
+  CHECK(o.command_result == CommandResult::kAccepted);
+  CHECK(o.status.state == TaskState::kUndocking);
+  CHECK(!o.status.charge_enable);
+  CHECK(s->run_until(TaskState::kNotTasking, 20));
+  CHECK(s->out.status.last_result == TaskResult::kUndocked);
+  DOUBLES_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.004);
+  s->run_for(1.0);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, UndockWaitsForAnObstacleBehind) {
+  auto s = docked_sim();
+  s->obstacles.push_back(s->world.transform(Vec2(-kHalfLength - 0.15, 0)));
+  s->command(HostCommandType::kUndock);
+  const double x = s->world.x_m;
+  s->run_for(2.0);
+  DOUBLES_EQUAL(x, s->world.x_m, 0);
+  CHECK(s->out.blocked);
+  CHECK(s->out.status.state == TaskState::kUndocking);
+  s->obstacles.clear();
+  CHECK(s->run_until(TaskState::kNotTasking, 20));
+}
+
+TEST(TaskManager, UndockFailsWhenCurrentDoesNotStop186) {
+  auto s = docked_sim();
+  s->current_stays_on = true;
+  s->command(HostCommandType::kUndock);
+  CHECK(s->run_until(TaskState::kFault, 5));
+  LONGS_EQUAL(186, static_cast<int>(s->out.status.fault));
+  DOUBLES_EQUAL(kHalfLength, s->world.x_m, 0.003);  // never drove with current flowing
+}
+
+TEST(TaskManager, DockWhileDockedIsReportedAndDoesNotMove) {
+  auto s = docked_sim();
+  TaskOutput o = s->command(HostCommandType::kDock);
+  CHECK(o.command_result == CommandResult::kAlreadyDocked);
+  CHECK(o.status.state == TaskState::kFinishTasking);
+  // After a cancel (charging off) the robot still sits on the contacts: dock confirms charging without moving.
+  s->command(HostCommandType::kCancel);
+  CHECK(s->out.status.state == TaskState::kNotTasking);
+  CHECK(s->out.status.last_result == TaskResult::kCancelled);
+  const double x = s->world.x_m;
+  o = s->command(HostCommandType::kDock);
+  CHECK(o.command_result == CommandResult::kAlreadyDocked);
+  CHECK(o.status.state == TaskState::kWaitForCharge);
+  CHECK(s->run_until(TaskState::kFinishTasking, 6));
+  DOUBLES_EQUAL(x, s->world.x_m, 0);
+}
+
+TEST(TaskManager, BusyAndCancelFromEveryActiveState) {
+  const TaskState targets[] = {TaskState::kGetTaskingCmd, TaskState::kReachTaskingPoint, TaskState::kAlign,
+                               TaskState::kWaitForCharge, TaskState::kRetry};
+  for (TaskState target : targets) {
+    auto s = std::make_unique<Sim>();
+    s->charger_works = false;
+    s->command(HostCommandType::kDock);
+    if (target != TaskState::kGetTaskingCmd) CHECK(s->run_until(target, 40));
+    CHECK(s->out.status.state == target);
+    TaskOutput o = s->command(HostCommandType::kTestMode);
+    if (s->out.status.state == target) CHECK(o.command_result == CommandResult::kRejectedBusy);
+    o = s->command(HostCommandType::kCancel);
+    CHECK(o.command_result == CommandResult::kAccepted);
+    CHECK(o.status.state == TaskState::kNotTasking);
+    CHECK(o.cmd.vx_mps == 0 && o.cmd.wz_radps == 0);
+    CHECK(!o.status.charge_enable);
+    s->run_for(0.5);
+    LONGS_EQUAL(0, s->zero_violations);
+  }
+}
+
+TEST(TaskManager, StaleChassisAndLidarFaults) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->lidar_ok = false;
+  s->step();
+  LONGS_EQUAL(185, static_cast<int>(s->out.status.fault));
+  s->lidar_ok = true;
+  s->command(HostCommandType::kCancel);
+  auto d = docked_sim();
+  d->lidar_ok = false;  // not moving: the lidar does not matter while charging
+  d->run_for(0.5);
+  CHECK(d->out.status.state == TaskState::kFinishTasking);
+  d->chassis_ok = false;
+  d->step();
+  LONGS_EQUAL(184, static_cast<int>(d->out.status.fault));
+  LONGS_EQUAL(0, d->zero_violations);
+}
+
+TEST(TaskManager, TaskTimeout189) {
+  auto s = std::make_unique<Sim>();
+  s->params.task_timeout_s = 3.0;
+  s->reconfigure();
+  s->occluded = true;
+  s->params.max_swings = 100;
+  s->reconfigure();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kFault, 4));
+  LONGS_EQUAL(189, static_cast<int>(s->out.status.fault));
+}
+
+TEST(TaskManager, FaultClearsWithCancelOrANewDock) {
+  auto s = std::make_unique<Sim>();
+  s->occluded = true;
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kFault, 30));
+  TaskOutput o = s->command(HostCommandType::kUndock);  // not on the contacts
+  CHECK(o.command_result == CommandResult::kRejectedNotDocked);
+  CHECK(o.status.state == TaskState::kFault);
+  o = s->command(HostCommandType::kCancel);
+  CHECK(o.status.state == TaskState::kNotTasking);
+  LONGS_EQUAL(0, static_cast<int>(o.status.fault));
+  // A fault also clears with a new dock command, which starts a fresh task.
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kFault, 30));
+  s->occluded = false;
+  o = s->command(HostCommandType::kDock);
+  CHECK(o.command_result == CommandResult::kAccepted);
+  CHECK(o.status.state == TaskState::kGetTaskingCmd);
+  LONGS_EQUAL(0, static_cast<int>(o.status.fault));
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+}
+
+TEST(TaskManager, TestModeReportsTheDockAndNeverMoves) {
+  auto s = std::make_unique<Sim>();
+  TaskOutput o = s->command(HostCommandType::kTestMode);
+  CHECK(o.status.state == TaskState::kTestMode);
+  s->run_for(1.0);
+  CHECK(s->out.status.dock_valid);
+  const Pose2 truth = s->world.inverse().compose(s->dock);
+  DOUBLES_EQUAL(truth.x_m, s->out.status.dock_pose.x_m, 1e-9);
+  o = s->command(HostCommandType::kDock);
+  CHECK(o.command_result == CommandResult::kRejectedBusy);
+  DOUBLES_EQUAL(1.2, s->world.x_m, 0);
+  o = s->command(HostCommandType::kCancel);
+  CHECK(o.status.state == TaskState::kNotTasking);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, Deterministic) {
+  auto run = [] {
+    auto s = std::make_unique<Sim>();
+    s->charger_fails_first = 1;
+    s->command(HostCommandType::kDock);
+    std::vector<double> trace;
+    for (int i = 0; i < 2500; ++i) {
+      const TaskOutput o = s->step();
+      trace.push_back(o.cmd.vx_mps);
+      trace.push_back(o.cmd.wz_radps);
+      trace.push_back(static_cast<double>(o.status.state));
+    }
+    return trace;
+  };
+  const std::vector<double> a = run(), b = run();
+  CHECK(a == b);
+}
