@@ -436,7 +436,6 @@ ControlOutput SmoothController::step(const ControlInput& in) {
   }
   // The law runs on the docking frame: the real body frame, or for rear pads the body frame turned by π.
   Pose2 robot = in.dock_in_robot.inverse();
-  const Real th_real = robot.yaw_rad;
   if (p_.backwards) robot.yaw_rad = wrap_angle(robot.yaw_rad + kPi);
   const Vec2 pad = robot.transform(Vec2(c.pad_reach_m, 0));
   if (stalled(c, pad.x(), positive_dt(in), &stall_s_)) {
@@ -486,11 +485,6 @@ ControlOutput SmoothController::step(const ControlInput& in) {
   o.phase = static_cast<std::uint8_t>(ph);
   o.cmd.vx_mps = p_.backwards ? -v : v;
   o.cmd.wz_radps = w;
-  if (p_.holonomic && d < p_.lateral_assist_range_m) {
-    // Move the pads along the dock's y towards 0; the dock y axis seen from the body is (sin θ, cos θ).
-    const Real vyd = -clamp_abs(p_.lateral_assist_kp * pad.y(), p_.lateral_assist_max_mps);
-    o.cmd.vy_mps = std::cos(th_real) * vyd;
-  }
   return o;
 }
 

@@ -222,27 +222,24 @@ class Seed003Controller final : public DockingController {
 ///   v = v_max/(1 + β|κ|^λ), v ≤ v_max·d/slowdown_radius, v ≤ √(2·a_dec·d) (d = pad distance to the contact plane),
 ///   v ≥ creep_speed (the deadband floor), ω = κ·v ≤ ω_max with v recomputed to keep κ.
 /// Never commands v ≤ 0 while running: one forward motion, no reversals, no in-place rotation (v is floored at
-/// min_turn_speed_mps when ω saturates). On mecanum (holonomic = true) within lateral_assist_range_m of contact it
-/// adds vy to cancel the pads' remaining lateral error. backwards = true docks with rear pads: the law runs on the
-/// reversed robot frame and v is negated.
+/// min_turn_speed_mps when ω saturates). vy is always 0: the same law serves mecanum drives (a vy assist on the pads'
+/// lateral error was tried and destabilised the heading loop, see docs/controllers.md). backwards = true docks with
+/// rear pads: the law runs on the reversed robot frame and v is negated.
 struct SmoothParams {
   DockingCommonParams common{};
   bool backwards = false;                          ///< Pads at the rear (body x = −pad_reach_m).
-  bool holonomic = false;                          ///< Mecanum: allow the vy assist.
-  Real k_phi = static_cast<Real>(3.0);
-  Real k_delta = static_cast<Real>(2.0);
+  Real k_phi = static_cast<Real>(5.0);    ///< Nav2 default 3.0; see docs/controllers.md for why higher here.
+  Real k_delta = static_cast<Real>(4.0);  ///< Nav2 default 2.0.
   Real beta = static_cast<Real>(0.4);
   Real lambda = static_cast<Real>(2.0);
   Real v_max_mps = static_cast<Real>(0.25);
   Real w_max_radps = static_cast<Real>(0.75);
   Real slowdown_radius_m = static_cast<Real>(0.25);
   Real max_decel_mps2 = static_cast<Real>(0.25);   ///< Braking profile towards the contact plane, m/s².
-  Real goal_projection_m = static_cast<Real>(0.25);///< Goal behind the docked pose, m (Nav2 default).
+  /// Goal behind the docked pose, m (Nav2: 0.25 from a staging pose on the axis; 0.10 here, see the docs).
+  Real goal_projection_m = static_cast<Real>(0.10);
   /// Smallest forward speed when ω saturates, m/s (keeps the turn an arc: radius ≥ this/ω_max).
   Real min_turn_speed_mps = static_cast<Real>(0.03);
-  Real lateral_assist_range_m = static_cast<Real>(0.10);  ///< Mecanum vy assist starts this close to contact, m.
-  Real lateral_assist_kp = static_cast<Real>(1.5);        ///< vy per m of pad lateral error, 1/s.
-  Real lateral_assist_max_mps = static_cast<Real>(0.04);
 };
 
 enum class SmoothPhase : std::uint8_t {
