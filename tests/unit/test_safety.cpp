@@ -1,0 +1,190 @@
+// Obstacle check (seed 004 Table 3 footprints) and the pose-deviation test, on hand-built scans.
+#include <cmath>
+#include <memory>
+
+#include "dockcore/dock_profile.hpp"
+#include "dockcore/safety.hpp"
+
+#include <CppUTest/TestHarness.h>
+
+using namespace dockcore;
+
+namespace {
+
+/// Full-turn scan, 0.5° beams, no returns; add() puts a return at a robot-frame point (identity mount unless given).
+struct Scan {
+  static constexpr std::size_t kBeams = 720;
+  LaserScanN<kBeams> s;
+  Pose2 mount{};
+  Scan() { s.reset(kBeams, -kPi, kTwoPi / kBeams, 0); }
+  /// Puts returns on the two beams nearest the bearing of p (the check wants 2 points), at p's range.
+  void add(const Vec2& p_robot) {
+    const Vec2 p = mount.inverse_transform(p_robot);
+    const double a = std::atan2(p.y(), p.x());
+    const long i = std::lround((a + kPi) / (kTwoPi / kBeams));
+    for (long k = i; k <= i + 1; ++k) s.ranges_m[static_cast<std::size_t>((k + kBeams) % kBeams)] = p.norm();
+  }
+  ScanView view() const { return s.view(); }
+};
+
+}  // namespace
+
+TEST_GROUP(Safety){};
+
+TEST(Safety, EmptyScanIsValidAndClear) {
+  ObstacleChecker c;
+  c.configure(square_footprint(), nullptr);
+  Scan sc;
+  const ObstacleFlags f = c.check(sc.view(), sc.mount, nullptr);
+  CHECK(f.valid);
+  CHECK(!f.forward && !f.backward && !f.rotation);
+  ScanView bad = sc.view();
+  bad.angle_increment_rad = 0;
+  CHECK(!c.check(bad, sc.mount, nullptr).valid);
+}
+
+TEST(Safety, SquareForwardAreaStartsAtTheBodyFront) {
+  ObstacleChecker c;
+  c.configure(square_footprint(), nullptr);
+  {
+    Scan sc;  // 0.2 m ahead of the 0.37 m front, on the axis: blocked forward, not behind; 0.57 m > 0.45 m: turning ok
+    sc.add(Vec2(0.57, 0.0));
+    const ObstacleFlags f = c.check(sc.view(), sc.mount, nullptr);
+    CHECK(f.forward && !f.backward && !f.rotation);
+    DOUBLES_EQUAL(0.2, f.nearest_forward_m, 1e-4);  // the second beam is 0.5° off the bearing
+  }
+  {
+    Scan sc;  // 0.32 m ahead of the front: beyond the 0.3 m area
+    sc.add(Vec2(0.69, 0.0));
+    CHECK(!c.check(sc.view(), sc.mount, nullptr).forward);
+  }
+  {
+    Scan sc;  // within the depth but |y| = 0.27 > 0.25
+    sc.add(Vec2(0.5, 0.27));
+    CHECK(!c.check(sc.view(), sc.mount, nullptr).forward);
+  }
+  {
+    Scan sc;  // inside the body: the robot itself
+    sc.add(Vec2(0.3, 0.0));
+    const ObstacleFlags f = c.check(sc.view(), sc.mount, nullptr);
+    CHECK(!f.forward && !f.rotation);
+    LONGS_EQUAL(2, f.self_points);
+  }
+}
+
+TEST(Safety, SquareRotationAndBackward) {
+  ObstacleChecker c;
+  c.configure(square_footprint(), nullptr);
+  Scan side;  // beside the body (|y| 0.40 > 0.25) within the 0.45 m circumscribed radius: a turning corner hits it
+  side.add(Vec2(0.0, 0.40));
+  ObstacleFlags f = c.check(side.view(), side.mount, nullptr);
+  CHECK(f.rotation && !f.forward && !f.backward);
+  Scan behind;
+  behind.add(Vec2(-0.5, 0.1));
+  f = c.check(behind.view(), behind.mount, nullptr);
+  CHECK(f.backward && !f.forward && !f.rotation);
+}
+
+TEST(Safety, CircularFootprint) {
+  ObstacleChecker c;
+  c.configure(circular_footprint(), nullptr);
+  Scan sc;  // 0.2 m ahead of the 0.275 m radius, inside |y| < 0.25
+  sc.add(Vec2(0.475, 0.1));
+  ObstacleFlags f = c.check(sc.view(), sc.mount, nullptr);
+  CHECK(f.forward && !f.rotation);
+  Scan beside;  // 0.32 m to the side: a round robot turning in place sweeps nothing new
+  beside.add(Vec2(0.0, 0.32));
+  f = c.check(beside.view(), beside.mount, nullptr);
+  CHECK(!f.rotation && !f.forward);
+}
+
+TEST(Safety, LidarMountIsApplied) {
+  ObstacleChecker c;
+  c.configure(square_footprint(), nullptr);
+  Scan sc;
+  sc.mount = Pose2{0.2, 0, 0};
+  sc.add(Vec2(0.5, 0.0));  // 0.3 m from the lidar, 0.5 m from the centre: 0.13 m ahead of the front
+  const ObstacleFlags f = c.check(sc.view(), sc.mount, nullptr);
+  CHECK(f.forward);
+  DOUBLES_EQUAL(0.13, f.nearest_forward_m, 1e-4);
+}
+
+TEST(Safety, TheDockAndTheWallBehindItAreExcluded) {
+  DockProfile prof;
+  CHECK(builtin_profile("breakpoint", prof) == ProfileError::kOk);
+  ObstacleChecker c;
+  c.configure(square_footprint(), &prof);
+  // Dock face 0.15 m ahead of the front edge, facing the robot.
+  const Pose2 dock{0.52, 0.0, kPi};
+  Scan sc;
+  sc.add(dock.transform(Vec2(0.0, 0.05)));    // on the face
+  sc.add(dock.transform(Vec2(-0.06, 0.115))); // in a slot
+  sc.add(dock.transform(Vec2(-0.10, 0.2)));   // the wall beside the dock, inside the forward area
+  ObstacleFlags f = c.check(sc.view(), sc.mount, &dock);
+  CHECK(!f.forward && !f.rotation);
+  LONGS_EQUAL(6, f.dock_points);
+  // Without the dock estimate the same points block.
+  CHECK(c.check(sc.view(), sc.mount, nullptr).forward);
+  // Something between the robot and the dock face (0.08 m in front of it, beyond the 0.05 m margin) blocks.
+  Scan in_front;
+  in_front.add(dock.transform(Vec2(0.08, 0.0)));
+  CHECK(c.check(in_front.view(), in_front.mount, &dock).forward);
+  CHECK(!c.is_dock_point(dock.transform(Vec2(0.08, 0.0)), dock));
+  CHECK(c.is_dock_point(dock.transform(Vec2(0.04, 0.0)), dock));
+  // Far to the side of the dock zone, at the wall line: not the dock.
+  CHECK(!c.is_dock_point(dock.transform(Vec2(-0.10, 0.7)), dock));
+}
+
+TEST(Safety, WingedDockBodyIsExcludedByThePolyline) {
+  DockProfile prof;
+  CHECK(builtin_profile("plate-v", prof) == ProfileError::kOk);
+  ObstacleChecker c;
+  c.configure(square_footprint(), &prof);
+  const Pose2 dock{0.6, 0.0, kPi};
+  // A wing point lies behind the face plane, so it is in the zone anyway; a point 0.03 m off the face's end, in
+  // front of the plane, is caught by the polyline margin.
+  const Vec2 off_face = dock.transform(Vec2(0.03, 0.15));
+  CHECK(c.is_dock_point(off_face, dock));
+}
+
+TEST(Safety, MotionGate) {
+  const MotionGateParams g;
+  ObstacleFlags f;
+  f.valid = true;
+  f.forward = true;
+  CHECK(motion_blocked(Twist2{0.1, 0, 0}, f, g));
+  CHECK(!motion_blocked(Twist2{-0.1, 0, 0}, f, g));
+  CHECK(!motion_blocked(Twist2{0, 0, 0.5}, f, g));
+  f.forward = false;
+  f.rotation = true;
+  CHECK(motion_blocked(Twist2{0, 0, 0.5}, f, g));
+  CHECK(!motion_blocked(Twist2{0.2, 0, 0.5}, f, g));  // curving forward: the forward area decides
+  CHECK(motion_blocked(Twist2{0, 0.1, 0}, f, g));     // holonomic sideways into the swept circle
+  f.rotation = false;
+  f.backward = true;
+  CHECK(motion_blocked(Twist2{-0.1, 0, 0}, f, g));
+  ObstacleFlags none;  // no scan: fail safe
+  CHECK(motion_blocked(Twist2{0.1, 0, 0}, none, g));
+  CHECK(!motion_blocked(Twist2{}, none, g));
+}
+
+TEST(Safety, PoseDeviation) {
+  const DeviationParams p;
+  const Pose2 expected{0, 0, 0};
+  LONGS_EQUAL(0, static_cast<int>(check_pose_deviation(Pose2{0.1, 0.1, 0.2}, expected, 1.0, 1.0, p)));
+  LONGS_EQUAL(178, static_cast<int>(check_pose_deviation(Pose2{0.25, 0.25, 0}, expected, 1.0, 1.0, p)));  // 0.354 m jump
+  LONGS_EQUAL(178, static_cast<int>(check_pose_deviation(expected, expected, 2.01, 1.0, p)));
+  LONGS_EQUAL(0, static_cast<int>(check_pose_deviation(expected, expected, 2.4, 2.3, p)));  // started far
+  LONGS_EQUAL(178, static_cast<int>(check_pose_deviation(expected, expected, 2.61, 2.3, p)));
+  LONGS_EQUAL(179, static_cast<int>(check_pose_deviation(Pose2{0, 0, deg_to_rad(31)}, expected, 1.0, 1.0, p)));
+  LONGS_EQUAL(0, static_cast<int>(check_pose_deviation(Pose2{0, 0, deg_to_rad(29)}, expected, 1.0, 1.0, p)));
+  // Wrap-around: 359° is 1°.
+  LONGS_EQUAL(0, static_cast<int>(check_pose_deviation(Pose2{0, 0, kPi - 0.01}, Pose2{0, 0, -kPi + 0.01}, 1.0, 1.0, p)));
+  LONGS_EQUAL(178, static_cast<int>(check_pose_deviation(Pose2{NAN, 0, 0}, expected, 1.0, 1.0, p)));
+}
+
+TEST(Safety, FaultNames) {
+  STRCMP_EQUAL("detection_failed", to_string(FaultCode::kDetectionFailed));
+  STRCMP_EQUAL("task_timeout", to_string(FaultCode::kTaskTimeout));
+  STRCMP_EQUAL("unknown", to_string(static_cast<FaultCode>(999)));
+}
