@@ -1,5 +1,6 @@
 // TaskManager and Dockcore in closed loop with a scripted fake controller, a kinematic robot and the lidar simulator.
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -657,4 +658,99 @@ TEST(TaskManager, Deterministic) {
   };
   const std::vector<double> a = run(), b = run();
   CHECK(a == b);
+}
+
+namespace {
+
+/// The Sim's world and robot, driven through Dockcore with the real estimator and filter on simulated scans.
+struct FacadeSim {
+  Sim w;  // world, robot integration and charging script (its TaskManager is unused)
+  FakeController ctrl;
+  std::unique_ptr<Dockcore> core = std::make_unique<Dockcore>(ctrl);
+  FacadeSim() {
+    DockcoreConfig cfg;
+    cfg.task.detect_wait_s = 0.3;
+    CHECK(core->configure(w.profile, cfg));
+  }
+  TickOutput step(HostCommand cmd = HostCommand{}) {
+    if (w.ticks % 5 == 0) {
+      simulate_scan(w.world_model(), w.world, w.model, w.rng, &w.scan, w.now_us);
+      core->on_scan(w.scan.view(), w.now_us, w.odom);
+    }
+    TickInput in;
+    in.now_us = w.now_us;
+    in.command = cmd;
+    in.odom_pose = w.odom;
+    in.contact = w.contact;
+    const bool current = w.contact && w.charge_enable && w.now_us - w.contact_since_us >= 500000;
+    in.charge_current_a = current ? 2.0 : 0.0;
+    const TickOutput o = core->tick(in);
+    w.charge_enable = o.status.charge_enable;
+    const bool zero = o.cmd.vx_mps == 0 && o.cmd.vy_mps == 0 && o.cmd.wz_radps == 0;
+    if (!zero && !moving_state(o.status.state)) ++w.zero_violations;
+    // Same integration and dock stop as Sim::step.
+    const Pose2 delta = Sim::arc(o.cmd, Sim::kTickUs * 1e-6);
+    w.world = w.world.compose(delta);
+    w.odom = w.odom.compose(delta);
+    const Vec2 front = w.dock.inverse_transform(w.world.transform(Vec2(kHalfLength, 0)));
+    if (front.x() < 0 && std::fabs(front.y()) < 0.3) {
+      const double back = -front.x();
+      w.world.x_m += back;
+      w.odom = w.odom.compose(Pose2{-back / std::fabs(std::cos(w.world.yaw_rad)), 0, 0});
+    }
+    const Vec2 f2 = w.dock.inverse_transform(w.world.transform(Vec2(kHalfLength, 0)));
+    w.contact = f2.x() <= 0.002 && std::fabs(f2.y()) < 0.05;
+    if (w.contact && !w.prev_contact) w.contact_since_us = w.now_us;
+    w.prev_contact = w.contact;
+    w.now_us += Sim::kTickUs;
+    ++w.ticks;
+    return o;
+  }
+  bool run_until(TaskState s, double max_s) {
+    for (int i = 0; i < static_cast<int>(max_s / 0.02); ++i) {
+      if (step().status.state == s) return true;
+    }
+    return false;
+  }
+};
+
+}  // namespace
+
+TEST_GROUP(Dockcore){};
+
+TEST(Dockcore, DocksWithTheRealEstimatorAndFilter) {
+  FacadeSim f;
+  TickOutput o = f.step(HostCommand{HostCommandType::kDock, 0});
+  CHECK(o.command_result == CommandResult::kAccepted);
+  CHECK(f.run_until(TaskState::kFinishTasking, 30));
+  CHECK(f.core->filter().initialised());
+  CHECK(f.core->estimator().counters().found > 10);
+  const Vec2 front = f.w.world.transform(Vec2(kHalfLength, 0));
+  DOUBLES_EQUAL(0.0, front.x(), 0.003);
+  CHECK(std::fabs(front.y()) < 0.05);
+  LONGS_EQUAL(0, f.w.zero_violations);
+  printf("\nsizeof(Dockcore) = %zu, TaskManager = %zu, DockPoseEstimator = %zu, LaserScan = %zu\n", sizeof(Dockcore),
+         sizeof(TaskManager), sizeof(DockPoseEstimator), sizeof(LaserScan));
+}
+
+TEST(Dockcore, PushIsAFaultOnTheFirstScanAfterIt) {
+  FacadeSim f;
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  CHECK(f.run_until(TaskState::kAlign, 5));
+  for (int i = 0; i < 25; ++i) f.step();
+  f.w.world.y_m += 0.4;
+  while (f.w.ticks % 5 != 0) f.step();
+  const TickOutput o = f.step();  // the scan after the push is processed in this tick
+  CHECK(o.status.state == TaskState::kFault);
+  LONGS_EQUAL(178, static_cast<int>(o.status.fault));
+}
+
+TEST(Dockcore, NoScansMeansLidarStaleWhenMoving) {
+  FacadeSim f;
+  TickInput in;
+  in.now_us = 1000000;
+  in.command = HostCommand{HostCommandType::kDock, 0};
+  const TickOutput o = f.core->tick(in);
+  CHECK(o.status.state == TaskState::kFault);
+  LONGS_EQUAL(185, static_cast<int>(o.status.fault));
 }
