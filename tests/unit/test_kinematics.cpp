@@ -1,6 +1,7 @@
 // core kinematics: wheel speeds from hand formulas, round trips, curvature-preserving saturation, acceleration limiter,
 // and agreement with the simulated chassis' own kinematics (docksim::body_twist_to_wheel_radps).
 #include <cmath>
+#include <type_traits>
 
 #include "dockcore/kinematics.hpp"
 #include "docksim/chassis.hpp"
