@@ -1,0 +1,167 @@
+#pragma once
+// Docking scenarios: one TOML file describing the robot (drive, limits, footprint, lidar and camera mounts, chassis
+// imperfections), the lidar model, the dock and the world, the start-pose envelope, a timeline of disturbances and the
+// controller with its parameters. docs/scenarios.md documents every key with its unit and default.
+//
+// Errors (unknown key, wrong type, value out of range, bad profile file, ...) are ScenarioError exceptions whose
+// message starts with "<source>:<line>:<column>: " (1-based, the TOML source region of the offending key or value).
+// Host-side (tools/): heap and exceptions are fine here.
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "dockcore/controllers.hpp"
+#include "dockcore/dock_pose_estimator.hpp"
+#include "dockcore/dock_profile.hpp"
+#include "dockcore/geometry.hpp"
+#include "dockcore/kinematics.hpp"
+#include "dockcore/safety.hpp"
+#include "dockcore/task_manager.hpp"
+#include "docksim/chassis.hpp"
+#include "docksim/lidar_sim.hpp"
+
+namespace docksim {
+
+/// A scenario could not be read. what() is complete and user-readable; inside a file it starts with
+/// "<source>:<line>:<column>: ".
+class ScenarioError : public std::runtime_error {
+ public:
+  ScenarioError(const std::string& message, int line = 0, int column = 0)
+      : std::runtime_error(message), line_(line), column_(column) {}
+  int line() const { return line_; }      ///< 1-based; 0 when not tied to a position.
+  int column() const { return column_; }  ///< 1-based; 0 when not tied to a position.
+
+ private:
+  int line_;
+  int column_;
+};
+
+/// Disturbances on the timeline ([[events]] type = ...).
+enum class EventKind : std::uint8_t {
+  kPush,                ///< "push": true pose jumps by (dx, dy) world metres and dyaw; odometry does not see it.
+  kOccludeDock,         ///< "occlude_dock": the dock is invisible to lidar and camera for duration_s.
+  kObstacle,            ///< "obstacle": a disc (x, y, r) in the world for duration_s (<= 0: for good).
+  kLidarDropout,        ///< "lidar_dropout": no scans for duration_s.
+  kChargingNeverStarts, ///< "charging_never_starts": the charger delivers no current from t_s on.
+  kChassisSilent,       ///< "chassis_silent": the chassis stops answering for duration_s.
+};
+
+/// Stable TOML name of an event kind ("push", ...). Never null.
+const char* to_string(EventKind k);
+
+struct ScenarioEvent {
+  double t_s = 0;  ///< When it happens, s after the dock command.
+  EventKind kind = EventKind::kPush;
+  double dx_m = 0, dy_m = 0, dyaw_rad = 0;  ///< push (world frame).
+  double duration_s = 0;                    ///< occlude_dock, obstacle, lidar_dropout, chassis_silent.
+  double x_m = 0, y_m = 0, r_m = 0.1;       ///< obstacle: centre (world) and radius.
+  bool hold_last_command = false;           ///< chassis_silent: motors keep the last command (else they stop).
+};
+
+/// Simulated camera that sees one target point on the dock (seed 003's vision process).
+struct CameraSpec {
+  bool enabled = false;         ///< false: ControlInput::camera is never valid.
+  dockcore::CameraModel model{};///< fx, cx, image width and mount (robot frame).
+  double rate_hz = 20.0;        ///< Frames per second.
+  double latency_s = 0.05;      ///< Image time to delivery.
+  double sigma_px = 1.0;        ///< Gaussian pixel noise on u, 1 sigma.
+  double dropout_prob = 0.0;    ///< Chance a frame has no detection.
+  double min_depth_m = 0.05;    ///< Target closer than this along the optical axis: not seen (blind zone).
+  double max_depth_m = 4.0;     ///< Farther: not seen.
+  double v_px = 240.0;          ///< Row reported for the target (2D world: constant).
+  dockcore::Vec2 target_in_dock = dockcore::Vec2::Zero();  ///< The target point, dock frame (default: contacts).
+};
+
+/// Start poses are drawn uniformly from these ranges: the robot centre at `distance` from the dock origin at
+/// `bearing` (dock frame, 0 = straight out of the face), heading = facing the dock origin (rear facing it for rear
+/// pads) + `heading`.
+struct StartEnvelope {
+  double distance_min_m = 0.5, distance_max_m = 2.5;
+  double bearing_min_rad = -dockcore::kPi / 4, bearing_max_rad = dockcore::kPi / 4;
+  double heading_min_rad = -dockcore::kPi / 6, heading_max_rad = dockcore::kPi / 6;
+};
+
+/// Static world objects besides the dock and its wall (world coordinates).
+struct WorldPolyline {
+  std::vector<dockcore::Vec2> points;
+  bool closed = false;
+};
+struct WorldBox {
+  dockcore::Vec2 centre = dockcore::Vec2::Zero();
+  double size_x_m = 0.3, size_y_m = 0.3, yaw_rad = 0;
+};
+struct WorldCircle {
+  dockcore::Vec2 centre = dockcore::Vec2::Zero();
+  double r_m = 0.1;
+};
+
+/// Host behaviour around the task manager.
+struct HostSpec {
+  double chassis_stale_s = 0.1;  ///< No chassis feedback for this long: chassis_ok = false.
+  int redock_after_fault = 0;    ///< Re-send the dock command this many times after a fault (a host retrying).
+  double redock_delay_s = 1.0;   ///< Wait this long in FAULT before re-sending (cancel, then dock).
+};
+
+/// Everything one docking simulation needs.
+struct Scenario {
+  std::string name;    ///< Scenario name (default: the file name without .toml).
+  std::string source;  ///< File it came from.
+  std::uint64_t seed = 1;
+  double max_time_s = 120.0;     ///< A run that has not ended by then is a timeout.
+  double settle_after_end_s = 0.3;  ///< Keep simulating this long after charging is confirmed / a final fault.
+
+  // Robot.
+  ChassisParams chassis{};             ///< Drive geometry, motors, noise, footprint (pads), contacts, battery.
+  dockcore::DriveLimits limits{};      ///< Kinematics saturation and acceleration limits.
+  dockcore::FootprintParams safety{};  ///< Obstacle check (derived from the footprint plus check areas).
+  Pose2 lidar_mount{};                 ///< Lidar in the robot frame.
+  CameraSpec camera{};
+
+  // Lidar.
+  LidarModel lidar{};
+  double scan_latency_s = 0.03;  ///< Scan time (stamp) to delivery to dockcore.
+
+  // Dock and world.
+  dockcore::DockProfile profile{};
+  std::string profile_name = "plate-v";
+  Pose2 dock_pose{};                ///< Dock frame in the world.
+  double dock_face_half_width_m = 0.15;
+  bool wall = true;                 ///< A wall behind the dock, flush with the profile's minimum x.
+  double wall_half_length_m = 2.0;
+  std::vector<WorldPolyline> polylines;
+  std::vector<WorldBox> boxes;
+  std::vector<WorldCircle> circles;
+
+  StartEnvelope start{};
+  std::vector<ScenarioEvent> events;  ///< Sorted by t_s (stable).
+
+  // Dockcore.
+  dockcore::EstimatorParams estimator{};
+  dockcore::TaskParams task{};
+  HostSpec host{};
+
+  // Controller.
+  std::string controller = "smooth";
+  dockcore::Seed000Params seed000{};
+  dockcore::Seed004Params seed004{};
+  dockcore::Seed003Params seed003{};
+  dockcore::SmoothParams smooth{};
+};
+
+/// Controller names in table order: seed000, seed004, seed003, smooth.
+const std::vector<std::string>& controller_names();
+/// True when `name` is one of controller_names().
+bool is_controller_name(const std::string& name);
+
+/// Parses scenario TOML held in `text`; `source_name` names it in messages and resolves relative profile paths
+/// (relative to its directory). Throws ScenarioError. O(text size).
+Scenario parse_scenario_toml(const std::string& text, const std::string& source_name);
+/// Reads and parses a scenario file. Throws ScenarioError (also when it cannot be read).
+Scenario load_scenario_file(const std::string& path);
+
+/// The pose of the pads' docked robot centre etc. are derived from the footprint: distance from the robot centre to
+/// the pads along the docking direction, m (what controllers call pad_reach_m). O(1).
+double pad_reach_of(const ChassisParams& chassis);
+
+}  // namespace docksim

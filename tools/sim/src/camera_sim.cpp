@@ -1,0 +1,50 @@
+#include "docksim/camera_sim.hpp"
+
+#include <cmath>
+
+namespace docksim {
+
+using dockcore::Real;
+
+dockcore::CameraTarget project_target(const CameraSimParams& p, const dockcore::Pose2& robot_world,
+                                      const dockcore::Vec2& target_world) {
+  dockcore::CameraTarget t;
+  const dockcore::Pose2 cam = robot_world.compose(p.model.mount);
+  const dockcore::Vec2 q = cam.inverse_transform(target_world);  // camera frame: x along the optical axis, y left
+  const double x = static_cast<double>(q.x()), y = static_cast<double>(q.y());
+  if (!(x >= p.min_depth_m && x <= p.max_depth_m)) return t;
+  // Image u grows to the right; robot/camera y grows to the left.
+  const double u = static_cast<double>(p.model.cx_px) - static_cast<double>(p.model.fx_px) * y / x;
+  if (u < 0 || u > static_cast<double>(p.model.image_width_px)) return t;
+  t.valid = true;
+  t.u_px = static_cast<Real>(u);
+  t.v_px = static_cast<Real>(p.v_px);
+  t.confidence = 1;
+  return t;
+}
+
+void CameraSim::update(std::uint64_t t_us, const dockcore::Pose2& robot_world, const dockcore::Vec2& target_world,
+                       bool visible) {
+  const std::uint64_t period_us = static_cast<std::uint64_t>(std::llround(1e6 / p_.rate_hz));
+  const std::uint64_t latency_us = static_cast<std::uint64_t>(std::llround(p_.latency_s * 1e6));
+  if (t_us >= next_capture_us_) {
+    dockcore::CameraTarget f = visible ? project_target(p_, robot_world, target_world) : dockcore::CameraTarget{};
+    // Draws happen for every frame, in a fixed order, so the stream does not depend on visibility.
+    const double noise = rng_.normal() * p_.sigma_px;
+    const bool dropped = rng_.bernoulli(p_.dropout_prob);
+    if (f.valid) {
+      f.u_px = static_cast<Real>(static_cast<double>(f.u_px) + noise);
+      if (dropped) f = dockcore::CameraTarget{};
+    }
+    f.stamp_us = t_us;
+    in_flight_.push_back(f);
+    next_capture_us_ = (next_capture_us_ == 0 && t_us > period_us ? t_us : next_capture_us_) + period_us;
+    if (next_capture_us_ <= t_us) next_capture_us_ = t_us + period_us;
+  }
+  while (!in_flight_.empty() && in_flight_.front().stamp_us + latency_us <= t_us) {
+    latest_ = in_flight_.front();
+    in_flight_.pop_front();
+  }
+}
+
+}  // namespace docksim

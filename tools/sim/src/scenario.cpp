@@ -1,0 +1,704 @@
+#include "docksim/scenario.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string_view>
+#include <utility>
+
+#include <toml++/toml.h>
+
+#include "docksim/profile_file.hpp"
+
+namespace docksim {
+
+const char* to_string(EventKind k) {
+  switch (k) {
+    case EventKind::kPush: return "push";
+    case EventKind::kOccludeDock: return "occlude_dock";
+    case EventKind::kObstacle: return "obstacle";
+    case EventKind::kLidarDropout: return "lidar_dropout";
+    case EventKind::kChargingNeverStarts: return "charging_never_starts";
+    case EventKind::kChassisSilent: return "chassis_silent";
+  }
+  return "?";
+}
+
+const std::vector<std::string>& controller_names() {
+  static const std::vector<std::string> names = {"seed000", "seed004", "seed003", "smooth"};
+  return names;
+}
+
+bool is_controller_name(const std::string& name) {
+  const auto& n = controller_names();
+  return std::find(n.begin(), n.end(), name) != n.end();
+}
+
+double pad_reach_of(const ChassisParams& c) {
+  const double sgn = c.footprint.pad_side == PadSide::kRear ? -1.0 : 1.0;
+  return sgn * static_cast<double>(pad_point_body(c.footprint).x());
+}
+
+namespace {
+
+using dockcore::Real;
+using dockcore::Vec2;
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+using Handler = std::function<void(const toml::node&)>;
+using Handlers = std::vector<std::pair<std::string, Handler>>;
+
+const char* type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date/time";
+  }
+}
+
+std::string dir_of(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+}
+
+std::string stem_of(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
+  if (base.size() > 5 && base.compare(base.size() - 5, 5, ".toml") == 0) base.resize(base.size() - 5);
+  return base;
+}
+
+class Parser {
+ public:
+  explicit Parser(std::string source) : src_(std::move(source)) {}
+
+  [[noreturn]] void fail(const toml::source_region& where, const std::string& what) const {
+    const int line = static_cast<int>(where.begin.line);
+    const int col = static_cast<int>(where.begin.column);
+    throw ScenarioError(src_ + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " + what, line, col);
+  }
+
+  /// Dispatches every key of `t` to its handler; unknown keys are errors naming the expected ones.
+  void each(const toml::table& t, const std::string& path, const Handlers& hs) const {
+    for (auto&& [key, value] : t) {
+      const std::string k(key.str());
+      const Handler* h = nullptr;
+      for (const auto& p : hs) {
+        if (p.first == k) h = &p.second;
+      }
+      if (h == nullptr) {
+        std::string expected;
+        for (const auto& p : hs) expected += (expected.empty() ? "" : ", ") + p.first;
+        fail(key.source(), "unknown key '" + path + k + "' (expected " + expected + ")");
+      }
+      key_ = path + k;
+      (*h)(value);
+    }
+  }
+
+  const toml::table& table(const toml::node& n) const {
+    const toml::table* t = n.as_table();
+    if (t == nullptr) fail(n.source(), key_ + " must be a table, not " + type_name(n));
+    return *t;
+  }
+
+  double number(const toml::node& n, double lo, double hi) const {
+    double v = 0;
+    if (const auto* f = n.as_floating_point()) {
+      v = f->get();
+    } else if (const auto* i = n.as_integer()) {
+      v = static_cast<double>(i->get());
+    } else {
+      fail(n.source(), key_ + " must be a number, not " + type_name(n));
+    }
+    if (!std::isfinite(v)) fail(n.source(), key_ + " is not finite");
+    if (v < lo || v > hi) {
+      std::ostringstream s;
+      s << key_ << " = " << v << " is out of range [" << lo << ", " << hi << "]";
+      fail(n.source(), s.str());
+    }
+    return v;
+  }
+
+  std::int64_t integer(const toml::node& n, std::int64_t lo, std::int64_t hi) const {
+    const auto* i = n.as_integer();
+    if (i == nullptr) fail(n.source(), key_ + " must be an integer, not " + type_name(n));
+    const std::int64_t v = i->get();
+    if (v < lo || v > hi) {
+      fail(n.source(), key_ + " = " + std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " +
+                           std::to_string(hi) + "]");
+    }
+    return v;
+  }
+
+  bool boolean(const toml::node& n) const {
+    const auto* b = n.as_boolean();
+    if (b == nullptr) fail(n.source(), key_ + " must be true or false, not " + type_name(n));
+    return b->get();
+  }
+
+  std::string string(const toml::node& n) const {
+    const auto* s = n.as_string();
+    if (s == nullptr) fail(n.source(), key_ + " must be a string, not " + type_name(n));
+    return s->get();
+  }
+
+  std::string choice(const toml::node& n, const std::vector<std::string>& options) const {
+    const std::string s = string(n);
+    if (std::find(options.begin(), options.end(), s) == options.end()) {
+      std::string all;
+      for (const auto& o : options) all += (all.empty() ? "" : ", ") + o;
+      fail(n.source(), key_ + " = \"" + s + "\" is not one of " + all);
+    }
+    return s;
+  }
+
+  /// [lo, hi] pair of numbers with lo <= hi.
+  std::pair<double, double> range(const toml::node& n, double lo, double hi) const {
+    const toml::array* a = n.as_array();
+    if (a == nullptr || a->size() != 2) fail(n.source(), key_ + " must be [min, max]");
+    const double x = number((*a)[0], lo, hi), y = number((*a)[1], lo, hi);
+    if (x > y) fail(n.source(), key_ + ": min > max");
+    return {x, y};
+  }
+
+  Vec2 point(const toml::node& n) const {
+    const toml::array* a = n.as_array();
+    if (a == nullptr || a->size() != 2) fail(n.source(), key_ + ": a point must be [x_m, y_m]");
+    return Vec2(static_cast<Real>(number((*a)[0], -1e4, 1e4)), static_cast<Real>(number((*a)[1], -1e4, 1e4)));
+  }
+
+  // Handler factories.
+  Handler num(double* out, double lo, double hi) const {
+    return [this, out, lo, hi](const toml::node& n) { *out = number(n, lo, hi); };
+  }
+  Handler deg(double* out_rad, double lo_deg, double hi_deg) const {
+    return [this, out_rad, lo_deg, hi_deg](const toml::node& n) { *out_rad = number(n, lo_deg, hi_deg) * kDeg; };
+  }
+  Handler real(Real* out, double lo, double hi) const {
+    return [this, out, lo, hi](const toml::node& n) { *out = static_cast<Real>(number(n, lo, hi)); };
+  }
+  Handler real_deg(Real* out_rad, double lo_deg, double hi_deg) const {
+    return [this, out_rad, lo_deg, hi_deg](const toml::node& n) {
+      *out_rad = static_cast<Real>(number(n, lo_deg, hi_deg) * kDeg);
+    };
+  }
+  Handler flag(bool* out) const {
+    return [this, out](const toml::node& n) { *out = boolean(n); };
+  }
+  Handler sub(const std::string& path, std::function<Handlers()> make) const {
+    return [this, path, make](const toml::node& n) { each(table(n), path, make()); };
+  }
+
+  const std::string& src() const { return src_; }
+
+ private:
+  std::string src_;
+  mutable std::string key_;
+};
+
+constexpr double kBig = 1e6;
+
+void add_common(const Parser& p, Handlers& h, dockcore::DockingCommonParams* c, bool* pad_reach_set) {
+  h.emplace_back("pad_reach_m", [&p, c, pad_reach_set](const toml::node& n) {
+    c->pad_reach_m = static_cast<Real>(p.number(n, 0.0, 5.0));
+    *pad_reach_set = true;
+  });
+  h.emplace_back("creep_speed_mps", p.real(&c->creep_speed_mps, 0.0, 1.0));
+  h.emplace_back("stall_press_m", p.real(&c->stall_press_m, -0.1, 0.1));
+  h.emplace_back("stall_timeout_s", p.real(&c->stall_timeout_s, 0.0, kBig));
+}
+
+struct ParseState {
+  bool pad_reach_set = false;
+  bool seed003_holonomic_set = false;
+  bool smooth_backwards_set = false;
+  bool check_length_set = false, check_width_set = false;
+  double motor_latency_s = -1;
+  double lidar_sigma_m = -1, lidar_sigma_prop = -1, lidar_dropout = -1, lidar_jitter_rad = -1, lidar_rate_hz = -1,
+         lidar_max_range_m = -1;
+  int mixed_pixels = -1;
+  std::string lidar_model = "ld06";
+  const toml::node* lidar_model_node = nullptr;
+  std::string profile = "plate-v";
+  const toml::node* profile_node = nullptr;
+  std::string footprint_shape = "square";
+  double check_length_m = 0.3, check_width_m = 0.5;
+};
+
+}  // namespace
+
+Scenario parse_scenario_toml(const std::string& text, const std::string& source_name) {
+  Parser p(source_name);
+  toml::table root;
+  try {
+    root = toml::parse(std::string_view(text), std::string_view(source_name));
+  } catch (const toml::parse_error& e) {
+    p.fail(e.source(), std::string(e.description()));
+  }
+
+  Scenario sc;
+  sc.source = source_name;
+  sc.name = stem_of(source_name);
+  ParseState st;
+  // Scenario defaults that differ from the libraries' own.
+  sc.limits.max_vx_mps = static_cast<Real>(0.4);
+  sc.limits.max_wz_radps = static_cast<Real>(1.0);
+
+  auto robot_handlers = [&]() {
+    ChassisParams& c = sc.chassis;
+    Handlers h;
+    h.emplace_back("kinematics", [&](const toml::node& n) {
+      c.geometry.kind = p.choice(n, {"diff", "mecanum"}) == "mecanum" ? DriveKind::kMecanum : DriveKind::kDifferential;
+    });
+    h.emplace_back("wheel_radius_m", p.num(&c.geometry.wheel_radius_m, 0.005, 1.0));
+    h.emplace_back("wheel_base_m", p.num(&c.geometry.wheel_base_m, 0.02, 5.0));
+    h.emplace_back("lx_m", p.num(&c.geometry.lx_m, 0.01, 5.0));
+    h.emplace_back("ly_m", p.num(&c.geometry.ly_m, 0.01, 5.0));
+    h.emplace_back("limits", p.sub("robot.limits.", [&]() {
+      dockcore::DriveLimits& l = sc.limits;
+      return Handlers{{"max_vx_mps", p.real(&l.max_vx_mps, 0, 10)},
+                      {"max_vy_mps", p.real(&l.max_vy_mps, 0, 10)},
+                      {"max_wz_radps", p.real(&l.max_wz_radps, 0, 20)},
+                      {"max_wheel_radps", p.real(&l.max_wheel_radps, 0, 1000)},
+                      {"max_linear_accel_mps2", p.real(&l.max_linear_accel_mps2, 0, 100)},
+                      {"max_angular_accel_radps2", p.real(&l.max_angular_accel_radps2, 0, 100)}};
+    }));
+    h.emplace_back("footprint", p.sub("robot.footprint.", [&]() {
+      FootprintParams& f = c.footprint;
+      return Handlers{
+          {"shape", [&](const toml::node& n) { st.footprint_shape = p.choice(n, {"square", "circle"}); }},
+          {"length_m", p.num(&f.length_m, 0.05, 5.0)},
+          {"width_m", p.num(&f.width_m, 0.05, 5.0)},
+          {"radius_m", p.num(&f.radius_m, 0.025, 2.5)},
+          {"centre_x_m", p.num(&f.centre_x_m, -2.0, 2.0)},
+          {"pads", [&](const toml::node& n) {
+             f.pad_side = p.choice(n, {"front", "rear"}) == "rear" ? PadSide::kRear : PadSide::kFront;
+           }},
+          {"pad_offset_y_m", p.num(&f.pad_offset_y_m, -1.0, 1.0)},
+          {"check_length_m", [&](const toml::node& n) { st.check_length_m = p.number(n, 0.0, 5.0); }},
+          {"check_width_m", [&](const toml::node& n) { st.check_width_m = p.number(n, 0.0, 5.0); }},
+      };
+    }));
+    h.emplace_back("lidar", p.sub("robot.lidar.", [&]() {
+      return Handlers{{"x_m", p.real(&sc.lidar_mount.x_m, -2, 2)},
+                      {"y_m", p.real(&sc.lidar_mount.y_m, -2, 2)},
+                      {"yaw_deg", p.real_deg(&sc.lidar_mount.yaw_rad, -180, 180)}};
+    }));
+    h.emplace_back("camera", p.sub("robot.camera.", [&]() {
+      CameraSpec& cam = sc.camera;
+      return Handlers{
+          {"enabled", p.flag(&cam.enabled)},
+          {"fx_px", p.real(&cam.model.fx_px, 1, 1e5)},
+          {"cx_px", p.real(&cam.model.cx_px, 0, 1e5)},
+          {"width_px", p.real(&cam.model.image_width_px, 1, 1e5)},
+          {"x_m", p.real(&cam.model.mount.x_m, -2, 2)},
+          {"y_m", p.real(&cam.model.mount.y_m, -2, 2)},
+          {"yaw_deg", p.real_deg(&cam.model.mount.yaw_rad, -180, 180)},
+          {"rate_hz", p.num(&cam.rate_hz, 0.1, 1000)},
+          {"latency_s", p.num(&cam.latency_s, 0, 5)},
+          {"sigma_px", p.num(&cam.sigma_px, 0, 1000)},
+          {"dropout", p.num(&cam.dropout_prob, 0, 1)},
+          {"min_depth_m", p.num(&cam.min_depth_m, 0, 100)},
+          {"max_depth_m", p.num(&cam.max_depth_m, 0, 100)},
+          {"target_x_m", [&](const toml::node& n) { cam.target_in_dock.x() = static_cast<Real>(p.number(n, -2, 2)); }},
+          {"target_y_m", [&](const toml::node& n) { cam.target_in_dock.y() = static_cast<Real>(p.number(n, -2, 2)); }},
+      };
+    }));
+    h.emplace_back("motor", p.sub("robot.motor.", [&]() {
+      MotorParams& m = c.motor;
+      return Handlers{{"latency_s", [&](const toml::node& n) { st.motor_latency_s = p.number(n, 0, 1.0); }},
+                      {"time_constant_s", p.num(&m.time_constant_s, 0, 10)},
+                      {"max_accel_radps2", p.num(&m.max_accel_radps2, 0, 1e4)},
+                      {"max_speed_radps", p.num(&m.max_speed_radps, 0, 1e4)},
+                      {"deadband_radps", p.num(&m.deadband_radps, 0, 100)}};
+    }));
+    h.emplace_back("odometry", p.sub("robot.odometry.", [&]() {
+      NoiseParams& o = c.noise;
+      return Handlers{{"slip_sigma", p.num(&o.slip_sigma, 0, 0.5)},
+                      {"slip_correlation_s", p.num(&o.slip_correlation_s, 0, 100)},
+                      {"encoder_cpr", [&](const toml::node& n) {
+                         o.encoder_cpr = static_cast<std::int32_t>(p.integer(n, 1, 1 << 24));
+                       }},
+                      {"radius_error", p.num(&o.odom_radius_error, -0.5, 0.5)},
+                      {"radius_diff", p.num(&o.odom_radius_diff, -0.5, 0.5)},
+                      {"base_error", p.num(&o.odom_base_error, -0.5, 0.5)}};
+    }));
+    return h;
+  };
+
+  auto lidar_handlers = [&]() {
+    return Handlers{
+        {"model", [&](const toml::node& n) { st.lidar_model = p.string(n); st.lidar_model_node = &n; }},
+        {"sigma_range_m", [&](const toml::node& n) { st.lidar_sigma_m = p.number(n, 0, 1); }},
+        {"sigma_prop", [&](const toml::node& n) { st.lidar_sigma_prop = p.number(n, 0, 1); }},
+        {"dropout", [&](const toml::node& n) { st.lidar_dropout = p.number(n, 0, 1); }},
+        {"angular_jitter_deg", [&](const toml::node& n) { st.lidar_jitter_rad = p.number(n, 0, 10) * kDeg; }},
+        {"mixed_pixels", [&](const toml::node& n) { st.mixed_pixels = p.boolean(n) ? 1 : 0; }},
+        {"rate_hz", [&](const toml::node& n) { st.lidar_rate_hz = p.number(n, 0.5, 100); }},
+        {"max_range_m", [&](const toml::node& n) { st.lidar_max_range_m = p.number(n, 0.5, 100); }},
+        {"latency_s", p.num(&sc.scan_latency_s, 0, 2)},
+    };
+  };
+
+  auto dock_handlers = [&]() {
+    ContactParams& k = sc.chassis.contact;
+    return Handlers{
+        {"profile", [&](const toml::node& n) { st.profile = p.string(n); st.profile_node = &n; }},
+        {"x_m", p.real(&sc.dock_pose.x_m, -1e3, 1e3)},
+        {"y_m", p.real(&sc.dock_pose.y_m, -1e3, 1e3)},
+        {"yaw_deg", p.real_deg(&sc.dock_pose.yaw_rad, -180, 180)},
+        {"face_half_width_m", p.num(&sc.dock_face_half_width_m, 0.005, 2)},
+        {"wall", p.flag(&sc.wall)},
+        {"wall_half_length_m", p.num(&sc.wall_half_length_m, 0.1, 100)},
+        {"contacts", p.sub("dock.contacts.", [&]() {
+           return Handlers{{"lateral_tolerance_m", p.num(&k.lateral_tolerance_m, 0, 0.5)},
+                           {"yaw_tolerance_deg", p.deg(&k.yaw_tolerance_rad, 0, 45)},
+                           {"min_press_m", p.num(&k.min_press_m, 0, 0.1)},
+                           {"press_limit_m", p.num(&k.press_limit_m, 0, 0.1)},
+                           {"charge_delay_s", p.num(&k.charge_delay_s, 0, 60)},
+                           {"charge_current_a", p.num(&k.charge_current_a, 0, 1000)}};
+         })},
+    };
+  };
+
+  auto world_handlers = [&]() {
+    auto array_of_tables = [&](const toml::node& n, const std::string& what,
+                               const std::function<void(const toml::table&)>& one) {
+      const toml::array* a = n.as_array();
+      if (a == nullptr) p.fail(n.source(), "world." + what + " must be an array of tables ([[world." + what + "]])");
+      for (const toml::node& e : *a) {
+        const toml::table* t = e.as_table();
+        if (t == nullptr) p.fail(e.source(), "world." + what + " entries must be tables");
+        one(*t);
+      }
+    };
+    return Handlers{
+        {"polylines", [&, array_of_tables](const toml::node& n) {
+           array_of_tables(n, "polylines", [&](const toml::table& t) {
+             WorldPolyline pl;
+             p.each(t, "world.polylines.", {{"points", [&](const toml::node& pn) {
+                                               const toml::array* a = pn.as_array();
+                                               if (a == nullptr || a->size() < 2) {
+                                                 p.fail(pn.source(), "points must be an array of >= 2 [x_m, y_m]");
+                                               }
+                                               for (const toml::node& q : *a) pl.points.push_back(p.point(q));
+                                             }},
+                                            {"closed", p.flag(&pl.closed)}});
+             if (pl.points.size() < 2) p.fail(t.source(), "a polyline needs points");
+             sc.polylines.push_back(pl);
+           });
+         }},
+        {"boxes", [&, array_of_tables](const toml::node& n) {
+           array_of_tables(n, "boxes", [&](const toml::table& t) {
+             WorldBox b;
+             p.each(t, "world.boxes.",
+                    {{"x_m", [&](const toml::node& v) { b.centre.x() = static_cast<Real>(p.number(v, -1e3, 1e3)); }},
+                     {"y_m", [&](const toml::node& v) { b.centre.y() = static_cast<Real>(p.number(v, -1e3, 1e3)); }},
+                     {"size_x_m", p.num(&b.size_x_m, 0.001, 1e3)},
+                     {"size_y_m", p.num(&b.size_y_m, 0.001, 1e3)},
+                     {"yaw_deg", p.deg(&b.yaw_rad, -180, 180)}});
+             sc.boxes.push_back(b);
+           });
+         }},
+        {"circles", [&, array_of_tables](const toml::node& n) {
+           array_of_tables(n, "circles", [&](const toml::table& t) {
+             WorldCircle c;
+             p.each(t, "world.circles.",
+                    {{"x_m", [&](const toml::node& v) { c.centre.x() = static_cast<Real>(p.number(v, -1e3, 1e3)); }},
+                     {"y_m", [&](const toml::node& v) { c.centre.y() = static_cast<Real>(p.number(v, -1e3, 1e3)); }},
+                     {"r_m", p.num(&c.r_m, 0.001, 100)}});
+             sc.circles.push_back(c);
+           });
+         }},
+    };
+  };
+
+  auto start_handlers = [&]() {
+    StartEnvelope& s = sc.start;
+    return Handlers{
+        {"distance_m", [&](const toml::node& n) {
+           const auto r = p.range(n, 0.05, 50);
+           s.distance_min_m = r.first;
+           s.distance_max_m = r.second;
+         }},
+        {"bearing_deg", [&](const toml::node& n) {
+           const auto r = p.range(n, -90, 90);
+           s.bearing_min_rad = r.first * kDeg;
+           s.bearing_max_rad = r.second * kDeg;
+         }},
+        {"heading_deg", [&](const toml::node& n) {
+           const auto r = p.range(n, -180, 180);
+           s.heading_min_rad = r.first * kDeg;
+           s.heading_max_rad = r.second * kDeg;
+         }},
+    };
+  };
+
+  auto events_handler = [&](const toml::node& n) {
+    const toml::array* a = n.as_array();
+    if (a == nullptr) p.fail(n.source(), "events must be an array of tables ([[events]])");
+    for (const toml::node& e : *a) {
+      const toml::table* t = e.as_table();
+      if (t == nullptr) p.fail(e.source(), "events entries must be tables");
+      ScenarioEvent ev;
+      const toml::node* type = t->get("type");
+      if (type == nullptr) p.fail(t->source(), "event without 'type'");
+      if (t->get("t_s") == nullptr) p.fail(t->source(), "event without 't_s'");
+      const std::string kind = p.choice(*type, {"push", "occlude_dock", "obstacle", "lidar_dropout",
+                                                "charging_never_starts", "chassis_silent"});
+      Handlers h{{"type", [](const toml::node&) {}}, {"t_s", p.num(&ev.t_s, 0, 1e5)}};
+      const Handler dur = p.num(&ev.duration_s, 0, 1e5);
+      if (kind == "push") {
+        ev.kind = EventKind::kPush;
+        h.emplace_back("dx_m", p.num(&ev.dx_m, -10, 10));
+        h.emplace_back("dy_m", p.num(&ev.dy_m, -10, 10));
+        h.emplace_back("dyaw_deg", p.deg(&ev.dyaw_rad, -180, 180));
+      } else if (kind == "occlude_dock") {
+        ev.kind = EventKind::kOccludeDock;
+        h.emplace_back("duration_s", dur);
+      } else if (kind == "obstacle") {
+        ev.kind = EventKind::kObstacle;
+        h.emplace_back("x_m", p.num(&ev.x_m, -1e3, 1e3));
+        h.emplace_back("y_m", p.num(&ev.y_m, -1e3, 1e3));
+        h.emplace_back("r_m", p.num(&ev.r_m, 0.005, 10));
+        h.emplace_back("duration_s", dur);
+      } else if (kind == "lidar_dropout") {
+        ev.kind = EventKind::kLidarDropout;
+        h.emplace_back("duration_s", dur);
+      } else if (kind == "charging_never_starts") {
+        ev.kind = EventKind::kChargingNeverStarts;
+      } else {
+        ev.kind = EventKind::kChassisSilent;
+        h.emplace_back("duration_s", dur);
+        h.emplace_back("motion", [&](const toml::node& m) { ev.hold_last_command = p.choice(m, {"stop", "hold"}) == "hold"; });
+      }
+      p.each(*t, "events." + kind + ".", h);
+      sc.events.push_back(ev);
+    }
+  };
+
+  auto task_handlers = [&]() {
+    dockcore::TaskParams& t = sc.task;
+    return Handlers{
+        {"detect_wait_s", p.real(&t.detect_wait_s, 0, 1e3)},
+        {"swing_amplitude_deg", p.real_deg(&t.swing_amplitude_rad, 0, 180)},
+        {"max_swings", [&](const toml::node& n) { t.max_swings = static_cast<std::uint8_t>(p.integer(n, 0, 255)); }},
+        {"target_lost_after_s", p.real(&t.target_lost_after_s, 0, 1e3)},
+        {"target_lost_timeout_s", p.real(&t.target_lost_timeout_s, 0, 1e3)},
+        {"obstacle_timeout_s", p.real(&t.obstacle_timeout_s, 0, 1e3)},
+        {"charge_confirm_timeout_s", p.real(&t.charge_confirm_timeout_s, 0, 1e3)},
+        {"max_retries", [&](const toml::node& n) { t.max_retries = static_cast<std::uint8_t>(p.integer(n, 0, 255)); }},
+        {"staging_distance_m", p.real(&t.staging_distance_m, 0, 10)},
+        {"task_timeout_s", p.real(&t.task_timeout_s, 0, 1e5)},
+        {"check_distance_error_tolerance_m", p.real(&t.deviation.check_distance_error_tolerance_m, 0, 100)},
+        {"push_distance_tolerance_m", p.real(&t.deviation.push_distance_tolerance_m, 0, 100)},
+        {"check_angle_error_tolerance_deg", p.real_deg(&t.deviation.check_angle_error_tolerance_rad, 0, 180)},
+    };
+  };
+
+  auto estimator_handlers = [&]() {
+    dockcore::EstimatorParams& e = sc.estimator;
+    return Handlers{{"max_range_m", p.real(&e.max_range_m, 0.1, 100)},
+                    {"min_range_m", p.real(&e.min_range_m, 0, 10)},
+                    {"range_sigma_m", p.real(&e.range_sigma_m, 0.0001, 1)}};
+  };
+
+  auto host_handlers = [&]() {
+    HostSpec& h = sc.host;
+    return Handlers{{"chassis_stale_s", p.num(&h.chassis_stale_s, 0.001, 100)},
+                    {"redock_after_fault", [&](const toml::node& n) { h.redock_after_fault = static_cast<int>(p.integer(n, 0, 100)); }},
+                    {"redock_delay_s", p.num(&h.redock_delay_s, 0, 100)}};
+  };
+
+  auto controller_handlers = [&]() {
+    Handlers h{{"name", [&](const toml::node& n) { sc.controller = p.choice(n, controller_names()); }}};
+    // Common settings apply to all four controllers.
+    h.emplace_back("pad_reach_m", [&](const toml::node& n) {
+      const Real v = static_cast<Real>(p.number(n, 0, 5));
+      sc.seed000.common.pad_reach_m = sc.seed004.common.pad_reach_m = v;
+      sc.seed003.common.pad_reach_m = sc.smooth.common.pad_reach_m = v;
+      st.pad_reach_set = true;
+    });
+    h.emplace_back("creep_speed_mps", [&](const toml::node& n) {
+      const Real v = static_cast<Real>(p.number(n, 0, 1));
+      sc.seed000.common.creep_speed_mps = sc.seed004.common.creep_speed_mps = v;
+      sc.seed003.common.creep_speed_mps = sc.smooth.common.creep_speed_mps = v;
+    });
+    h.emplace_back("stall_timeout_s", [&](const toml::node& n) {
+      const Real v = static_cast<Real>(p.number(n, 0, 1e3));
+      sc.seed000.common.stall_timeout_s = sc.seed004.common.stall_timeout_s = v;
+      sc.seed003.common.stall_timeout_s = sc.smooth.common.stall_timeout_s = v;
+    });
+    h.emplace_back("seed000", p.sub("controller.seed000.", [&]() {
+      dockcore::Seed000Params& c = sc.seed000;
+      Handlers s;
+      add_common(p, s, &c.common, &st.pad_reach_set);
+      s.emplace_back("angle_threshold_rad", p.real(&c.angle_threshold_rad, 0, 3.2));
+      s.emplace_back("rotate_exit_rad", p.real(&c.rotate_exit_rad, 0, 3.2));
+      s.emplace_back("rotate_kp", p.real(&c.rotate_kp, 0, 100));
+      s.emplace_back("rotate_max_radps", p.real(&c.rotate_max_radps, 0, 20));
+      s.emplace_back("rotate_min_radps", p.real(&c.rotate_min_radps, 0, 20));
+      s.emplace_back("forward_speed_mps", p.real(&c.forward_speed_mps, 0, 5));
+      s.emplace_back("slowdown_distance_m", p.real(&c.slowdown_distance_m, 0, 10));
+      return s;
+    }));
+    h.emplace_back("seed004", p.sub("controller.seed004.", [&]() {
+      dockcore::Seed004Params& c = sc.seed004;
+      Handlers s;
+      add_common(p, s, &c.common, &st.pad_reach_set);
+      s.emplace_back("angle_tolerance_rad", p.real(&c.angle_tolerance_rad, 0, 3.2));
+      s.emplace_back("distance_tolerance_m", p.real(&c.distance_tolerance_m, 0, 10));
+      s.emplace_back("relative_distance_m", p.real(&c.relative_distance_m, 0, 10));
+      s.emplace_back("robot_distance_tolerance_m", p.real(&c.robot_distance_tolerance_m, -10, 10));
+      s.emplace_back("angle_kp", p.real(&c.angle_kp, 0, 100));
+      s.emplace_back("distance_kp", p.real(&c.distance_kp, 0, 100));
+      s.emplace_back("max_wz_radps", p.real(&c.max_wz_radps, 0, 20));
+      s.emplace_back("min_wz_radps", p.real(&c.min_wz_radps, 0, 20));
+      s.emplace_back("max_speed_mps", p.real(&c.max_speed_mps, 0, 5));
+      s.emplace_back("min_speed_mps", p.real(&c.min_speed_mps, 0, 5));
+      s.emplace_back("final_speed_mps", p.real(&c.final_speed_mps, 0, 5));
+      s.emplace_back("final_heading_kp", p.real(&c.final_heading_kp, 0, 100));
+      return s;
+    }));
+    h.emplace_back("seed003", p.sub("controller.seed003.", [&]() {
+      dockcore::Seed003Params& c = sc.seed003;
+      Handlers s;
+      add_common(p, s, &c.common, &st.pad_reach_set);
+      s.emplace_back("holonomic", [&](const toml::node& n) { c.holonomic = p.boolean(n); st.seed003_holonomic_set = true; });
+      s.emplace_back("window", [&](const toml::node& n) {
+        c.window = static_cast<std::size_t>(p.integer(n, 1, static_cast<std::int64_t>(dockcore::kSeed003MaxWindow)));
+      });
+      const std::pair<const char*, Real*> reals[] = {
+          {"ema_alpha", &c.ema_alpha}, {"stage_switch_m", &c.stage_switch_m}, {"stage1_kw", &c.stage1_kw},
+          {"stage1_max_wz_radps", &c.stage1_max_wz_radps}, {"stage1_kv", &c.stage1_kv},
+          {"stage1_target_m", &c.stage1_target_m}, {"stage1_max_vx_mps", &c.stage1_max_vx_mps},
+          {"goal_z_m", &c.goal_z_m}, {"z_kp", &c.z_kp}, {"z_kd", &c.z_kd}, {"z_max_mps", &c.z_max_mps},
+          {"x_kp", &c.x_kp}, {"x_kd", &c.x_kd}, {"x_max_mps", &c.x_max_mps}, {"u_kp", &c.u_kp}, {"u_kd", &c.u_kd},
+          {"u_max_radps", &c.u_max_radps}, {"seed_period_s", &c.seed_period_s}, {"success_z_m", &c.success_z_m},
+          {"success_x_m", &c.success_x_m}, {"success_u_px", &c.success_u_px}, {"success_hold_s", &c.success_hold_s},
+          {"blind_zone_m", &c.blind_zone_m}, {"target_timeout_s", &c.target_timeout_s},
+          {"final_speed_mps", &c.final_speed_mps}, {"final_max_travel_m", &c.final_max_travel_m}};
+      for (const auto& r : reals) s.emplace_back(r.first, p.real(r.second, 0, 1e4));
+      return s;
+    }));
+    h.emplace_back("smooth", p.sub("controller.smooth.", [&]() {
+      dockcore::SmoothParams& c = sc.smooth;
+      Handlers s;
+      add_common(p, s, &c.common, &st.pad_reach_set);
+      s.emplace_back("backwards", [&](const toml::node& n) { c.backwards = p.boolean(n); st.smooth_backwards_set = true; });
+      const std::pair<const char*, Real*> reals[] = {
+          {"k_phi", &c.k_phi}, {"k_delta", &c.k_delta}, {"beta", &c.beta}, {"lambda", &c.lambda},
+          {"v_max_mps", &c.v_max_mps}, {"w_max_radps", &c.w_max_radps}, {"slowdown_radius_m", &c.slowdown_radius_m},
+          {"max_decel_mps2", &c.max_decel_mps2}, {"goal_projection_m", &c.goal_projection_m},
+          {"min_turn_speed_mps", &c.min_turn_speed_mps}};
+      for (const auto& r : reals) s.emplace_back(r.first, p.real(r.second, 0, 1e4));
+      return s;
+    }));
+    return h;
+  };
+
+  const Handlers top{
+      {"name", [&](const toml::node& n) { sc.name = p.string(n); }},
+      {"seed", [&](const toml::node& n) { sc.seed = static_cast<std::uint64_t>(p.integer(n, 0, INT64_MAX)); }},
+      {"max_time_s", p.num(&sc.max_time_s, 0.1, 1e5)},
+      {"settle_after_end_s", p.num(&sc.settle_after_end_s, 0, 100)},
+      {"robot", p.sub("robot.", robot_handlers)},
+      {"lidar", p.sub("lidar.", lidar_handlers)},
+      {"dock", p.sub("dock.", dock_handlers)},
+      {"world", p.sub("world.", world_handlers)},
+      {"start", p.sub("start.", start_handlers)},
+      {"events", events_handler},
+      {"task", p.sub("task.", task_handlers)},
+      {"estimator", p.sub("estimator.", estimator_handlers)},
+      {"host", p.sub("host.", host_handlers)},
+      {"controller", p.sub("controller.", controller_handlers)},
+  };
+  p.each(root, "", top);
+
+  // --- Derived values and cross-checks ---
+  ChassisParams& c = sc.chassis;
+  c.footprint.shape = st.footprint_shape == "circle" ? FootprintShape::kCircle : FootprintShape::kRectangle;
+  if (st.motor_latency_s >= 0) {
+    c.motor.latency_steps = static_cast<std::size_t>(std::lround(st.motor_latency_s / c.dt_s));
+  }
+  if (const char* bad = check_chassis_params(c)) p.fail(root.source(), std::string("robot: ") + bad);
+
+  if (!lidar_model(st.lidar_model, &sc.lidar)) {
+    std::string names;
+    for (const auto& n : lidar_model_names()) names += (names.empty() ? "" : ", ") + n;
+    p.fail(st.lidar_model_node != nullptr ? st.lidar_model_node->source() : root.source(),
+           "lidar.model = \"" + st.lidar_model + "\" is not one of " + names);
+  }
+  if (st.lidar_sigma_m >= 0) sc.lidar.sigma_const_m = st.lidar_sigma_m;
+  if (st.lidar_sigma_prop >= 0) sc.lidar.sigma_prop = st.lidar_sigma_prop;
+  if (st.lidar_dropout >= 0) sc.lidar.dropout_prob = st.lidar_dropout;
+  if (st.lidar_jitter_rad >= 0) sc.lidar.angular_jitter_rad = st.lidar_jitter_rad;
+  if (st.mixed_pixels >= 0) sc.lidar.mixed_pixels = st.mixed_pixels == 1;
+  if (st.lidar_rate_hz > 0) sc.lidar.rate_hz = st.lidar_rate_hz;
+  if (st.lidar_max_range_m > 0) sc.lidar.max_range_m = st.lidar_max_range_m;
+
+  sc.profile_name = st.profile;
+  {
+    // A relative profile path is relative to the scenario file.
+    std::string ref = st.profile;
+    const bool is_file = ref.find('/') != std::string::npos ||
+                         (ref.size() > 5 && ref.compare(ref.size() - 5, 5, ".toml") == 0);
+    if (is_file && !ref.empty() && ref[0] != '/') ref = dir_of(source_name) + ref;
+    try {
+      sc.profile = resolve_profile(ref);
+    } catch (const ProfileFileError& e) {
+      p.fail(st.profile_node != nullptr ? st.profile_node->source() : root.source(), std::string("dock.profile: ") + e.what());
+    }
+  }
+
+  // Obstacle-check footprint from the chassis outline (centred on the footprint's extent about the rotation centre).
+  dockcore::FootprintParams& f = sc.safety;
+  if (c.footprint.shape == FootprintShape::kCircle) {
+    f.shape = dockcore::FootprintShape::kCircular;
+    f.radius_m = static_cast<Real>(std::fabs(c.footprint.centre_x_m) + c.footprint.radius_m);
+    f.circumscribed_radius_m = f.radius_m;
+  } else {
+    f.shape = dockcore::FootprintShape::kSquare;
+    f.half_length_m = static_cast<Real>(std::fabs(c.footprint.centre_x_m) + c.footprint.length_m / 2);
+    f.half_width_m = static_cast<Real>(c.footprint.width_m / 2);
+    f.circumscribed_radius_m = static_cast<Real>(std::hypot(static_cast<double>(f.half_length_m), c.footprint.width_m / 2));
+  }
+  f.check_length_m = static_cast<Real>(st.check_length_m);
+  f.check_width_m = static_cast<Real>(st.check_width_m);
+
+  const bool mecanum = c.geometry.kind == DriveKind::kMecanum;
+  const bool rear = c.footprint.pad_side == PadSide::kRear;
+  if (!st.pad_reach_set) {
+    const Real reach = static_cast<Real>(pad_reach_of(c));
+    sc.seed000.common.pad_reach_m = sc.seed004.common.pad_reach_m = reach;
+    sc.seed003.common.pad_reach_m = sc.smooth.common.pad_reach_m = reach;
+  }
+  if (!st.seed003_holonomic_set) sc.seed003.holonomic = mecanum;
+  if (!st.smooth_backwards_set) sc.smooth.backwards = rear;
+  sc.seed003.camera = sc.camera.model;
+  sc.task.max_vx_mps = sc.limits.max_vx_mps > 0 ? sc.limits.max_vx_mps : sc.task.max_vx_mps;
+  sc.task.max_vy_mps = sc.limits.max_vy_mps > 0 ? sc.limits.max_vy_mps : sc.task.max_vy_mps;
+  sc.task.max_wz_radps = sc.limits.max_wz_radps > 0 ? sc.limits.max_wz_radps : sc.task.max_wz_radps;
+
+  std::stable_sort(sc.events.begin(), sc.events.end(),
+                   [](const ScenarioEvent& a, const ScenarioEvent& b) { return a.t_s < b.t_s; });
+  return sc;
+}
+
+Scenario load_scenario_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ScenarioError("cannot open scenario file " + path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw ScenarioError("cannot read scenario file " + path);
+  return parse_scenario_toml(ss.str(), path);
+}
+
+}  // namespace docksim
