@@ -84,7 +84,7 @@ struct EstimatorParams {
   Real association_gate_m = static_cast<Real>(0.08);  ///< Points farther from every visible segment are ignored.
   Real inlier_gate_m = static_cast<Real>(0.03);   ///< |measured − expected| below this is an inlier.
   std::uint8_t max_iterations = 10;               ///< Gauss-Newton cap per candidate.
-  std::uint8_t max_candidates = 24;               ///< Hypotheses refined per scan at most (nearest first).
+  std::uint8_t max_candidates = 12;               ///< Hypotheses refined per scan at most (best prescore first).
   Real min_feature_length_m = static_cast<Real>(0.08);  ///< Profile segments shorter than this seed no hypotheses.
   Real min_inlier_fraction = static_cast<Real>(0.6);    ///< Inliers / unoccluded beams expected on the dock, at least.
   Real max_violation_fraction = static_cast<Real>(0.1); ///< See-through beams / expected beams, at most.
