@@ -1,0 +1,34 @@
+#pragma once
+/// @file HAL: where complete lidar scans come from. Drivers (serial LD06 / RPLIDAR, UDP Lakibeam) implement it;
+/// dockd and tests consume it. Core never sees this header: it takes ScanView.
+
+#include <cstdint>
+
+#include "dockcore/laser_scan.hpp"
+
+namespace dockcore::hal {
+
+/// Counters every lidar source keeps so nothing is dropped silently.
+struct LidarCounters {
+  std::uint32_t scans = 0;          ///< Complete scans published.
+  std::uint32_t crc_errors = 0;     ///< Packets failing their checksum.
+  std::uint32_t resyncs = 0;        ///< Times the parser lost and regained packet framing.
+  std::uint32_t dropped_bytes = 0;  ///< Bytes discarded while resynchronising.
+  std::uint32_t reconnects = 0;     ///< Device reopened after it vanished.
+};
+
+/// A lidar delivering complete turns.
+class LidarSource {
+ public:
+  /// Copies the newest complete scan into `out` if one arrived since the last call; returns false otherwise (out
+  /// untouched). Non-blocking. stamp_us is the host's monotonic time of the scan's first sample.
+  virtual bool poll_scan(LaserScan& out) = 0;
+  /// File descriptor to wait on (epoll), or -1 when the source is polled.
+  virtual int fd() const = 0;
+  virtual const LidarCounters& counters() const = 0;
+
+ protected:
+  ~LidarSource() = default;
+};
+
+}  // namespace dockcore::hal
