@@ -10,5 +10,9 @@ void register_perception(CLI::App& app);
 void register_detect(CLI::App& app);
 /// `dock-sim scene`: simulate one scene, detect the dock, print the pose and draw an SVG (scene.cpp).
 void register_scene(CLI::App& app);
+/// `dock-sim run`: one closed-loop docking of a scenario: timeline, outcome, SVG (run.cpp).
+void register_run(CLI::App& app);
+/// `dock-sim montecarlo`: many seeded starts per controller, comparison table (run.cpp).
+void register_montecarlo(CLI::App& app);
 
 }  // namespace docksim_cli

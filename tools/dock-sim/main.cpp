@@ -9,6 +9,8 @@ int main(int argc, char** argv) {
   docksim_cli::register_scene(app);
   docksim_cli::register_detect(app);
   docksim_cli::register_perception(app);
+  docksim_cli::register_run(app);
+  docksim_cli::register_montecarlo(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -38,7 +38,7 @@ void CameraSim::update(std::uint64_t t_us, const dockcore::Pose2& robot_world, c
     }
     f.stamp_us = t_us;
     in_flight_.push_back(f);
-    next_capture_us_ = (next_capture_us_ == 0 && t_us > period_us ? t_us : next_capture_us_) + period_us;
+    next_capture_us_ += period_us;
     if (next_capture_us_ <= t_us) next_capture_us_ = t_us + period_us;
   }
   while (!in_flight_.empty() && in_flight_.front().stamp_us + latency_us <= t_us) {

@@ -51,7 +51,9 @@ enum class EventKind : std::uint8_t {
 const char* to_string(EventKind k);
 
 struct ScenarioEvent {
-  double t_s = 0;  ///< When it happens, s after the dock command.
+  /// When it happens, s of simulated time (the first dock command is sent on the first control tick after the first
+  /// scan has been delivered: scan latency plus at most one tick, ~0.04 s with the defaults).
+  double t_s = 0;
   EventKind kind = EventKind::kPush;
   double dx_m = 0, dy_m = 0, dyaw_rad = 0;  ///< push (world frame).
   double duration_s = 0;                    ///< occlude_dock, obstacle, lidar_dropout, chassis_silent.

@@ -1,0 +1,104 @@
+#pragma once
+// Closed-loop simulation of one docking: docksim::Chassis (5 ms steps) + the lidar simulator (at the model's rate,
+// delivered after a scan latency) + the camera simulation + the Dockcore facade (estimator, filter, task manager)
+// driving one of the four controllers at 50 Hz, its twist saturated and acceleration-limited by dockcore's
+// kinematics and sent as wheel speeds. Scenario events are applied at their times. Records the trajectory, a timeline
+// of task states, controller phases, faults, events and contact changes, and the outcome metrics.
+// Host-side. Deterministic: the same scenario, controller and seed give bit-identical results (every random draw
+// comes from docksim::Rng streams derived from the seed).
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "dockcore/geometry.hpp"
+#include "dockcore/task_manager.hpp"
+#include "docksim/scenario.hpp"
+
+namespace docksim {
+
+/// A start pose, in the envelope's terms and as poses.
+struct StartPose {
+  double distance_m = 0;   ///< Robot centre to dock origin.
+  double bearing_rad = 0;  ///< Of the robot centre in the dock frame (0 = straight out of the face).
+  double heading_rad = 0;  ///< Heading offset from facing the dock (rear facing it for rear pads).
+  Pose2 robot_in_dock{};
+  Pose2 robot_world{};
+};
+
+/// The start pose for given envelope coordinates. O(1).
+StartPose start_from(const Scenario& sc, double distance_m, double bearing_rad, double heading_rad);
+/// A start pose drawn uniformly from the scenario's envelope with an Rng derived from `seed`. O(1).
+StartPose draw_start(const Scenario& sc, std::uint64_t seed);
+/// Seed of Monte Carlo trial `index` for base seed `base` (splitmix64 mixing): the same for every controller.
+std::uint64_t trial_seed(std::uint64_t base, std::uint64_t index);
+
+enum class TimelineKind : std::uint8_t { kState, kPhase, kFault, kEvent, kContact, kHost };
+const char* to_string(TimelineKind k);
+
+struct TimelineEntry {
+  double t_s = 0;
+  TimelineKind kind = TimelineKind::kState;
+  int code = 0;       ///< State code, phase code, fault code, event kind, 1/0 for contact/charging changes.
+  std::string text;   ///< Human-readable ("ALIGN", "fault 178 distance_deviation", ...).
+};
+
+struct TrajectorySample {
+  double t_s = 0;
+  Pose2 pose{};            ///< True robot pose, world.
+  double vx_cmd_mps = 0;   ///< Commanded forward speed after kinematics.
+  std::uint8_t state = 0;  ///< Task state code.
+};
+
+/// The outcome of one run.
+struct SimOutcome {
+  bool charging_confirmed = false;  ///< The task manager reached FINISH_TASKING.
+  double time_to_charging_s = std::numeric_limits<double>::quiet_NaN();  ///< From the first dock command.
+  /// Pads at the end (at charging confirmation when it happened): lateral = pad y in the dock frame, longitudinal =
+  /// pad x in the dock frame (negative = pressed past the contact plane), yaw = pad heading error. Ground truth.
+  double lateral_m = 0, longitudinal_m = 0, yaw_rad = 0;
+  double path_length_m = 0;        ///< Of the robot centre, true motion.
+  int reversals = 0;               ///< Sign changes of the commanded vx (|vx| > 1 mm/s).
+  int inplace_turns_45 = 0;        ///< Stretches of turning with |v| < 1 cm/s whose cumulative |yaw| exceeded 45°.
+  double max_inplace_turn_rad = 0; ///< Largest such stretch.
+  /// Smallest distance between the robot outline and any obstacle (world objects and obstacle events; the dock and
+  /// its wall are not obstacles). +inf when there is none.
+  double min_clearance_m = std::numeric_limits<double>::infinity();
+  std::map<int, int> faults;       ///< Fault code -> times raised.
+  dockcore::TaskState final_state = dockcore::TaskState::kNotTasking;
+  bool timed_out = false;          ///< max_time_s reached without charging or a final fault.
+  int retries = 0;                 ///< Charging retries used (task manager).
+  double end_time_s = 0;
+};
+
+struct SimRun {
+  std::string controller;
+  std::uint64_t seed = 0;
+  StartPose start{};
+  SimOutcome outcome{};
+  std::vector<TimelineEntry> timeline;
+  std::vector<TrajectorySample> trajectory;
+  Pose2 final_pose{};                           ///< True pose at the end.
+  std::vector<dockcore::Vec2> last_scan_world;  ///< Valid returns of the last simulated scan, world coordinates.
+};
+
+struct SimOptions {
+  bool record_trajectory = true;
+  double trajectory_period_s = 0.05;
+  bool keep_last_scan = true;
+  const StartPose* start = nullptr;  ///< Fixed start instead of draw_start(seed).
+};
+
+/// Runs one docking of `sc` with `controller` (one of controller_names()). Throws ScenarioError for an unknown
+/// controller. Cost: O(duration / 5 ms) chassis steps plus the lidar and estimator per scan.
+SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint64_t seed,
+                   const SimOptions& options = SimOptions{});
+
+/// The robot's outline in the body frame (rectangle corners or a 24-gon). O(1).
+std::vector<dockcore::Vec2> footprint_outline(const ChassisParams& chassis);
+
+/// The static world the lidar sees: dock, wall, polylines, boxes, circles (no event obstacles). O(objects).
+World scenario_world(const Scenario& sc, bool with_dock = true);
+
+}  // namespace docksim

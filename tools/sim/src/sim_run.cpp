@@ -1,0 +1,548 @@
+#include "docksim/sim_run.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "dockcore/controllers.hpp"
+#include "dockcore/dockcore.hpp"
+#include "dockcore/faults.hpp"
+#include "dockcore/kinematics.hpp"
+#include "docksim/camera_sim.hpp"
+#include "docksim/chassis.hpp"
+#include "docksim/lidar_sim.hpp"
+#include "docksim/rng.hpp"
+
+namespace docksim {
+
+using dockcore::Real;
+using dockcore::Vec2;
+
+namespace {
+
+constexpr double kPiD = 3.14159265358979323846;
+constexpr int kStepsPerTick = 4;  // 4 x 5 ms = 20 ms control period (50 Hz)
+
+std::uint64_t mix64(std::uint64_t z) {
+  z += 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+Vec2 v2(double x, double y) { return Vec2(static_cast<Real>(x), static_cast<Real>(y)); }
+double dd(Real r) { return static_cast<double>(r); }
+
+double wrapd(double a) {
+  double r = std::remainder(a, 2.0 * kPiD);
+  if (r <= -kPiD) r += 2.0 * kPiD;
+  return r;
+}
+
+// --- clearance geometry (double precision) ---
+struct P {
+  double x, y;
+};
+P pd(const Vec2& v) { return P{dd(v.x()), dd(v.y())}; }
+double cross(P a, P b, P c) { return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x); }
+double point_seg(P p, P a, P b) {
+  const double vx = b.x - a.x, vy = b.y - a.y;
+  const double l2 = vx * vx + vy * vy;
+  double t = l2 > 0 ? ((p.x - a.x) * vx + (p.y - a.y) * vy) / l2 : 0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(p.x - (a.x + t * vx), p.y - (a.y + t * vy));
+}
+bool segs_cross(P a, P b, P c, P d) {
+  const double d1 = cross(c, d, a), d2 = cross(c, d, b), d3 = cross(a, b, c), d4 = cross(a, b, d);
+  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0));
+}
+double seg_seg(P a, P b, P c, P d) {
+  if (segs_cross(a, b, c, d)) return 0;
+  return std::min({point_seg(a, c, d), point_seg(b, c, d), point_seg(c, a, b), point_seg(d, a, b)});
+}
+bool inside_poly(P p, const std::vector<P>& poly) {
+  bool in = false;
+  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    if ((poly[i].y > p.y) != (poly[j].y > p.y) &&
+        p.x < (poly[j].x - poly[i].x) * (p.y - poly[i].y) / (poly[j].y - poly[i].y) + poly[i].x) {
+      in = !in;
+    }
+  }
+  return in;
+}
+
+struct Obstacles {
+  std::vector<std::pair<P, P>> segments;
+  struct Disc {
+    P c;
+    double r;
+  };
+  std::vector<Disc> discs;
+};
+
+/// Clearance between the robot outline (polygon in world, or a disc) and the obstacles.
+double clearance(const std::vector<P>& poly, bool is_disc, P disc_c, double disc_r, const Obstacles& obs) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& s : obs.segments) {
+    double d;
+    if (is_disc) {
+      d = std::max(0.0, point_seg(disc_c, s.first, s.second) - disc_r);
+    } else {
+      d = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < poly.size(); ++i) d = std::min(d, seg_seg(poly[i], poly[(i + 1) % poly.size()], s.first, s.second));
+      if (d > 0 && inside_poly(s.first, poly)) d = 0;
+    }
+    best = std::min(best, d);
+  }
+  for (const auto& c : obs.discs) {
+    double d;
+    if (is_disc) {
+      d = std::hypot(disc_c.x - c.c.x, disc_c.y - c.c.y) - disc_r - c.r;
+    } else if (inside_poly(c.c, poly)) {
+      d = 0;
+    } else {
+      d = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < poly.size(); ++i) d = std::min(d, point_seg(c.c, poly[i], poly[(i + 1) % poly.size()]) - c.r);
+    }
+    best = std::min(best, std::max(0.0, d));
+  }
+  return best;
+}
+
+dockcore::DriveGeometry core_geometry(const DriveGeometry& g) {
+  dockcore::DriveGeometry c;
+  c.kind = g.kind == DriveKind::kMecanum ? dockcore::DriveKind::kMecanum : dockcore::DriveKind::kDifferential;
+  c.wheel_radius_m = static_cast<Real>(g.wheel_radius_m);
+  c.wheel_base_m = static_cast<Real>(g.wheel_base_m);
+  c.lx_m = static_cast<Real>(g.lx_m);
+  c.ly_m = static_cast<Real>(g.ly_m);
+  return c;
+}
+
+struct Controllers {
+  explicit Controllers(const Scenario& sc) : s000(sc.seed000), s004(sc.seed004), s003(sc.seed003), smooth(sc.smooth) {}
+  dockcore::Seed000Controller s000;
+  dockcore::Seed004Controller s004;
+  dockcore::Seed003Controller s003;
+  dockcore::SmoothController smooth;
+  dockcore::DockingController* get(const std::string& name) {
+    if (name == "seed000") return &s000;
+    if (name == "seed004") return &s004;
+    if (name == "seed003") return &s003;
+    if (name == "smooth") return &smooth;
+    return nullptr;
+  }
+};
+
+std::string fault_text(int code) {
+  return "fault " + std::to_string(code) + " " + dockcore::to_string(static_cast<dockcore::FaultCode>(code));
+}
+
+}  // namespace
+
+const char* to_string(TimelineKind k) {
+  switch (k) {
+    case TimelineKind::kState: return "state";
+    case TimelineKind::kPhase: return "phase";
+    case TimelineKind::kFault: return "fault";
+    case TimelineKind::kEvent: return "event";
+    case TimelineKind::kContact: return "contact";
+    case TimelineKind::kHost: return "host";
+  }
+  return "?";
+}
+
+std::uint64_t trial_seed(std::uint64_t base, std::uint64_t index) { return mix64(mix64(base) ^ (index * 0xD1B54A32D192ED03ull)); }
+
+StartPose start_from(const Scenario& sc, double distance_m, double bearing_rad, double heading_rad) {
+  StartPose s;
+  s.distance_m = distance_m;
+  s.bearing_rad = bearing_rad;
+  s.heading_rad = heading_rad;
+  const double x = distance_m * std::cos(bearing_rad), y = distance_m * std::sin(bearing_rad);
+  const bool rear = sc.chassis.footprint.pad_side == PadSide::kRear;
+  const double yaw = wrapd(std::atan2(-y, -x) + heading_rad + (rear ? kPiD : 0.0));
+  s.robot_in_dock = Pose2{static_cast<Real>(x), static_cast<Real>(y), static_cast<Real>(yaw)};
+  s.robot_world = sc.dock_pose.compose(s.robot_in_dock);
+  return s;
+}
+
+StartPose draw_start(const Scenario& sc, std::uint64_t seed) {
+  Rng rng(mix64(seed ^ 0x5354415254ull));
+  const StartEnvelope& e = sc.start;
+  const double d = rng.uniform(e.distance_min_m, e.distance_max_m);
+  const double b = rng.uniform(e.bearing_min_rad, e.bearing_max_rad);
+  const double h = rng.uniform(e.heading_min_rad, e.heading_max_rad);
+  return start_from(sc, d, b, h);
+}
+
+std::vector<Vec2> footprint_outline(const ChassisParams& c) {
+  const FootprintParams& f = c.footprint;
+  std::vector<Vec2> pts;
+  if (f.shape == FootprintShape::kCircle) {
+    for (int i = 0; i < 24; ++i) {
+      const double a = 2 * kPiD * i / 24;
+      pts.push_back(v2(f.centre_x_m + f.radius_m * std::cos(a), f.radius_m * std::sin(a)));
+    }
+  } else {
+    const double hx = f.length_m / 2, hy = f.width_m / 2, cx = f.centre_x_m;
+    pts = {v2(cx + hx, hy), v2(cx - hx, hy), v2(cx - hx, -hy), v2(cx + hx, -hy)};
+  }
+  return pts;
+}
+
+World scenario_world(const Scenario& sc, bool with_dock) {
+  World w;
+  if (with_dock) w.add_dock(sc.profile, sc.dock_pose);
+  if (sc.wall) {
+    double min_x = 0;
+    for (std::size_t i = 0; i < sc.profile.vertex_count; ++i) min_x = std::min(min_x, dd(sc.profile.vertices_m[i].x()));
+    w.add_polyline({sc.dock_pose.transform(v2(min_x, -sc.wall_half_length_m)),
+                    sc.dock_pose.transform(v2(min_x, sc.wall_half_length_m))},
+                   false, 0.5);
+  }
+  for (const auto& pl : sc.polylines) w.add_polyline(pl.points, pl.closed);
+  for (const auto& b : sc.boxes) w.add_box(b.centre, b.size_x_m, b.size_y_m, b.yaw_rad);
+  for (const auto& c : sc.circles) w.add_circle(c.centre, c.r_m);
+  return w;
+}
+
+SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint64_t seed, const SimOptions& opt) {
+  SimRun run;
+  run.controller = controller;
+  run.seed = seed;
+  run.start = opt.start != nullptr ? *opt.start : draw_start(sc, seed);
+  SimOutcome& out = run.outcome;
+
+  auto ctrls = std::make_unique<Controllers>(sc);
+  dockcore::DockingController* ctl = ctrls->get(controller);
+  if (ctl == nullptr) throw ScenarioError("unknown controller '" + controller + "'");
+
+  // Dockcore is large (estimator buffers, a scan copy): heap, not stack.
+  auto core = std::make_unique<dockcore::Dockcore>(*ctl);
+  dockcore::DockcoreConfig cfg;
+  cfg.estimator = sc.estimator;
+  cfg.task = sc.task;
+  cfg.footprint = sc.safety;
+  cfg.lidar_mount = sc.lidar_mount;
+  if (!core->configure(sc.profile, cfg)) throw ScenarioError("dock profile has no segments");
+
+  Chassis chassis(sc.chassis, mix64(seed ^ 0x43484153ull));
+  DockPlacement dp;
+  dp.pose_world = sc.dock_pose;
+  dp.face_half_width_m = sc.dock_face_half_width_m;
+  chassis.set_dock(dp);
+  chassis.set_true_pose(run.start.robot_world);
+  chassis.reset_odometry(Pose2{});
+  Rng lidar_rng(mix64(seed ^ 0x4C494441ull));
+
+  CameraSimParams camp;
+  camp.model = sc.camera.model;
+  camp.rate_hz = sc.camera.rate_hz;
+  camp.latency_s = sc.camera.latency_s;
+  camp.sigma_px = sc.camera.sigma_px;
+  camp.dropout_prob = sc.camera.dropout_prob;
+  camp.min_depth_m = sc.camera.min_depth_m;
+  camp.max_depth_m = sc.camera.max_depth_m;
+  camp.v_px = sc.camera.v_px;
+  CameraSim camera(camp, mix64(seed ^ 0x43414dull));
+  const Vec2 target_world = sc.dock_pose.transform(sc.camera.target_in_dock);
+
+  const dockcore::DriveGeometry geom = core_geometry(sc.chassis.geometry);
+  const double dt = sc.chassis.dt_s;
+  const double tick_dt = dt * kStepsPerTick;
+
+  // World state driven by events.
+  const World world_with_dock = scenario_world(sc, true);
+  const World world_no_dock = scenario_world(sc, false);
+  Obstacles static_obs;
+  {
+    World o;
+    for (const auto& pl : sc.polylines) o.add_polyline(pl.points, pl.closed);
+    for (const auto& b : sc.boxes) o.add_box(b.centre, b.size_x_m, b.size_y_m, b.yaw_rad);
+    for (const auto& s : o.segments) static_obs.segments.push_back({pd(s.a), pd(s.b)});
+    for (const auto& c : sc.circles) static_obs.discs.push_back({pd(c.centre), c.r_m});
+  }
+  struct ActiveObstacle {
+    Vec2 c;
+    double r;
+    double until_s;
+  };
+  std::vector<ActiveObstacle> active_obs;
+  double occluded_until = -1, dropout_until = -1, silent_until = -1;
+  bool silent = false;
+  std::size_t next_event = 0;
+
+  // Lidar pipeline.
+  const double scan_period = 1.0 / sc.lidar.rate_hz;
+  double next_scan_t = 0;
+  struct PendingScan {
+    dockcore::LaserScan scan;
+    std::uint64_t stamp_us;
+    Pose2 odom;
+    Pose2 lidar_world;
+  };
+  std::vector<std::unique_ptr<PendingScan>> pending;
+  std::unique_ptr<PendingScan> last_scan;
+
+  // Footprint for clearance.
+  const std::vector<Vec2> outline = footprint_outline(sc.chassis);
+  const bool disc = sc.chassis.footprint.shape == FootprintShape::kCircle;
+
+  // Host state.
+  dockcore::Twist2 prev_cmd{};
+  dockcore::TaskState prev_state = dockcore::TaskState::kNotTasking;
+  std::uint8_t prev_phase = 255;
+  dockcore::FaultCode prev_fault = dockcore::FaultCode::kNone;
+  bool prev_contact = false, prev_charging = false, prev_blocked = false, prev_lost = false;
+  int redocks_left = sc.host.redock_after_fault;
+  double fault_since = -1;
+  bool send_dock = false;
+  bool first_dock_sent = false;
+  double dock_cmd_t = 0;
+  double end_at = -1;
+  double last_responding_t = 0;
+  ChassisState reported = chassis.state();  // what the host last heard from the chassis
+  int last_vx_sign = 0;
+  double inplace_acc = 0;
+  double next_traj_t = 0;
+
+  auto add = [&](double t, TimelineKind k, int code, const std::string& text) {
+    run.timeline.push_back(TimelineEntry{t, k, code, text});
+  };
+  auto close_inplace = [&]() {
+    if (inplace_acc > kPiD / 4) ++out.inplace_turns_45;
+    out.max_inplace_turn_rad = std::max(out.max_inplace_turn_rad, inplace_acc);
+    inplace_acc = 0;
+  };
+
+  const std::uint64_t max_steps = static_cast<std::uint64_t>(std::ceil(sc.max_time_s / dt));
+  std::uint64_t k = 0;
+  for (; k <= max_steps; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    const std::uint64_t now_us = static_cast<std::uint64_t>(std::llround(t * 1e6));
+    if (end_at >= 0 && t >= end_at) break;
+
+    // 1. Events.
+    while (next_event < sc.events.size() && sc.events[next_event].t_s <= t + 1e-9) {
+      const ScenarioEvent& ev = sc.events[next_event++];
+      char buf[160];
+      switch (ev.kind) {
+        case EventKind::kPush:
+          chassis.apply_pose_jump(ev.dx_m, ev.dy_m, ev.dyaw_rad);
+          std::snprintf(buf, sizeof buf, "push dx %.3f m dy %.3f m dyaw %.1f deg", ev.dx_m, ev.dy_m, ev.dyaw_rad * 180 / kPiD);
+          break;
+        case EventKind::kOccludeDock:
+          occluded_until = std::max(occluded_until, t + ev.duration_s);
+          std::snprintf(buf, sizeof buf, "dock occluded for %.2f s", ev.duration_s);
+          break;
+        case EventKind::kObstacle:
+          active_obs.push_back({v2(ev.x_m, ev.y_m), ev.r_m, ev.duration_s > 0 ? t + ev.duration_s : 1e300});
+          std::snprintf(buf, sizeof buf, "obstacle r %.2f m at (%.2f, %.2f) for %.2f s", ev.r_m, ev.x_m, ev.y_m, ev.duration_s);
+          break;
+        case EventKind::kLidarDropout:
+          dropout_until = std::max(dropout_until, t + ev.duration_s);
+          std::snprintf(buf, sizeof buf, "lidar dropout for %.2f s", ev.duration_s);
+          break;
+        case EventKind::kChargingNeverStarts:
+          chassis.set_charging_inhibited(true);
+          std::snprintf(buf, sizeof buf, "charger will never deliver current");
+          break;
+        case EventKind::kChassisSilent:
+          silent_until = std::max(silent_until, t + ev.duration_s);
+          chassis.set_frozen(true, ev.hold_last_command ? FreezeMotion::kHoldLastCommand : FreezeMotion::kStop);
+          silent = true;
+          std::snprintf(buf, sizeof buf, "chassis silent for %.2f s (%s)", ev.duration_s,
+                        ev.hold_last_command ? "motors hold the last command" : "motors stop");
+          break;
+      }
+      add(t, TimelineKind::kEvent, static_cast<int>(ev.kind), buf);
+    }
+    if (silent && t >= silent_until) {
+      chassis.set_frozen(false);
+      silent = false;
+      add(t, TimelineKind::kEvent, static_cast<int>(EventKind::kChassisSilent), "chassis answers again");
+    }
+    active_obs.erase(std::remove_if(active_obs.begin(), active_obs.end(),
+                                    [&](const ActiveObstacle& o) { return t >= o.until_s; }),
+                     active_obs.end());
+    const bool occluded = t < occluded_until;
+
+    const ChassisState& cs = chassis.state();
+    if (cs.responding) {
+      reported = cs;
+      last_responding_t = t;
+    }
+
+    // 2. Lidar: capture at the model's rate from the true lidar pose, deliver after the scan latency.
+    if (t + 1e-9 >= next_scan_t) {
+      next_scan_t += scan_period;
+      if (t >= dropout_until) {
+        auto ps = std::make_unique<PendingScan>();
+        ps->lidar_world = cs.true_pose.compose(sc.lidar_mount);
+        World w = occluded ? world_no_dock : world_with_dock;
+        for (const auto& o : active_obs) w.add_circle(o.c, o.r);
+        simulate_scan(w, ps->lidar_world, sc.lidar, lidar_rng, &ps->scan, now_us);
+        ps->stamp_us = now_us;
+        ps->odom = reported.odom_pose;
+        pending.push_back(std::move(ps));
+      }
+    }
+    while (!pending.empty() &&
+           static_cast<double>(now_us - pending.front()->stamp_us) * 1e-6 + 1e-9 >= sc.scan_latency_s) {
+      core->on_scan(pending.front()->scan.view(), pending.front()->stamp_us, pending.front()->odom);
+      last_scan = std::move(pending.front());
+      pending.erase(pending.begin());
+    }
+
+    // 3. Camera.
+    if (sc.camera.enabled) camera.update(now_us, cs.true_pose, target_world, !occluded);
+
+    // 4. Control tick.
+    if (k % kStepsPerTick == 0) {
+      dockcore::TickInput in;
+      in.now_us = now_us;
+      // The host sends the first dock command once the lidar has delivered a scan (dockd would not start blind).
+      if (!first_dock_sent && last_scan) {
+        send_dock = true;
+        first_dock_sent = true;
+        dock_cmd_t = t;
+      }
+      if (send_dock) {
+        in.command = dockcore::HostCommand{dockcore::HostCommandType::kDock, 0};
+        send_dock = false;
+        add(t, TimelineKind::kHost, 1, "host: dock");
+      }
+      in.odom_pose = reported.odom_pose;
+      dockcore::WheelSpeeds m;
+      m.count = cs.wheel_count;
+      for (std::size_t i = 0; i < m.count; ++i) m.radps[i] = static_cast<Real>(reported.wheel_measured_radps[i]);
+      in.odom_twist = dockcore::wheels_to_twist(geom, m);
+      if (sc.camera.enabled) in.camera = camera.latest();
+      in.contact = reported.contact;
+      in.charge_current_a = static_cast<Real>(reported.charge_current_a);
+      in.chassis_ok = t - last_responding_t <= sc.host.chassis_stale_s;
+      const dockcore::TickOutput o = core->tick(in);
+
+      // Kinematics: saturation keeping curvature, then the acceleration limit, then wheel speeds.
+      dockcore::Twist2 cmd = dockcore::saturate_twist(geom, sc.limits, o.cmd);
+      cmd = dockcore::limit_acceleration(sc.limits, prev_cmd, cmd, static_cast<Real>(tick_dt));
+      // A zero twist (stop, fault, idle) is sent at once: the drive's own lag and limits do the braking.
+      if (o.cmd.vx_mps == 0 && o.cmd.vy_mps == 0 && o.cmd.wz_radps == 0) cmd = dockcore::Twist2{};
+      prev_cmd = cmd;
+      const dockcore::WheelSpeeds w = dockcore::twist_to_wheels(geom, cmd);
+      WheelRadps wr{};
+      for (std::size_t i = 0; i < w.count && i < kMaxWheels; ++i) wr[i] = dd(w.radps[i]);
+      chassis.command_wheels(wr);
+
+      // Timeline.
+      const dockcore::TaskStatus& s = o.status;
+      if (s.state != prev_state) {
+        add(t, TimelineKind::kState, static_cast<int>(s.state), dockcore::to_string(s.state));
+        if (s.state == dockcore::TaskState::kFinishTasking && !out.charging_confirmed) {
+          out.charging_confirmed = true;
+          out.time_to_charging_s = t - dock_cmd_t;
+          out.lateral_m = cs.pad_lateral_m;
+          out.longitudinal_m = -cs.press_m;
+          out.yaw_rad = cs.pad_yaw_error_rad;
+          end_at = t + sc.settle_after_end_s;
+        }
+        prev_phase = 255;
+      }
+      if (s.state == dockcore::TaskState::kAlign && s.phase != prev_phase) {
+        add(t, TimelineKind::kPhase, s.phase, std::string(ctl->name()) + " " + ctl->phase_name(s.phase));
+        prev_phase = s.phase;
+      }
+      if (s.fault != prev_fault && s.fault != dockcore::FaultCode::kNone) {
+        add(t, TimelineKind::kFault, static_cast<int>(s.fault), fault_text(static_cast<int>(s.fault)));
+        ++out.faults[static_cast<int>(s.fault)];
+      }
+      prev_fault = s.fault;
+      if (o.blocked != prev_blocked) {
+        add(t, TimelineKind::kHost, o.blocked ? 1 : 0, o.blocked ? "motion blocked by an obstacle" : "motion free again");
+        prev_blocked = o.blocked;
+      }
+      if (o.target_lost != prev_lost) {
+        add(t, TimelineKind::kHost, o.target_lost ? 1 : 0, o.target_lost ? "target lost: holding" : "target reacquired");
+        prev_lost = o.target_lost;
+      }
+      if (s.state == dockcore::TaskState::kFault) {
+        if (prev_state != dockcore::TaskState::kFault) fault_since = t;
+        if (redocks_left > 0 && t - fault_since >= sc.host.redock_delay_s) {
+          --redocks_left;
+          send_dock = true;
+        } else if (redocks_left == 0 && end_at < 0) {
+          end_at = t + sc.settle_after_end_s;
+        }
+      }
+      prev_state = s.state;
+      out.retries = s.retries;
+
+      // Metrics on the command actually sent.
+      const double vx = dd(cmd.vx_mps);
+      const int sgn = vx > 1e-3 ? 1 : (vx < -1e-3 ? -1 : 0);
+      if (sgn != 0) {
+        if (last_vx_sign != 0 && sgn != last_vx_sign) ++out.reversals;
+        last_vx_sign = sgn;
+      }
+      // Clearance.
+      if (!static_obs.segments.empty() || !static_obs.discs.empty() || !active_obs.empty()) {
+        Obstacles obs = static_obs;
+        for (const auto& a : active_obs) obs.discs.push_back({pd(a.c), a.r});
+        std::vector<P> poly;
+        for (const auto& q : outline) poly.push_back(pd(cs.true_pose.transform(q)));
+        const P centre = pd(cs.true_pose.transform(v2(sc.chassis.footprint.centre_x_m, 0)));
+        out.min_clearance_m = std::min(out.min_clearance_m, clearance(poly, disc, centre, sc.chassis.footprint.radius_m, obs));
+      }
+      if (opt.record_trajectory && t + 1e-9 >= next_traj_t) {
+        run.trajectory.push_back(TrajectorySample{t, cs.true_pose, vx, static_cast<std::uint8_t>(s.state)});
+        next_traj_t += opt.trajectory_period_s;
+      }
+    }
+
+    // 5. Physics.
+    const Pose2 before = chassis.state().true_pose;
+    chassis.step();
+    const ChassisState& after = chassis.state();
+    out.path_length_m += std::hypot(dd(after.true_pose.x_m - before.x_m), dd(after.true_pose.y_m - before.y_m));
+    const double speed = std::hypot(after.true_twist.vx_mps, after.true_twist.vy_mps);
+    if (speed < 0.01) {
+      inplace_acc += std::fabs(after.true_twist.wz_radps) * dt;
+    } else {
+      close_inplace();
+    }
+    if (after.contact != prev_contact) {
+      add(t + dt, TimelineKind::kContact, after.contact ? 1 : 0, after.contact ? "contacts closed" : "contacts open");
+      prev_contact = after.contact;
+    }
+    if (after.charging != prev_charging) {
+      add(t + dt, TimelineKind::kContact, after.charging ? 3 : 2, after.charging ? "charging current on" : "charging current off");
+      prev_charging = after.charging;
+    }
+  }
+  close_inplace();
+  const ChassisState& fs = chassis.state();
+  out.end_time_s = static_cast<double>(k) * dt;
+  out.final_state = prev_state;
+  out.timed_out = !out.charging_confirmed && prev_state != dockcore::TaskState::kFault;
+  if (!out.charging_confirmed) {
+    out.lateral_m = fs.pad_lateral_m;
+    out.longitudinal_m = -fs.press_m;
+    out.yaw_rad = fs.pad_yaw_error_rad;
+  }
+  if (out.timed_out) add(out.end_time_s, TimelineKind::kHost, 0, "timeout: max_time_s reached");
+  run.final_pose = fs.true_pose;
+  if (opt.keep_last_scan && last_scan) {
+    const dockcore::LaserScan& s = last_scan->scan;
+    for (std::size_t i = 0; i < s.count; ++i) {
+      const double r = dd(s.ranges_m[i]);
+      if (!(r > 0)) continue;
+      const double a = dd(s.angle_min_rad) + static_cast<double>(i) * dd(s.angle_increment_rad);
+      run.last_scan_world.push_back(last_scan->lidar_world.transform(v2(r * std::cos(a), r * std::sin(a))));
+    }
+  }
+  return run;
+}
+
+}  // namespace docksim
