@@ -110,6 +110,7 @@ bool DockPoseEstimator::load_scan(const ScanView& scan) {
   const Real si = std::sin(angle_inc_rad_);
   Vec2 d(0, 0);
   points_.clear();
+  valid_beams_ = 0;
   for (std::size_t i = 0; i < beams_; ++i) {
     if ((i & 63u) == 0) {
       const Real a = scan.angle_rad(i);
@@ -121,16 +122,23 @@ bool DockPoseEstimator::load_scan(const ScanView& scan) {
     const Real r = scan.ranges_m[i];
     const bool ok = is_valid_range(r) && r >= params_.min_range_m && r <= params_.max_range_m;
     range_m_[i] = ok ? r : 0;
-    if (ok) {
-      ScanPoint sp;
-      sp.p_m = r * d;
-      sp.range_m = r;
-      sp.angle_rad = scan.angle_rad(i);
-      sp.index = static_cast<std::uint32_t>(i);
-      points_.push_back(sp);
-    }
+    valid_beams_ += ok ? 1u : 0u;
   }
   return true;
+}
+
+void DockPoseEstimator::build_points() {
+  // Only the global search needs Cartesian points; tracking works on the beams directly.
+  points_.clear();
+  for (std::size_t i = 0; i < beams_; ++i) {
+    if (range_m_[i] == 0) continue;
+    ScanPoint sp;
+    sp.p_m = range_m_[i] * dir_[i];
+    sp.range_m = range_m_[i];
+    sp.angle_rad = angle_min_rad_ + static_cast<Real>(i) * angle_inc_rad_;
+    sp.index = static_cast<std::uint32_t>(i);
+    points_.push_back(sp);
+  }
 }
 
 bool DockPoseEstimator::wall_behind(const Pose2& pose, long first, std::size_t k_first_hit,
@@ -541,6 +549,7 @@ void DockPoseEstimator::add_window_hypotheses(std::size_t* n) {
 }
 
 std::size_t DockPoseEstimator::generate_candidates() {
+  build_points();
   std::size_t n = 0;
   add_window_hypotheses(&n);
   const SegmentStats stats = extract_line_segments(points_, angle_inc_rad_, wraps_, params_.segments, segs_);
@@ -604,7 +613,7 @@ DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lida
     est.status = EstimateStatus::kBadScan;
     return est;
   }
-  if (points_.size() < params_.min_inliers) {
+  if (valid_beams_ < params_.min_inliers) {
     est.status = EstimateStatus::kNoPoints;
     return est;
   }

@@ -186,6 +186,8 @@ class DockPoseEstimator {
     RejectReason reject;
   };
   bool load_scan(const ScanView& scan);
+  /// Fills points_ from the loaded beams (global search only).
+  void build_points();
   Refined refine(const Pose2& initial);
   void verify(Refined& r);
   /// Signed index of the beam nearest angle_rad (may lie outside [0, beams) for a partial scan).
@@ -231,6 +233,7 @@ class DockPoseEstimator {
   Vec2 dir_[kMaxScanPoints];
   Real range_m_[kMaxScanPoints];
   std::size_t beams_ = 0;
+  std::size_t valid_beams_ = 0;
   Real angle_min_rad_ = 0;
   Real angle_inc_rad_ = 0;
   bool wraps_ = false;
