@@ -12,6 +12,9 @@ constexpr Real R(double v) { return static_cast<Real>(v); }
 // Larger lets the surface adjoining the dock (a wall flush with its back) drag the fit.
 constexpr Real kOverhangM = static_cast<Real>(0.002);
 
+// Smallest |cos(incidence)| used to turn a point-to-line residual into a range residual.
+constexpr Real kMinCosIncidence = static_cast<Real>(0.2);
+
 // Gauss-Newton iterations that use Huber weights before switching to Tukey's biweight.
 constexpr std::uint8_t kHuberIterations = 3;
 
@@ -268,7 +271,13 @@ DockPoseEstimator::Refined DockPoseEstimator::refine(const Pose2& initial) {
       Real overhang = 0;
       if (!placed_.nearest(p, &seg, &dist, &e, &overhang) || dist > gate || overhang > kOverhangM) continue;
       const Vec2& n = placed_.n[seg];
-      const Vec3 jac(-n.x(), -n.y(), Vec2(-n.y(), n.x()).dot(p - t));
+      // Work in range units: the lidar's noise is along the beam, so a residual of e across the surface is a range
+      // error of e / cos(incidence). Weighting by that is the maximum-likelihood fit (and what the Cramér–Rao bound
+      // assumes); plain point-to-line would under-use oblique surfaces such as wings. Capped at 78° incidence.
+      Real cos_inc = std::fabs(n.dot(dir_[i]));
+      cos_inc = cos_inc > kMinCosIncidence ? cos_inc : kMinCosIncidence;
+      e /= cos_inc;
+      const Vec3 jac = Vec3(-n.x(), -n.y(), Vec2(-n.y(), n.x()).dot(p - t)) / cos_inc;
       const Real ae = std::fabs(e);
       // Huber while the pose is rough (convex, pulls in from afar); Tukey's biweight once it is close, so points
       // from depth edges (mixed pixels, jitter at a slot wall) stop pulling the fit at all.
