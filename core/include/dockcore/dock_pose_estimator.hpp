@@ -95,8 +95,9 @@ struct EstimatorParams {
   std::uint16_t min_inliers = 10;  ///< Absolute floor on inliers (a 0.3 m dock 2 m away gives ~13 with LD06).
   /// Inliers / all beams expected on the dock (occluded included), at least: how much of the dock may be hidden.
   Real min_visible_fraction = static_cast<Real>(0.5);
-  /// Returns allowed on the line of a long profile segment 4-12 cm past its end. A real dock's surfaces stop at its
-  /// edges; a wall or box face matched as the dock's face carries on.
+  /// Returns allowed on the line of a long profile segment 4-12 cm past its end (more are allowed while they stay
+  /// under 30 % of the returns there). A real dock's surfaces stop at its edges; a wall or box face matched as the
+  /// dock's face carries on.
   std::uint16_t max_extension_points = 2;
   /// Distance from a segment's line within which a return past its end counts as an extension. Narrower than the
   /// inlier gate: a wall meeting a 45° wing at its tip stays ~overhang away from the wing's line.
@@ -125,7 +126,8 @@ struct EstimatorParams {
 };
 
 /// Parameters for a lidar whose 1-σ range noise is `range_sigma_m`: the noise-dependent gates (inlier gate 3σ,
-/// inlier and shape RMS 1.5σ, extension band 2σ, association gate 6σ, each with a floor for very clean lidars) scaled from
+/// inlier and shape RMS 1.5σ, extension band 2σ, association gate 6σ, each with a floor for very
+/// clean lidars) scaled from
 /// the defaults, which are this function's result for 10 mm. O(1).
 EstimatorParams estimator_params_for_noise(Real range_sigma_m);
 
@@ -211,8 +213,9 @@ class DockPoseEstimator {
   bool wall_behind(const Pose2& pose, long first, std::size_t k_first_hit, std::size_t k_last_hit) const;
   /// Score to choose between poses of one object: inliers discounted by fit, minus see-through beams.
   Real quality(const Refined& r) const;
-  /// True when p lies on the line of a long visible segment of placed_, 4-12 cm past its end.
-  bool continues_past_end(const Vec2& p) const;
+  /// For a return p: 0 when it is not 4-12 cm past the end of a long visible segment of placed_ (or lies on the
+  /// dock), 1 when it is but off that segment's line, 2 when it continues the segment's line.
+  int continues_past_end(const Vec2& p) const;
 
   /// Hypotheses collected per scan before ranking; beyond this they are counted as truncated.
   static constexpr std::size_t kMaxHypotheses = 128;
