@@ -76,9 +76,12 @@ bool write_svg(const docksim::SvgCanvas& c, const std::string& path, const char*
 struct RunOptions {
   std::string scenario;
   std::string controller;  // empty: the scenario's
-  long long seed = -1;     // < 0: the scenario's
+  std::uint64_t seed = 0;
+  bool seed_set = false;   // false: the scenario's
   std::string svg;
   bool json = false;
+  bool trace = false;
+  std::vector<double> start;  // distance m, bearing deg, heading deg; empty: drawn from the seed
 };
 
 void draw_run(const docksim::Scenario& sc, const docksim::SimRun& r, const std::string& path) {
@@ -137,6 +140,9 @@ nlohmann::ordered_json outcome_json(const docksim::SimRun& r) {
   j["final_state"] = dockcore::to_string(o.final_state);
   j["timed_out"] = o.timed_out;
   j["end_time_s"] = r6(o.end_time_s);
+  if (!std::isnan(o.seed_success_t_s)) {
+    j["seed_success"] = {{"t_s", r6(o.seed_success_t_s)}, {"z_err_m", r6(o.seed_success_z_err_m)}, {"x_m", r6(o.seed_success_x_m)}};
+  }
   return j;
 }
 
@@ -153,8 +159,14 @@ int run_one(const RunOptions& opt) {
     std::cerr << "dock-sim run: unknown controller '" << ctl << "' (seed000, seed004, seed003, smooth)\n";
     return 2;
   }
-  const std::uint64_t seed = opt.seed >= 0 ? static_cast<std::uint64_t>(opt.seed) : sc.seed;
-  const docksim::SimRun r = docksim::run_docking(sc, ctl, seed);
+  const std::uint64_t seed = opt.seed_set ? opt.seed : sc.seed;
+  docksim::SimOptions so;
+  docksim::StartPose fixed;
+  if (opt.start.size() == 3) {
+    fixed = docksim::start_from(sc, opt.start[0], opt.start[1] / kRadToDeg, opt.start[2] / kRadToDeg);
+    so.start = &fixed;
+  }
+  const docksim::SimRun r = docksim::run_docking(sc, ctl, seed, so);
   const docksim::SimOutcome& o = r.outcome;
 
   if (opt.json) {
@@ -187,6 +199,14 @@ int run_one(const RunOptions& opt) {
       std::printf("  fault %d %s x%d\n", kv.first, dockcore::to_string(static_cast<dockcore::FaultCode>(kv.first)), kv.second);
     }
   }
+  if (opt.trace) {
+    std::printf("trace: t_s x_m y_m yaw_deg vx_cmd_mps state (true pose, world)\n");
+    for (const auto& s : r.trajectory) {
+      std::printf("  %7.2f %8.4f %8.4f %8.2f %+7.3f %s\n", s.t_s, static_cast<double>(s.pose.x_m),
+                  static_cast<double>(s.pose.y_m), static_cast<double>(s.pose.yaw_rad) * kRadToDeg, s.vx_cmd_mps,
+                  dockcore::to_string(static_cast<dockcore::TaskState>(s.state)));
+    }
+  }
   if (!opt.svg.empty()) draw_run(sc, r, opt.svg);
   return o.charging_confirmed ? 0 : 1;
 }
@@ -196,7 +216,8 @@ struct McOptions {
   std::string scenario;
   int trials = 100;
   std::string controller;  // empty: the scenario's; "all"
-  long long seed = -1;
+  std::uint64_t seed = 0;
+  bool seed_set = false;
   int jobs = 1;
   bool json = false;
   std::string svg;
@@ -220,6 +241,7 @@ struct Summary {
   double min_clearance_m = std::numeric_limits<double>::infinity();
   std::map<int, int> faults;
   int timeouts = 0;
+  std::vector<double> seed_t, seed_z, seed_x;  // seed003's own success test
 };
 
 Summary summarise(const std::string& name, const std::vector<docksim::SimRun>& runs) {
@@ -243,6 +265,11 @@ Summary summarise(const std::string& name, const std::vector<docksim::SimRun>& r
     s.min_clearance_m = std::min(s.min_clearance_m, o.min_clearance_m);
     for (const auto& kv : o.faults) s.faults[kv.first] += kv.second;
     s.timeouts += o.timed_out;
+    if (!std::isnan(o.seed_success_t_s)) {
+      s.seed_t.push_back(o.seed_success_t_s);
+      s.seed_z.push_back(o.seed_success_z_err_m);
+      s.seed_x.push_back(o.seed_success_x_m);
+    }
   }
   return s;
 }
@@ -272,6 +299,29 @@ void print_table(const std::vector<Summary>& sums) {
                 triple(s.lat_mm, "%.1f").c_str(), triple(s.lon_mm, "%.1f").c_str(), triple(s.yaw_deg, "%.2f").c_str(),
                 t.c_str(), fmt("%.2f", pct(s.path_m, 50)).c_str(), rev.c_str(), inp.c_str(), clr.c_str(),
                 faults_str(s.faults).c_str());
+  }
+  for (const auto& s : sums) {
+    if (s.seed_t.empty()) continue;
+    double mt = 0, mz = 0, mx = 0, sz = 0, sx = 0;
+    const double n = static_cast<double>(s.seed_t.size());
+    for (std::size_t i = 0; i < s.seed_t.size(); ++i) {
+      mt += s.seed_t[i] / n;
+      mz += s.seed_z[i] / n;
+      mx += s.seed_x[i] / n;
+    }
+    for (std::size_t i = 0; i < s.seed_t.size(); ++i) {
+      sz += (s.seed_z[i] - mz) * (s.seed_z[i] - mz) / n;
+      sx += (s.seed_x[i] - mx) * (s.seed_x[i] - mx) / n;
+    }
+    double az = 0, ax = 0;
+    for (std::size_t i = 0; i < s.seed_t.size(); ++i) {
+      az = std::max(az, std::fabs(s.seed_z[i]));
+      ax = std::max(ax, std::fabs(s.seed_x[i]));
+    }
+    std::printf("%s own success test held in %zu/%d runs: mean time %.1f s; at that moment depth error mean %+.1f cm "
+                "sd %.1f cm max|.| %.1f cm, lateral mean %+.1f cm sd %.1f cm max|.| %.1f cm\n",
+                s.name.c_str(), s.seed_t.size(), s.trials, mt, mz * 100, std::sqrt(sz) * 100, az * 100, mx * 100,
+                std::sqrt(sx) * 100, ax * 100);
   }
   std::printf("errors and times over successful runs; path = median; reversals / in-place turns: total (runs with any);"
               " clearance = minimum over all runs\n");
@@ -353,7 +403,7 @@ int run_mc(const McOptions& opt) {
     std::cerr << "dock-sim montecarlo: --trials and --jobs must be >= 1\n";
     return 2;
   }
-  const std::uint64_t base = opt.seed >= 0 ? static_cast<std::uint64_t>(opt.seed) : sc.seed;
+  const std::uint64_t base = opt.seed_set ? opt.seed : sc.seed;
   const std::size_t n = static_cast<std::size_t>(opt.trials);
   const std::size_t total = n * ctls.size();
   std::vector<docksim::SimRun> runs(total);
@@ -447,10 +497,14 @@ void register_run(CLI::App& app) {
       "bad arguments or a bad scenario file.");
   sub->add_option("scenario", o->scenario, "Scenario TOML file (docs/scenarios.md)")->required();
   sub->add_option("--controller", o->controller, "seed000, seed004, seed003 or smooth (default: the scenario's)");
-  sub->add_option("--seed", o->seed, "Seed: start pose and every noise stream (default: the scenario's)");
+  CLI::Option* seed = sub->add_option("--seed", o->seed, "Seed: start pose and every noise stream (default: the scenario's)");
   sub->add_option("--svg", o->svg, "Write trajectory, robot outline, dock and last scan as SVG to this file");
   sub->add_flag("--json", o->json, "Print one JSON object (outcome and timeline) instead of text");
-  sub->callback([o]() {
+  sub->add_option("--start", o->start, "Fixed start: DISTANCE_M BEARING_DEG HEADING_DEG (default: drawn from the "
+                                      "scenario's envelope with the seed)")->expected(3);
+  sub->add_flag("--trace", o->trace, "Also print the trajectory (every 50 ms: true pose, commanded vx, task state)");
+  sub->callback([o, seed]() {
+    o->seed_set = seed->count() > 0;
     const int rc = run_one(*o);
     if (rc != 0) throw CLI::RuntimeError(rc);
   });
@@ -466,13 +520,14 @@ void register_montecarlo(CLI::App& app) {
   sub->add_option("scenario", o->scenario, "Scenario TOML file (docs/scenarios.md)")->required();
   sub->add_option("--trials", o->trials, "Starts per controller")->capture_default_str();
   sub->add_option("--controller", o->controller, "seed000, seed004, seed003, smooth or all (default: the scenario's)");
-  sub->add_option("--seed", o->seed, "Base seed (default: the scenario's)");
+  CLI::Option* seed = sub->add_option("--seed", o->seed, "Base seed (default: the scenario's)");
   sub->add_option("--jobs", o->jobs, "Worker threads")->capture_default_str();
   sub->add_flag("--json", o->json, "Print JSON (summary and per-run outcomes) instead of the table");
   sub->add_option("--svg", o->svg,
                   "Draw all trajectories and the success/time map over the start envelope (one file per controller: "
                   "NAME-<controller>.svg when several)");
-  sub->callback([o]() {
+  sub->callback([o, seed]() {
+    o->seed_set = seed->count() > 0;
     const int rc = run_mc(*o);
     if (rc != 0) throw CLI::RuntimeError(rc);
   });

@@ -452,6 +452,14 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       }
       if (s.state == dockcore::TaskState::kAlign && s.phase != prev_phase) {
         add(t, TimelineKind::kPhase, s.phase, std::string(ctl->name()) + " " + ctl->phase_name(s.phase));
+        if (controller == "seed003" && s.phase == static_cast<std::uint8_t>(dockcore::Seed003Phase::kSeedSuccess) &&
+            std::isnan(out.seed_success_t_s)) {
+          const Pose2 cam = cs.true_pose.compose(sc.camera.model.mount);
+          const Vec2 q = cam.inverse_transform(target_world);
+          out.seed_success_t_s = t - dock_cmd_t;
+          out.seed_success_z_err_m = dd(q.x()) - dd(sc.seed003.goal_z_m);
+          out.seed_success_x_m = -dd(q.y());
+        }
         prev_phase = s.phase;
       }
       if (s.fault != prev_fault && s.fault != dockcore::FaultCode::kNone) {

@@ -70,6 +70,12 @@ struct SimOutcome {
   bool timed_out = false;          ///< max_time_s reached without charging or a final fault.
   int retries = 0;                 ///< Charging retries used (task manager).
   double end_time_s = 0;
+  /// seed003 only: when its own success test (phase SEED_SUCCESS) first held, from the first dock command, and the
+  /// true camera-to-target errors then: depth along the optical axis minus goal_z_m, and lateral offset (positive =
+  /// target to the right). NaN when it never held. This is what seed 003's published table measures.
+  double seed_success_t_s = std::numeric_limits<double>::quiet_NaN();
+  double seed_success_z_err_m = std::numeric_limits<double>::quiet_NaN();
+  double seed_success_x_m = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct SimRun {
