@@ -18,8 +18,8 @@
 ///
 /// Cost: O(B) to read the scan (B beams, no trig per beam), O(B) segmentation, then per candidate
 /// O(I · W · S) with I <= max_iterations, W beams in the dock's span, S visible profile segments; at most
-/// max_candidates candidates are refined. No heap; the object holds its working buffers (~100 kB with double, so keep
-/// it static or a member, not on a small stack).
+/// max_candidates candidates are refined. No heap; the object holds its working buffers (~290 kB with double,
+/// ~150 kB with float), so keep it static or a member, not on a small stack.
 
 #include <cstddef>
 #include <cstdint>

@@ -9,7 +9,7 @@
 /// - tick(): the filtered dock seen from the current odometry pose, the latest raw detection (for the push test),
 ///   the latest scan and the host's flags go to the TaskManager; its twist and status come back.
 /// The filter is reset when a new dock task starts (the robot may have been carried since the last one).
-/// No heap; the object is large (estimator buffers plus one LaserScan copy, ~0.2 MB with double): keep it static or
+/// No heap; the object is large (estimator buffers plus one LaserScan copy, ~360 kB with double): keep it static or
 /// a member, never on a small stack.
 
 #include <cstdint>
