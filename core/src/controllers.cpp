@@ -408,12 +408,14 @@ const char* SmoothController::phase_name(std::uint8_t phase) const {
     case 1: return "SLOWDOWN";
     case 2: return "CREEP";
     case 3: return "DOCKED";
+    case 4: return "LINEUP";
     default: return "UNKNOWN";
   }
 }
 
 void SmoothController::reset() {
   phase_ = SmoothPhase::kApproach;
+  lineup_ = false;
   stall_s_ = 0;
 }
 
@@ -451,9 +453,27 @@ ControlOutput SmoothController::step(const ControlInput& in) {
   if (r < r_min) r = r_min;
   const Real phi = wrap_angle(kPi + los);
   const Real delta = wrap_angle(robot.yaw_rad + los);
-  const Real kappa = graceful_curvature(r, phi, delta, p_.k_phi, p_.k_delta);
-
   const Real d = pad.x() > 0 ? pad.x() : kZero;  // pads to the contact plane
+  if (p_.lineup_distance_m > 0) {
+    if (pad.x() < p_.lineup_distance_m && std::fabs(robot.y_m) < p_.lineup_engage_lateral_m &&
+        std::fabs(wrap_angle(robot.yaw_rad - kPi)) < p_.lineup_engage_heading_rad) {
+      lineup_ = true;
+    }
+    if (pad.x() > p_.lineup_distance_m + p_.lineup_hysteresis_m) lineup_ = false;
+  } else {
+    lineup_ = false;
+  }
+  Real kappa = 0;
+  if (lineup_) {
+    // Axis tracker. e: heading off the docked heading π (positive = turned left); moving along −x the centre's
+    // lateral y changes as −v·sin e, so the wanted e is +atan(y/L_y); the heading closes on it over L_h of travel.
+    // Linearised in travel s: L_h·y'' + y' + y/L_y = 0 (ζ = ½√(L_y/L_h) ≈ 0.87 with the defaults).
+    const Real e = wrap_angle(robot.yaw_rad - kPi);
+    const Real e_want = clamp_abs(std::atan(robot.y_m / p_.lineup_lateral_m), p_.lineup_max_heading_rad);
+    kappa = clamp_abs(wrap_angle(e_want - e) / p_.lineup_heading_m, p_.lineup_max_curvature_inv_m);
+  } else {
+    kappa = graceful_curvature(r, phi, delta, p_.k_phi, p_.k_delta);
+  }
   Real v = p_.v_max_mps / (kOne + p_.beta * std::pow(std::fabs(kappa), p_.lambda));
   SmoothPhase ph = SmoothPhase::kApproach;
   if (p_.slowdown_radius_m > 0) {
@@ -480,6 +500,7 @@ ControlOutput SmoothController::step(const ControlInput& in) {
     v = p_.w_max_radps / std::fabs(kappa);
     if (v < p_.min_turn_speed_mps) v = p_.min_turn_speed_mps;
   }
+  if (lineup_ && ph != SmoothPhase::kCreep) ph = SmoothPhase::kLineup;
   phase_ = ph;
   ControlOutput o;
   o.phase = static_cast<std::uint8_t>(ph);

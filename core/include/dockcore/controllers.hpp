@@ -240,6 +240,25 @@ struct SmoothParams {
   Real goal_projection_m = static_cast<Real>(0.10);
   /// Smallest forward speed when ω saturates, m/s (keeps the turn an arc: radius ≥ this/ω_max).
   Real min_turn_speed_mps = static_cast<Real>(0.03);
+  /// Line-up: once the pads are this close to the contact plane (m), the graceful law hands over to an axis tracker
+  /// (the graceful goal sits only goal_projection_m behind the pads, so its 1/r turns the estimate's lateral noise
+  /// into heading noise right where the contacts judge the heading). ≤ 0 disables the line-up.
+  Real lineup_distance_m = static_cast<Real>(0.40);
+  /// ... and the robot centre is within this of the axis, m, and its heading within lineup_engage_heading_rad of
+  /// the docked heading (otherwise the graceful law keeps going: it is the one that can swing a far-off robot in).
+  Real lineup_engage_lateral_m = static_cast<Real>(0.05);
+  Real lineup_engage_heading_rad = deg_to_rad(static_cast<Real>(15));
+  /// Leave the line-up again only beyond lineup_distance_m + this, m (hysteresis against estimate jumps).
+  Real lineup_hysteresis_m = static_cast<Real>(0.10);
+  /// Axis tracker: wanted heading offset atan(y / lineup_lateral_m) for a robot-centre lateral offset y, m.
+  Real lineup_lateral_m = static_cast<Real>(0.30);
+  /// Axis tracker: the heading closes its error over this much travel (curvature = error / this), m.
+  Real lineup_heading_m = static_cast<Real>(0.10);
+  /// Axis tracker: largest wanted heading offset from the axis, rad.
+  Real lineup_max_heading_rad = deg_to_rad(static_cast<Real>(20));
+  /// Axis tracker: largest path curvature, 1/m. Keeps both wheels above the drive deadband at creep speed
+  /// (diff drive, 0.30 m track: at 0.03 m/s and 2 1/m the inner wheel still turns at 0.7 of the mean).
+  Real lineup_max_curvature_inv_m = static_cast<Real>(2.0);
 };
 
 enum class SmoothPhase : std::uint8_t {
@@ -247,6 +266,7 @@ enum class SmoothPhase : std::uint8_t {
   kSlowdown = 1,  ///< Inside the slowdown radius / braking profile.
   kCreep = 2,     ///< At the creep floor, waiting for the contacts.
   kDocked = 3,
+  kLineup = 4,    ///< Axis tracker near the dock (speed still from the slowdown / braking / creep profile).
 };
 
 class SmoothController final : public DockingController {
@@ -264,6 +284,7 @@ class SmoothController final : public DockingController {
  private:
   SmoothParams p_;
   SmoothPhase phase_ = SmoothPhase::kApproach;
+  bool lineup_ = false;
   Real stall_s_ = 0;
 };
 
