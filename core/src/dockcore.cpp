@@ -8,6 +8,7 @@ bool Dockcore::configure(const DockProfile& profile, const DockcoreConfig& confi
   tasks_.configure(config.task, config.footprint, profile);
   have_scan_ = false;
   pending_ = DetectionInput{};
+  filter_confirmed_ = false;
   last_estimate_ = DockEstimate{};
   prev_state_ = TaskState::kNotTasking;
   return estimator_.configure(profile, config.estimator);
@@ -31,7 +32,11 @@ const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_
   }
   last_estimate_ = estimator_.estimate(scan, config_.lidar_mount, hint_ptr);
   if (last_estimate_.found) {
-    filter_.update(last_estimate_.pose, last_estimate_.covariance, odom_pose, stamp_us);
+    const FilterUpdate u = filter_.update(last_estimate_.pose, last_estimate_.covariance, odom_pose, stamp_us);
+    // A (re)started filter rests on this one detection, which may be clutter: confirmed once a second detection
+    // agrees with it (is fused).
+    if (u == FilterUpdate::kInitialised || u == FilterUpdate::kReinitialised) filter_confirmed_ = false;
+    if (u == FilterUpdate::kFused) filter_confirmed_ = true;
     pending_.fresh = true;
     pending_.dock_in_robot = last_estimate_.pose;
     pending_.odom_at_scan = odom_pose;
@@ -60,6 +65,7 @@ TickOutput Dockcore::tick(const TickInput& in) {
     t.dock.valid = true;
     t.dock.pose = filter_.dock_in_robot(in.odom_pose, &t.dock.covariance);
     t.dock.stamp_us = filter_.last_update_us();
+    t.dock.confirmed = filter_confirmed_;
   }
   t.detection = pending_;
   pending_.fresh = false;
@@ -67,7 +73,10 @@ TickOutput Dockcore::tick(const TickInput& in) {
   TickOutput out = tasks_.tick(t);
   // A new dock task: forget the old dock (the robot may have been carried since), so the push test and the
   // controller start from this task's own detections.
-  if (out.status.state == TaskState::kGetTaskingCmd && prev_state_ != TaskState::kGetTaskingCmd) filter_.reset();
+  if (out.status.state == TaskState::kGetTaskingCmd && prev_state_ != TaskState::kGetTaskingCmd) {
+    filter_.reset();
+    filter_confirmed_ = false;
+  }
   prev_state_ = out.status.state;
   return out;
 }

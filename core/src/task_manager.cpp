@@ -203,6 +203,7 @@ void TaskManager::fail_attempt(FaultCode final_fault, const TaskInput& in) {
 void TaskManager::run_reach(const TaskInput& in) {
   if (dock_fresh(in)) {
     start_distance_m_ = std::sqrt(in.dock.pose.x_m * in.dock.pose.x_m + in.dock.pose.y_m * in.dock.pose.y_m);
+    deviation_count_ = 0;
     ctrl_->reset();
     enter(TaskState::kAlign, in);
     return;
@@ -233,13 +234,27 @@ void TaskManager::run_reach(const TaskInput& in) {
 void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
   if (in.detection.fresh && in.dock.valid) {
     const Pose2 detected = in.detection.odom_at_scan.compose(in.detection.dock_in_robot);
-    const Pose2 expected = in.odom_pose.compose(in.dock.pose);
+    // An unconfirmed filter rests on one detection: disagreeing with it is no evidence of a push, so only the
+    // distance limit is tested (expected = detected).
+    const Pose2 expected = in.dock.confirmed ? in.odom_pose.compose(in.dock.pose) : detected;
     const Pose2& d = in.detection.dock_in_robot;
     const Real dist = std::sqrt(d.x_m * d.x_m + d.y_m * d.y_m);
     const FaultCode f = check_pose_deviation(detected, expected, dist, start_distance_m_, params_.deviation);
-    if (f != FaultCode::kNone) {
-      raise(f, in);
-      return;
+    if (f == FaultCode::kNone) {
+      deviation_count_ = 0;
+    } else {
+      // A push moves every later detection to the same new place; an outlier is alone. Count only failing
+      // detections that agree with the previous failing one (same tolerances as the push test itself).
+      const bool repeats = deviation_count_ > 0 &&
+          check_pose_deviation(detected, deviation_pose_, static_cast<Real>(0), start_distance_m_,
+                               params_.deviation) ==
+              FaultCode::kNone;
+      deviation_count_ = repeats ? static_cast<std::uint8_t>(deviation_count_ + 1) : static_cast<std::uint8_t>(1);
+      deviation_pose_ = detected;
+      if (deviation_count_ >= params_.deviation.confirm_detections) {
+        raise(f, in);
+        return;
+      }
     }
   }
   ControlInput ci;

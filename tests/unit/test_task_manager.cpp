@@ -74,6 +74,8 @@ struct Sim {
   bool dock_valid = false;
   bool occluded = false;
   bool visible_only_when_turned = false;  // detection only with |yaw - start| > 10°
+  bool dock_confirmed = true;             // DockInput::confirmed
+  std::vector<Pose2> outliers;            // next detections report these dock poses (world frame), in order
   double start_yaw = kPi;
   bool charger_works = true;
   int charger_fails_first = 0;  // contacts that get no current (attempts)
@@ -134,6 +136,10 @@ struct Sim {
         dock_stamp_us = now_us;
         in.detection.fresh = true;
         in.detection.dock_in_robot = world.inverse().compose(dock);
+        if (!outliers.empty()) {
+          in.detection.dock_in_robot = world.inverse().compose(outliers.front());
+          outliers.erase(outliers.begin());
+        }
         in.detection.odom_at_scan = odom;
         in.detection.stamp_us = now_us;
       }
@@ -143,6 +149,7 @@ struct Sim {
     in.dock.valid = dock_valid;
     in.dock.pose = odom.inverse().compose(dock_in_odom);
     in.dock.stamp_us = dock_stamp_us;
+    in.dock.confirmed = dock_confirmed;
     in.odom_pose = odom;
     in.contact = contact;
     const bool current = contact && charge_enable && charger_works && contacts_made > charger_fails_first &&
@@ -298,13 +305,20 @@ TEST(TaskManager, DetectionDuringSwingStartsAlignment) {
   CHECK(s->run_until(TaskState::kFinishTasking, 30));
 }
 
-TEST(TaskManager, PushSidewaysGives178OnTheFirstDetection) {
+TEST(TaskManager, PushSidewaysGives178OnTheSecondDetection) {
   auto s = std::make_unique<Sim>();
   s->command(HostCommandType::kDock);
   CHECK(s->run_until(TaskState::kAlign, 5));
   s->run_for(0.5);
   s->world.y_m += 0.4;  // pushed: odometry does not see it
-  // The next scan tick is the first detection after the push: the fault must appear exactly then.
+  // The first detection after the push is suspect only; the second, agreeing with it, confirms the push (one scan
+  // cycle, 0.1 s, later) and the fault must appear exactly then.
+  while (s->ticks % 5 != 0) {
+    s->step();
+    CHECK(s->out.status.state == TaskState::kAlign);
+  }
+  s->step();
+  CHECK(s->out.status.state == TaskState::kAlign);
   while (s->ticks % 5 != 0) {
     s->step();
     CHECK(s->out.status.state == TaskState::kAlign);
@@ -315,7 +329,68 @@ TEST(TaskManager, PushSidewaysGives178OnTheFirstDetection) {
   CHECK(s->out.cmd.vx_mps == 0 && s->out.cmd.wz_radps == 0);
 }
 
-TEST(TaskManager, TurnedByHandGives179OnTheFirstDetection) {
+TEST(TaskManager, PushGives178OnTheFirstDetectionWhenConfirmIsOne) {
+  auto s = std::make_unique<Sim>();
+  s->params.deviation.confirm_detections = 1;
+  s->tm.configure(s->params, square_footprint(), s->profile);
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(0.5);
+  s->world.y_m += 0.4;
+  while (s->ticks % 5 != 0) s->step();
+  s->step();
+  CHECK(s->out.status.state == TaskState::kFault);
+  LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+}
+
+TEST(TaskManager, SingleOutlierDetectionIsNotAFault) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(0.5);
+  // Clutter taken for the dock once: 0.6 m beside the dock and turned 40° (past both push tolerances).
+  s->outliers.push_back(Pose2{0.1, 0.6, deg_to_rad(40)});
+  for (int i = 0; i < 50; ++i) {
+    s->step();
+    CHECK(s->out.status.state == TaskState::kAlign);
+  }
+  CHECK(s->outliers.empty());
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+}
+
+TEST(TaskManager, TwoDisagreeingOutliersInARowAreNotAFault) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(0.5);
+  // Two wrong detections in a row, 1.2 m apart: they do not agree with each other, so they are not a push.
+  s->outliers.push_back(Pose2{0.1, 0.6, 0});
+  s->outliers.push_back(Pose2{0.1, -0.6, 0});
+  for (int i = 0; i < 50; ++i) {
+    s->step();
+    CHECK(s->out.status.state == TaskState::kAlign);
+  }
+  CHECK(s->outliers.empty());
+}
+
+TEST(TaskManager, UnconfirmedFilterSkipsThePushTest) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(0.5);
+  s->world.y_m += 0.4;          // disagrees with the filter by 0.4 m ...
+  s->dock_confirmed = false;    // ... but the filter rests on one detection: no evidence of a push
+  for (int i = 0; i < 25; ++i) {
+    s->step();
+    CHECK(s->out.status.state == TaskState::kAlign);
+  }
+  s->dock_confirmed = true;     // the same disagreement against a confirmed filter: fault within two scans
+  for (int i = 0; i < 10 && s->out.status.state == TaskState::kAlign; ++i) s->step();
+  CHECK(s->out.status.state == TaskState::kFault);
+  LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+}
+
+TEST(TaskManager, TurnedByHandGives179OnTheSecondDetection) {
   auto s = std::make_unique<Sim>();
   s->command(HostCommandType::kDock);
   CHECK(s->run_until(TaskState::kAlign, 5));
@@ -323,6 +398,9 @@ TEST(TaskManager, TurnedByHandGives179OnTheFirstDetection) {
   // Turn about the dock origin by 35°: position relative to the dock keeps its distance, so only the yaw test fires.
   const Pose2 turn{0, 0, deg_to_rad(35)};
   s->world = turn.compose(s->world);
+  while (s->ticks % 5 != 0) s->step();
+  s->step();
+  CHECK(s->out.status.state == TaskState::kAlign);
   while (s->ticks % 5 != 0) s->step();
   s->step();
   CHECK(s->out.status.state == TaskState::kFault);
@@ -348,6 +426,10 @@ TEST(TaskManager, FarAwayDistanceTolerance178) {
   const double dx = 2.05 - s->world.x_m;
   s->world.x_m += dx;
   s->odom = s->odom.compose(Pose2{-dx, 0, 0});
+  // Two detections: one far detection alone could be clutter (DeviationParams::confirm_detections).
+  while (s->ticks % 5 != 0) s->step();
+  s->step();
+  CHECK(s->out.status.state == TaskState::kAlign);
   while (s->ticks % 5 != 0) s->step();
   s->step();
   CHECK(s->out.status.state == TaskState::kFault);
@@ -364,6 +446,10 @@ TEST(TaskManager, StartingFartherThanTheToleranceIsAllowedButNotDrivingAway) {
   const double dx = 2.75 - s->world.x_m;  // 0.35 m farther than at the start: beyond the 0.3 m growth margin
   s->world.x_m += dx;
   s->odom = s->odom.compose(Pose2{-dx, 0, 0});
+  // Two detections: one far detection alone could be clutter (DeviationParams::confirm_detections).
+  while (s->ticks % 5 != 0) s->step();
+  s->step();
+  CHECK(s->out.status.state == TaskState::kAlign);
   while (s->ticks % 5 != 0) s->step();
   s->step();
   LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
@@ -733,14 +819,16 @@ TEST(Dockcore, DocksWithTheRealEstimatorAndFilter) {
          sizeof(TaskManager), sizeof(DockPoseEstimator), sizeof(LaserScan));
 }
 
-TEST(Dockcore, PushIsAFaultOnTheFirstScanAfterIt) {
+TEST(Dockcore, PushIsAFaultOnTheSecondScanAfterIt) {
   FacadeSim f;
   f.step(HostCommand{HostCommandType::kDock, 0});
   CHECK(f.run_until(TaskState::kAlign, 5));
   for (int i = 0; i < 25; ++i) f.step();
   f.w.world.y_m += 0.4;
   while (f.w.ticks % 5 != 0) f.step();
-  const TickOutput o = f.step();  // the scan after the push is processed in this tick
+  CHECK(f.step().status.state == TaskState::kAlign);  // first scan after the push: suspect only
+  while (f.w.ticks % 5 != 0) f.step();
+  const TickOutput o = f.step();  // the second scan after the push confirms it
   CHECK(o.status.state == TaskState::kFault);
   LONGS_EQUAL(178, static_cast<int>(o.status.fault));
 }

@@ -7,7 +7,8 @@
 ///   the filter has no dock or the hint fails), then the filter update. The scan is copied so the tick can run the
 ///   obstacle check and give controllers (seed003) the latest ranges.
 /// - tick(): the filtered dock seen from the current odometry pose, the latest raw detection (for the push test),
-///   the latest scan and the host's flags go to the TaskManager; its twist and status come back.
+///   the latest scan and the host's flags go to the TaskManager; its twist and status come back. The push test
+///   trusts the filter only once it has fused a second, agreeing detection since it (re)started (DockInput::confirmed).
 /// The filter is reset when a new dock task starts (the robot may have been carried since the last one).
 /// No heap; the object is large (estimator buffers plus one LaserScan copy, ~360 kB with double): keep it static or
 /// a member, never on a small stack.
@@ -82,6 +83,7 @@ class Dockcore {
   DockEstimate last_estimate_{};
   DetectionInput pending_{};
   TaskState prev_state_ = TaskState::kNotTasking;
+  bool filter_confirmed_ = false;  ///< The filter fused a detection since its last (re)initialisation.
 };
 
 }  // namespace dockcore

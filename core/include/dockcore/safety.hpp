@@ -122,6 +122,11 @@ struct DeviationParams {
   /// Seed check_angle_error_tolerance (30°): the dock's yaw seen by the lidar may differ at most this much from
   /// where odometry expects it (the robot turned without its wheels seeing it) (rad).
   Real check_angle_error_tolerance_rad = deg_to_rad(static_cast<Real>(30));
+  /// Consecutive failing detections that raise the fault, each within the push tolerances of the previous one
+  /// (mapped into the odometry frame). A pushed robot's detections all agree with each other; a single wrong
+  /// detection (clutter taken for the dock) does not repeat at the same place. 1: fault on the first. Keep it below
+  /// DockFilterParams::reinit_after, or the filter adopts the pushed pose before the test fires.
+  std::uint8_t confirm_detections = 2;
 };
 
 /// Pose deviation test on one fresh detection. `detected_in_odom`: the detection mapped through the odometry pose at

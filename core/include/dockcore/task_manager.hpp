@@ -118,6 +118,10 @@ struct DockInput {
   Pose2 pose{};                   ///< Dock in the robot frame now.
   Mat3 covariance = Mat3::Zero(); ///< Robot-frame covariance of (x, y, yaw).
   std::uint64_t stamp_us = 0;     ///< Time of the last detection fused into it.
+  /// The estimate rests on at least two agreeing detections since the filter's last (re)initialisation. When false
+  /// a disagreeing detection says only that one of two detections is wrong, not that the robot was pushed: the
+  /// push test skips it (the filter's gate sorts it out).
+  bool confirmed = true;
 };
 
 /// The raw detection of the scan processed since the previous tick, if any (for the push test).
@@ -234,6 +238,8 @@ class TaskManager {
   bool lost_ = false;
   std::uint64_t lost_since_us_ = 0;
   Real start_distance_m_ = 0;
+  std::uint8_t deviation_count_ = 0;  ///< Consecutive detections failing the push test, each agreeing with the last.
+  Pose2 deviation_pose_{};            ///< The last failing detection in the odometry frame.
   // Obstacles.
   bool blocked_ = false;
   std::uint64_t blocked_since_us_ = 0;
