@@ -465,12 +465,22 @@ ControlOutput SmoothController::step(const ControlInput& in) {
   }
   Real kappa = 0;
   if (lineup_) {
-    // Axis tracker. e: heading off the docked heading π (positive = turned left); moving along −x the centre's
-    // lateral y changes as −v·sin e, so the wanted e is +atan(y/L_y); the heading closes on it over L_h of travel.
-    // Linearised in travel s: L_h·y'' + y' + y/L_y = 0 (ζ = ½√(L_y/L_h) ≈ 0.87 with the defaults).
+    // Axis tracker: the cubic y(s) from the centre's lateral offset and slope now to y = 0 with zero slope after a
+    // horizon D of travel along −x (s = −x; dy/ds = −tan e, e = heading off the docked heading π, positive = turned
+    // left); the curvature to command is the cubic's at s = 0. D = pads' distance − margin (aligned just before the
+    // contacts), but at least lineup_horizon_min_m: that floor bounds the noise gain (6/D² per m of lateral,
+    // 4/D per rad of heading) in the last centimetres, where the heading is held on the estimated axis.
+    // The lateral term has its own, longer floor: near the contacts the heading matters more (±2° vs ±10 mm at the
+    // pads, and a heading error moves the pads sideways by reach·sin e), and the estimate's lateral noise would
+    // otherwise become heading noise there.
     const Real e = wrap_angle(robot.yaw_rad - kPi);
-    const Real e_want = clamp_abs(std::atan(robot.y_m / p_.lineup_lateral_m), p_.lineup_max_heading_rad);
-    kappa = clamp_abs(wrap_angle(e_want - e) / p_.lineup_heading_m, p_.lineup_max_curvature_inv_m);
+    const Real left = d - p_.lineup_margin_m;
+    const Real dh = left > p_.lineup_horizon_min_m ? left : p_.lineup_horizon_min_m;
+    const Real dl = left > p_.lineup_lateral_horizon_min_m ? left : p_.lineup_lateral_horizon_min_m;
+    const Real slope = -std::tan(e);
+    const Real k = static_cast<Real>(6) * robot.y_m / (dl * dl) + static_cast<Real>(4) * slope / dh;
+    const Real s2 = kOne + slope * slope;
+    kappa = clamp_abs(k / (s2 * std::sqrt(s2)), p_.lineup_max_curvature_inv_m);
   } else {
     kappa = graceful_curvature(r, phi, delta, p_.k_phi, p_.k_delta);
   }

@@ -250,12 +250,13 @@ struct SmoothParams {
   Real lineup_engage_heading_rad = deg_to_rad(static_cast<Real>(15));
   /// Leave the line-up again only beyond lineup_distance_m + this, m (hysteresis against estimate jumps).
   Real lineup_hysteresis_m = static_cast<Real>(0.10);
-  /// Axis tracker: wanted heading offset atan(y / lineup_lateral_m) for a robot-centre lateral offset y, m.
-  Real lineup_lateral_m = static_cast<Real>(0.30);
-  /// Axis tracker: the heading closes its error over this much travel (curvature = error / this), m.
-  Real lineup_heading_m = static_cast<Real>(0.10);
-  /// Axis tracker: largest wanted heading offset from the axis, rad.
-  Real lineup_max_heading_rad = deg_to_rad(static_cast<Real>(20));
+  /// Axis tracker: the planned path meets the axis with zero heading error this far before the contact plane, m.
+  Real lineup_margin_m = static_cast<Real>(0.03);
+  /// Axis tracker: shortest planning horizon, m (bounds the noise gain on the estimate near the contacts).
+  Real lineup_horizon_min_m = static_cast<Real>(0.10);
+  /// Axis tracker: shortest horizon for the lateral term, m (≥ lineup_horizon_min_m: the heading is held harder
+  /// than the lateral offset near the contacts).
+  Real lineup_lateral_horizon_min_m = static_cast<Real>(0.30);
   /// Axis tracker: largest path curvature, 1/m. Keeps both wheels above the drive deadband at creep speed
   /// (diff drive, 0.30 m track: at 0.03 m/s and 2 1/m the inner wheel still turns at 0.7 of the mean).
   Real lineup_max_curvature_inv_m = static_cast<Real>(2.0);
