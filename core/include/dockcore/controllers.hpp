@@ -257,9 +257,9 @@ struct SmoothParams {
   /// Axis tracker: shortest horizon for the lateral term, m (≥ lineup_horizon_min_m: the heading is held harder
   /// than the lateral offset near the contacts).
   Real lineup_lateral_horizon_min_m = static_cast<Real>(0.30);
-  /// Axis tracker: largest path curvature, 1/m. Keeps both wheels above the drive deadband at creep speed
-  /// (diff drive, 0.30 m track: at 0.03 m/s and 2 1/m the inner wheel still turns at 0.7 of the mean).
-  Real lineup_max_curvature_inv_m = static_cast<Real>(2.0);
+  /// Axis tracker: largest path curvature, 1/m. Keeps both wheels above the drive deadband at creep speed (diff drive,
+  /// 0.30 m track, 0.05 m wheels: at 0.03 m/s and 3 1/m the inner wheel turns at 0.33 rad/s, above the 0.3 deadband).
+  Real lineup_max_curvature_inv_m = static_cast<Real>(3.0);
 };
 
 enum class SmoothPhase : std::uint8_t {
