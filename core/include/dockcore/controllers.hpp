@@ -246,8 +246,8 @@ struct SmoothParams {
   Real lineup_distance_m = static_cast<Real>(0.40);
   /// ... and the robot centre is within this of the axis, m, and its heading within lineup_engage_heading_rad of
   /// the docked heading (otherwise the graceful law keeps going: it is the one that can swing a far-off robot in).
-  Real lineup_engage_lateral_m = static_cast<Real>(0.05);
-  Real lineup_engage_heading_rad = deg_to_rad(static_cast<Real>(15));
+  Real lineup_engage_lateral_m = static_cast<Real>(0.03);
+  Real lineup_engage_heading_rad = deg_to_rad(static_cast<Real>(10));
   /// Leave the line-up again only beyond lineup_distance_m + this, m (hysteresis against estimate jumps).
   Real lineup_hysteresis_m = static_cast<Real>(0.10);
   /// Axis tracker: the planned path meets the axis with zero heading error this far before the contact plane, m.
