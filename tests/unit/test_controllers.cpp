@@ -361,6 +361,48 @@ TEST(Controllers, GracefulCurvatureSigns) {
                 1e-6);
 }
 
+// smooth's LINEUP axis tracker near the dock: the commanded curvature w/v is the cubic's from the pose to the axis
+// (y = 0, heading π) after the remaining travel, with the horizon floors of SmoothParams (0.10 m heading, 0.30 m
+// lateral, 0.03 m margin); far off the axis the graceful law keeps control.
+TEST(Controllers, SmoothLineupCurvature) {
+  ControlInput in;
+  in.dt_s = static_cast<Real>(kCtlDt);
+  in.dock_valid = true;
+  Pose2 robot;  // robot centre in the dock frame
+  SmoothController d;
+  // 10 mm left of the axis (dock frame y > 0 = the robot's right when facing the dock), aligned, pads 0.20 m out:
+  // left = 0.17 m, lateral horizon floored at 0.30 → κ = 6·0.01/0.30² = 0.667 1/m, a left turn (w > 0).
+  robot.x_m = static_cast<Real>(kPadReach + 0.20);
+  robot.y_m = static_cast<Real>(0.01);
+  robot.yaw_rad = static_cast<Real>(kPiD);
+  in.dock_in_robot = robot.inverse();
+  ControlOutput o = d.step(in);
+  CHECK_EQUAL(static_cast<int>(SmoothPhase::kLineup), static_cast<int>(o.phase));
+  CHECK(o.cmd.vx_mps > 0);
+  DOUBLES_EQUAL(6 * 0.01 / (0.30 * 0.30), o.cmd.wz_radps / o.cmd.vx_mps, 1e-4);
+  // On the axis, turned 0.02 rad left, pads 0.05 m out: heading horizon floored at 0.10 m →
+  // y'' = −4·tan 0.02/0.10 along the axis, curvature y''/(1 + tan² 0.02)^1.5 = −0.7996 1/m (turn right, back onto the
+  // axis heading).
+  d.reset();
+  robot.x_m = static_cast<Real>(kPadReach + 0.05);
+  robot.y_m = 0;
+  robot.yaw_rad = static_cast<Real>(wrapd(kPiD + 0.02));
+  in.dock_in_robot = robot.inverse();
+  o = d.step(in);
+  CHECK_EQUAL(static_cast<int>(SmoothPhase::kLineup), static_cast<int>(o.phase));
+  const double t2 = std::tan(0.02);
+  DOUBLES_EQUAL(-4 * t2 / 0.10 / std::pow(1 + t2 * t2, 1.5), o.cmd.wz_radps / o.cmd.vx_mps, 1e-4);
+  // 10 cm off the axis at the same distance: not lined up, so the graceful law (not LINEUP) steers.
+  d.reset();
+  robot.x_m = static_cast<Real>(kPadReach + 0.20);
+  robot.y_m = static_cast<Real>(0.10);
+  robot.yaw_rad = static_cast<Real>(kPiD);
+  in.dock_in_robot = robot.inverse();
+  o = d.step(in);
+  CHECK(o.phase != static_cast<std::uint8_t>(SmoothPhase::kLineup));
+  STRCMP_EQUAL("LINEUP", d.phase_name(static_cast<std::uint8_t>(SmoothPhase::kLineup)));
+}
+
 TEST(Controllers, LostTargetGivesZeroTwist) {
   Seed000Controller a;
   Seed004Controller b;
