@@ -224,7 +224,8 @@ class Seed003Controller final : public DockingController {
 /// Never commands v ≤ 0 while running: one forward motion, no reversals, no in-place rotation (v is floored at
 /// min_turn_speed_mps when ω saturates). vy is always 0: the same law serves mecanum drives (a vy assist on the pads'
 /// lateral error was tried and destabilised the heading loop, see docs/controllers.md). backwards = true docks with
-/// rear pads: the law runs on the reversed robot frame and v is negated.
+/// rear pads: the law runs on the reversed robot frame and v is negated. In the last lineup_distance_m, once near the
+/// axis, LINEUP replaces the graceful curvature with an axis tracker (see the lineup_* fields and docs/controllers.md).
 struct SmoothParams {
   DockingCommonParams common{};
   bool backwards = false;                          ///< Pads at the rear (body x = −pad_reach_m).
