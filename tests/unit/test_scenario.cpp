@@ -208,3 +208,11 @@ TEST(Scenario, ShippedFilesLoad) {
     CHECK_EQUAL(0, e.line());
   }
 }
+
+TEST(Scenario, SmoothLineupParametersAreSettable) {
+  const docksim::Scenario sc = docksim::parse_scenario_toml(
+      "[controller]\nname = \"smooth\"\n[controller.smooth]\nlineup_distance_m = 0.35\nlineup_max_curvature_inv_m = 2.5\n",
+      "lineup.toml");
+  DOUBLES_EQUAL(0.35, sc.smooth.lineup_distance_m, 1e-12);
+  DOUBLES_EQUAL(2.5, sc.smooth.lineup_max_curvature_inv_m, 1e-12);
+}

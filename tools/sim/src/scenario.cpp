@@ -597,7 +597,12 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
           {"k_phi", &c.k_phi}, {"k_delta", &c.k_delta}, {"beta", &c.beta}, {"lambda", &c.lambda},
           {"v_max_mps", &c.v_max_mps}, {"w_max_radps", &c.w_max_radps}, {"slowdown_radius_m", &c.slowdown_radius_m},
           {"max_decel_mps2", &c.max_decel_mps2}, {"goal_projection_m", &c.goal_projection_m},
-          {"min_turn_speed_mps", &c.min_turn_speed_mps}};
+          {"min_turn_speed_mps", &c.min_turn_speed_mps}, {"lineup_distance_m", &c.lineup_distance_m},
+          {"lineup_engage_lateral_m", &c.lineup_engage_lateral_m},
+          {"lineup_engage_heading_rad", &c.lineup_engage_heading_rad}, {"lineup_hysteresis_m", &c.lineup_hysteresis_m},
+          {"lineup_margin_m", &c.lineup_margin_m}, {"lineup_horizon_min_m", &c.lineup_horizon_min_m},
+          {"lineup_lateral_horizon_min_m", &c.lineup_lateral_horizon_min_m},
+          {"lineup_max_curvature_inv_m", &c.lineup_max_curvature_inv_m}};
       for (const auto& r : reals) s.emplace_back(r.first, p.real(r.second, 0, 1e4));
       return s;
     }));
