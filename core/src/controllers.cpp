@@ -61,6 +61,17 @@ bool finite_pose(const Pose2& p) {
   return std::isfinite(p.x_m) && std::isfinite(p.y_m) && std::isfinite(p.yaw_rad);
 }
 
+// The checks every controller makes before its own law, in this order: contact ends the run (arrived, sticky), a
+// stall that timed out stays failed, and a missing or non-finite estimate is "lost" when the controller needs one.
+// kRunning means carry on.
+ControlStatus common_guard(const ControlInput& in, bool docked, Real stall_s, const DockingCommonParams& c,
+                           bool needs_dock) {
+  if (docked || in.contact) return ControlStatus::kArrived;
+  if (stall_s >= c.stall_timeout_s) return ControlStatus::kFailed;
+  if (needs_dock && (!in.dock_valid || !finite_pose(in.dock_in_robot))) return ControlStatus::kLost;
+  return ControlStatus::kRunning;
+}
+
 Real positive_dt(const ControlInput& in) { return (in.dt_s > 0 && std::isfinite(in.dt_s)) ? in.dt_s : kZero; }
 
 }  // namespace
@@ -83,14 +94,9 @@ void Seed000Controller::reset() {
 
 ControlOutput Seed000Controller::step(const ControlInput& in) {
   const DockingCommonParams& c = p_.common;
-  if (phase_ == Seed000Phase::kDocked || in.contact) {
-    phase_ = Seed000Phase::kDocked;
-    return stopped(ControlStatus::kArrived, static_cast<std::uint8_t>(phase_));
-  }
-  if (stall_s_ >= c.stall_timeout_s) return stopped(ControlStatus::kFailed, static_cast<std::uint8_t>(phase_));
-  if (!in.dock_valid || !finite_pose(in.dock_in_robot)) {
-    return stopped(ControlStatus::kLost, static_cast<std::uint8_t>(phase_));
-  }
+  const ControlStatus guard = common_guard(in, phase_ == Seed000Phase::kDocked, stall_s_, c, true);
+  if (guard == ControlStatus::kArrived) phase_ = Seed000Phase::kDocked;
+  if (guard != ControlStatus::kRunning) return stopped(guard, static_cast<std::uint8_t>(phase_));
   const DockView dv = view_of(in, c.pad_reach_m);
   if (stalled(c, dv.pad.x(), positive_dt(in), &stall_s_)) {
     return stopped(ControlStatus::kFailed, static_cast<std::uint8_t>(phase_));
@@ -152,14 +158,9 @@ Real Seed004Controller::drive_speed(Real err_m, Real max_mps) const {
 
 ControlOutput Seed004Controller::step(const ControlInput& in) {
   const DockingCommonParams& c = p_.common;
-  if (phase_ == Seed004Phase::kDocked || in.contact) {
-    phase_ = Seed004Phase::kDocked;
-    return stopped(ControlStatus::kArrived, static_cast<std::uint8_t>(phase_));
-  }
-  if (stall_s_ >= c.stall_timeout_s) return stopped(ControlStatus::kFailed, static_cast<std::uint8_t>(phase_));
-  if (!in.dock_valid || !finite_pose(in.dock_in_robot)) {
-    return stopped(ControlStatus::kLost, static_cast<std::uint8_t>(phase_));
-  }
+  const ControlStatus guard = common_guard(in, phase_ == Seed004Phase::kDocked, stall_s_, c, true);
+  if (guard == ControlStatus::kArrived) phase_ = Seed004Phase::kDocked;
+  if (guard != ControlStatus::kRunning) return stopped(guard, static_cast<std::uint8_t>(phase_));
   const DockView dv = view_of(in, c.pad_reach_m);
   if (stalled(c, dv.pad.x(), positive_dt(in), &stall_s_)) {
     return stopped(ControlStatus::kFailed, static_cast<std::uint8_t>(phase_));
@@ -296,11 +297,10 @@ bool Seed003Controller::lidar_range(const ControlInput& in, Real u_px, Real* z_m
 
 ControlOutput Seed003Controller::step(const ControlInput& in) {
   const DockingCommonParams& c = p_.common;
-  if (phase_ == Seed003Phase::kDocked || in.contact) {
-    phase_ = Seed003Phase::kDocked;
-    return stopped(ControlStatus::kArrived, static_cast<std::uint8_t>(phase_));
-  }
-  if (stall_s_ >= c.stall_timeout_s) return stopped(ControlStatus::kFailed, static_cast<std::uint8_t>(phase_));
+  // Seed 003 steers on the camera target, so a missing dock estimate is not "lost" here.
+  const ControlStatus guard = common_guard(in, phase_ == Seed003Phase::kDocked, stall_s_, c, false);
+  if (guard == ControlStatus::kArrived) phase_ = Seed003Phase::kDocked;
+  if (guard != ControlStatus::kRunning) return stopped(guard, static_cast<std::uint8_t>(phase_));
   const Real dt = positive_dt(in);
   const Real cx = p_.camera.cx_px;
   const bool fresh = in.camera.valid && std::isfinite(in.camera.u_px) && in.camera.stamp_us <= in.now_us &&
@@ -428,14 +428,9 @@ Real SmoothController::graceful_curvature(Real r_m, Real phi_rad, Real delta_rad
 
 ControlOutput SmoothController::step(const ControlInput& in) {
   const DockingCommonParams& c = p_.common;
-  if (phase_ == SmoothPhase::kDocked || in.contact) {
-    phase_ = SmoothPhase::kDocked;
-    return stopped(ControlStatus::kArrived, static_cast<std::uint8_t>(phase_));
-  }
-  if (stall_s_ >= c.stall_timeout_s) return stopped(ControlStatus::kFailed, static_cast<std::uint8_t>(phase_));
-  if (!in.dock_valid || !finite_pose(in.dock_in_robot)) {
-    return stopped(ControlStatus::kLost, static_cast<std::uint8_t>(phase_));
-  }
+  const ControlStatus guard = common_guard(in, phase_ == SmoothPhase::kDocked, stall_s_, c, true);
+  if (guard == ControlStatus::kArrived) phase_ = SmoothPhase::kDocked;
+  if (guard != ControlStatus::kRunning) return stopped(guard, static_cast<std::uint8_t>(phase_));
   // The law runs on the docking frame: the real body frame, or for rear pads the body frame turned by π.
   Pose2 robot = in.dock_in_robot.inverse();
   if (p_.backwards) robot.yaw_rad = wrap_angle(robot.yaw_rad + kPi);
