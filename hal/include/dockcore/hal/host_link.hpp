@@ -21,6 +21,7 @@ struct StatusMessage {
   std::uint8_t align_phase = 0;
   std::uint16_t fault_code = 0;
   std::uint8_t retries = 0;
+  std::uint8_t last_result = 0;  ///< CommandResult of the last host command (CAN DockStatus.LastResult).
   bool dock_valid = false;
   Pose2 dock_in_robot{};
   std::uint64_t stamp_us = 0;
