@@ -1,0 +1,593 @@
+#include "config.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <utility>
+
+#include <toml++/toml.h>
+
+namespace dockd {
+
+using dockcore::Real;
+using dockcore::Vec2;
+
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+using Handler = std::function<void(const toml::node&)>;
+using Handlers = std::vector<std::pair<std::string, Handler>>;
+
+const char* type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date/time";
+  }
+}
+
+std::string dir_of(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+}
+
+/// The same error discipline as the scenario parser (tools/sim/src/scenario.cpp): every key dispatched to a
+/// handler, unknown keys and bad values reported at their TOML source position.
+class Parser {
+ public:
+  explicit Parser(std::string source) : src_(std::move(source)) {}
+
+  [[noreturn]] void fail(const toml::source_region& where, const std::string& what) const {
+    const int line = static_cast<int>(where.begin.line);
+    const int col = static_cast<int>(where.begin.column);
+    throw ConfigError(src_ + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " + what, line, col);
+  }
+
+  void each(const toml::table& t, const std::string& path, const Handlers& hs) const {
+    for (auto&& [key, value] : t) {
+      const std::string k(key.str());
+      const Handler* h = nullptr;
+      for (const auto& p : hs) {
+        if (p.first == k) h = &p.second;
+      }
+      if (h == nullptr) {
+        std::string expected;
+        for (const auto& p : hs) expected += (expected.empty() ? "" : ", ") + p.first;
+        fail(key.source(), "unknown key '" + path + k + "' (expected " + expected + ")");
+      }
+      key_ = path + k;
+      (*h)(value);
+    }
+  }
+
+  const toml::table& table(const toml::node& n) const {
+    const toml::table* t = n.as_table();
+    if (t == nullptr) fail(n.source(), key_ + " must be a table, not " + type_name(n));
+    return *t;
+  }
+
+  double number(const toml::node& n, double lo, double hi) const {
+    double v = 0;
+    if (const auto* f = n.as_floating_point()) {
+      v = f->get();
+    } else if (const auto* i = n.as_integer()) {
+      v = static_cast<double>(i->get());
+    } else {
+      fail(n.source(), key_ + " must be a number, not " + type_name(n));
+    }
+    if (!std::isfinite(v)) fail(n.source(), key_ + " is not finite");
+    if (v < lo || v > hi) {
+      std::ostringstream s;
+      s << key_ << " = " << v << " is out of range [" << lo << ", " << hi << "]";
+      fail(n.source(), s.str());
+    }
+    return v;
+  }
+
+  std::int64_t integer(const toml::node& n, std::int64_t lo, std::int64_t hi) const {
+    const auto* i = n.as_integer();
+    if (i == nullptr) fail(n.source(), key_ + " must be an integer, not " + type_name(n));
+    const std::int64_t v = i->get();
+    if (v < lo || v > hi) {
+      fail(n.source(), key_ + " = " + std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " +
+                           std::to_string(hi) + "]");
+    }
+    return v;
+  }
+
+  bool boolean(const toml::node& n) const {
+    const auto* b = n.as_boolean();
+    if (b == nullptr) fail(n.source(), key_ + " must be true or false, not " + type_name(n));
+    return b->get();
+  }
+
+  std::string string(const toml::node& n) const {
+    const auto* s = n.as_string();
+    if (s == nullptr) fail(n.source(), key_ + " must be a string, not " + type_name(n));
+    return s->get();
+  }
+
+  std::string choice(const toml::node& n, const std::vector<std::string>& options) const {
+    const std::string s = string(n);
+    if (std::find(options.begin(), options.end(), s) == options.end()) {
+      std::string all;
+      for (const auto& o : options) all += (all.empty() ? "" : ", ") + o;
+      fail(n.source(), key_ + " = \"" + s + "\" is not one of " + all);
+    }
+    return s;
+  }
+
+  Handler real(Real* out, double lo, double hi) const {
+    return [this, out, lo, hi](const toml::node& n) { *out = static_cast<Real>(number(n, lo, hi)); };
+  }
+  Handler real_deg(Real* out_rad, double lo_deg, double hi_deg) const {
+    return [this, out_rad, lo_deg, hi_deg](const toml::node& n) {
+      *out_rad = static_cast<Real>(number(n, lo_deg, hi_deg) * kDeg);
+    };
+  }
+  Handler num(double* out, double lo, double hi) const {
+    return [this, out, lo, hi](const toml::node& n) { *out = number(n, lo, hi); };
+  }
+  template <typename T>
+  Handler integ(T* out, std::int64_t lo, std::int64_t hi) const {
+    return [this, out, lo, hi](const toml::node& n) { *out = static_cast<T>(integer(n, lo, hi)); };
+  }
+  Handler flag(bool* out) const {
+    return [this, out](const toml::node& n) { *out = boolean(n); };
+  }
+  Handler str(std::string* out) const {
+    return [this, out](const toml::node& n) { *out = string(n); };
+  }
+  Handler sub(const std::string& path, std::function<Handlers()> make) const {
+    return [this, path, make](const toml::node& n) { each(table(n), path, make()); };
+  }
+  const std::string& key() const { return key_; }
+
+ private:
+  std::string src_;
+  mutable std::string key_;
+};
+
+/// A profile file: name (optional), contact_offset_m (optional), points = [[x, y], ...] (docs/docks.md).
+dockcore::DockProfile load_profile(const Parser& p, const toml::node& at, const std::string& path) {
+  toml::table t;
+  try {
+    t = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream s;
+    s << "profile file " << path << ":" << e.source().begin.line << ":" << e.source().begin.column << ": "
+      << e.description();
+    p.fail(at.source(), s.str());
+  }
+  std::vector<Vec2> pts;
+  double offset = 0;
+  std::string name = "custom";
+  for (auto&& [k, v] : t) {
+    const std::string key(k.str());
+    if (key == "name" && v.is_string()) {
+      name = v.as_string()->get();
+    } else if (key == "contact_offset_m" && (v.is_floating_point() || v.is_integer())) {
+      offset = v.is_integer() ? static_cast<double>(v.as_integer()->get()) : v.as_floating_point()->get();
+    } else if (key == "points" && v.is_array()) {
+      for (const toml::node& e : *v.as_array()) {
+        const toml::array* a = e.as_array();
+        if (a == nullptr || a->size() != 2) p.fail(at.source(), "profile file " + path + ": points must be [x, y] pairs");
+        double xy[2];
+        for (int i = 0; i < 2; ++i) {
+          const toml::node& c = (*a)[static_cast<std::size_t>(i)];
+          if (c.is_floating_point()) {
+            xy[i] = c.as_floating_point()->get();
+          } else if (c.is_integer()) {
+            xy[i] = static_cast<double>(c.as_integer()->get());
+          } else {
+            p.fail(at.source(), "profile file " + path + ": points must be numbers");
+          }
+        }
+        pts.emplace_back(static_cast<Real>(xy[0]), static_cast<Real>(xy[1]));
+      }
+    } else {
+      p.fail(at.source(), "profile file " + path + ": unknown or mistyped key '" + key + "'");
+    }
+  }
+  if (name.size() > 23) name.resize(23);
+  dockcore::DockProfile prof;
+  const dockcore::ProfileError e =
+      dockcore::make_profile(pts.data(), pts.size(), static_cast<Real>(offset), name.c_str(), prof);
+  if (e != dockcore::ProfileError::kOk) p.fail(at.source(), "profile file " + path + ": " + dockcore::to_string(e));
+  return prof;
+}
+
+}  // namespace
+
+bool parse_log_level(const std::string& s, LogLevel& out) {
+  if (s == "error") out = LogLevel::kError;
+  else if (s == "warn") out = LogLevel::kWarn;
+  else if (s == "info") out = LogLevel::kInfo;
+  else if (s == "debug") out = LogLevel::kDebug;
+  else return false;
+  return true;
+}
+
+const DockEntry* DockdConfig::find_dock(std::uint16_t id) const {
+  for (const DockEntry& d : docks) {
+    if (d.id == id) return &d;
+  }
+  return nullptr;
+}
+
+Pose2 nominal_docked_target(const DockdConfig& c) {
+  const Real reach = static_cast<Real>(c.pad_reach_m);
+  return c.pads_rear ? Pose2{-reach, 0, 0} : Pose2{reach, 0, dockcore::kPi};
+}
+
+dockcore::DockProfile profile_for_target(const dockcore::DockProfile& profile, const Pose2& nominal,
+                                         const Pose2& target) {
+  const Pose2 m = nominal.inverse().compose(target);
+  dockcore::DockProfile out = profile;
+  for (std::size_t i = 0; i < out.vertex_count; ++i) out.vertices_m[i] = m.transform(profile.vertices_m[i]);
+  return out;
+}
+
+DockdConfig parse_config_toml(const std::string& text, const std::string& source_name) {
+  Parser p(source_name);
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    p.fail(e.source(), std::string(e.description()));
+  }
+  DockdConfig c;
+  c.source = source_name;
+  std::string lidar_protocol = "ld06", lidar_transport = "serial", can_protocol = "dockcore-v1";
+  std::string drive_kind = "differential", footprint_shape = "square", pad_side = "front";
+  const toml::node* lidar_protocol_node = nullptr;
+  bool pad_reach_set = false, max_range_set = false;
+  std::vector<const toml::node*> dock_profile_nodes;
+
+  auto lidar = [&]() {
+    auto& l = c.lidar;
+    return Handlers{
+        {"protocol", [&](const toml::node& n) {
+           lidar_protocol = p.choice(n, {"ld06", "rplidar", "lakibeam"});
+           lidar_protocol_node = &n;
+         }},
+        {"transport", [&](const toml::node& n) { lidar_transport = p.choice(n, {"serial", "udp"}); }},
+        {"device", p.str(&l.device)},
+        {"baud", [&](const toml::node& n) {
+           l.baud = static_cast<std::uint32_t>(p.integer(n, 9600, 4000000));
+         }},
+        {"udp_bind", p.str(&l.udp_bind_address)},
+        {"udp_port", p.integ(&l.udp_port, 1, 65535)},
+        {"reconnect_min_ms", p.integ(&l.reconnect_min_ms, 10, 60000)},
+        {"reconnect_max_ms", p.integ(&l.reconnect_max_ms, 10, 600000)},
+        {"mount_x_m", p.real(&c.lidar_mount.x_m, -2, 2)},
+        {"mount_y_m", p.real(&c.lidar_mount.y_m, -2, 2)},
+        {"mount_yaw_deg", p.real_deg(&c.lidar_mount.yaw_rad, -180, 180)},
+        {"min_range_m", p.real(&c.estimator.min_range_m, 0, 10)},
+        {"max_range_m", [&](const toml::node& n) {
+           c.estimator.max_range_m = static_cast<Real>(p.number(n, 0.1, 100));
+           max_range_set = true;
+         }},
+        {"range_sigma_m", p.real(&c.estimator.range_sigma_m, 0.0001, 1)},
+    };
+  };
+  (void)max_range_set;
+
+  auto can = [&]() {
+    return Handlers{
+        {"interface", p.str(&c.can_interface)},
+        {"protocol", [&](const toml::node& n) { can_protocol = p.choice(n, {"dockcore-v1", "agilex-v2"}); }},
+        {"chassis_base_id", p.integ(&c.can.chassis_base_id, 0, 0x7F0)},
+        {"host_base_id", p.integ(&c.can.host_base_id, 0, 0x7F0)},
+        {"status_rate_hz", p.num(&c.status_rate_hz, 1, 50)},
+    };
+  };
+
+  auto robot = [&]() {
+    auto& g = c.drive;
+    Handlers h{
+        {"drive", [&](const toml::node& n) { drive_kind = p.choice(n, {"differential", "mecanum"}); }},
+        {"wheel_radius_m", p.real(&g.wheel_radius_m, 0.005, 1)},
+        {"track_m", p.real(&g.wheel_base_m, 0.02, 5)},
+        {"half_wheelbase_m", p.real(&g.lx_m, 0.01, 5)},
+        {"half_track_m", p.real(&g.ly_m, 0.01, 5)},
+        {"pad_side", [&](const toml::node& n) { pad_side = p.choice(n, {"front", "rear"}); }},
+        {"pad_reach_m", [&](const toml::node& n) {
+           c.pad_reach_m = p.number(n, 0.01, 3);
+           pad_reach_set = true;
+         }},
+    };
+    h.emplace_back("limits", p.sub("robot.limits.", [&]() {
+      auto& l = c.limits;
+      return Handlers{{"max_vx_mps", p.real(&l.max_vx_mps, 0, 5)},
+                      {"max_vy_mps", p.real(&l.max_vy_mps, 0, 5)},
+                      {"max_wz_radps", p.real(&l.max_wz_radps, 0, 10)},
+                      {"max_wheel_radps", p.real(&l.max_wheel_radps, 0, 500)},
+                      {"max_linear_accel_mps2", p.real(&l.max_linear_accel_mps2, 0, 20)},
+                      {"max_angular_accel_radps2", p.real(&l.max_angular_accel_radps2, 0, 50)}};
+    }));
+    h.emplace_back("footprint", p.sub("robot.footprint.", [&]() {
+      auto& f = c.footprint;
+      return Handlers{{"shape", [&](const toml::node& n) { footprint_shape = p.choice(n, {"square", "circle"}); }},
+                      {"half_length_m", p.real(&f.half_length_m, 0.01, 5)},
+                      {"half_width_m", p.real(&f.half_width_m, 0.01, 5)},
+                      {"radius_m", p.real(&f.radius_m, 0.01, 5)},
+                      {"check_length_m", p.real(&f.check_length_m, 0, 5)},
+                      {"check_width_m", p.real(&f.check_width_m, 0, 5)},
+                      {"circumscribed_radius_m", p.real(&f.circumscribed_radius_m, 0.01, 10)},
+                      {"self_margin_m", p.real(&f.self_margin_m, 0, 1)},
+                      {"dock_margin_m", p.real(&f.dock_margin_m, 0, 1)},
+                      {"min_points", p.integ(&f.min_points, 1, 1000)}};
+    }));
+    return h;
+  };
+
+  auto dock_entry = [&](const toml::node& n) {
+    const toml::table& t = p.table(n);
+    DockEntry d;
+    const toml::node* profile_node = &n;
+    double tx = 0, ty = 0, tyaw = 0;
+    bool tx_set = false, ty_set = false, tyaw_set = false;
+    const std::string base = p.key() + ".";
+    p.each(t, base,
+           Handlers{{"id", p.integ(&d.id, 0, 31)},
+                    {"profile", [&](const toml::node& v) {
+                       d.profile_ref = p.string(v);
+                       profile_node = &v;
+                     }},
+                    {"target_x_m", [&](const toml::node& v) { tx = p.number(v, -3, 3); tx_set = true; }},
+                    {"target_y_m", [&](const toml::node& v) { ty = p.number(v, -3, 3); ty_set = true; }},
+                    {"target_yaw_deg", [&](const toml::node& v) { tyaw = p.number(v, -180, 180); tyaw_set = true; }}});
+    if (tx_set || ty_set || tyaw_set) {
+      if (!(tx_set && ty_set && tyaw_set)) p.fail(n.source(), "dock target needs all of target_x_m, target_y_m, target_yaw_deg");
+      d.has_target = true;
+      d.target = Pose2{static_cast<Real>(tx), static_cast<Real>(ty), static_cast<Real>(tyaw * kDeg)};
+    }
+    for (const DockEntry& o : c.docks) {
+      if (o.id == d.id) p.fail(n.source(), "dock id " + std::to_string(d.id) + " appears twice");
+    }
+    c.docks.push_back(d);
+    dock_profile_nodes.push_back(profile_node);
+  };
+
+  auto controller = [&]() {
+    Handlers h{{"name", [&](const toml::node& n) { c.controller = p.choice(n, {"seed000", "seed004", "seed003", "smooth"}); }},
+               {"creep_speed_mps", [&](const toml::node& n) {
+                  const Real v = static_cast<Real>(p.number(n, 0.001, 1));
+                  c.seed000.common.creep_speed_mps = c.seed004.common.creep_speed_mps = v;
+                  c.seed003.common.creep_speed_mps = c.smooth.common.creep_speed_mps = v;
+                }},
+               {"stall_timeout_s", [&](const toml::node& n) {
+                  const Real v = static_cast<Real>(p.number(n, 0.1, 60));
+                  c.seed000.common.stall_timeout_s = c.seed004.common.stall_timeout_s = v;
+                  c.seed003.common.stall_timeout_s = c.smooth.common.stall_timeout_s = v;
+                }}};
+    h.emplace_back("smooth", p.sub("controller.smooth.", [&]() {
+      auto& s = c.smooth;
+      return Handlers{{"v_max_mps", p.real(&s.v_max_mps, 0.01, 2)},
+                      {"w_max_radps", p.real(&s.w_max_radps, 0.05, 5)},
+                      {"slowdown_radius_m", p.real(&s.slowdown_radius_m, 0, 3)},
+                      {"goal_projection_m", p.real(&s.goal_projection_m, 0, 1)},
+                      {"lineup_distance_m", p.real(&s.lineup_distance_m, 0, 2)}};
+    }));
+    h.emplace_back("seed000", p.sub("controller.seed000.", [&]() {
+      return Handlers{{"forward_speed_mps", p.real(&c.seed000.forward_speed_mps, 0.01, 2)}};
+    }));
+    h.emplace_back("seed004", p.sub("controller.seed004.", [&]() {
+      return Handlers{{"max_speed_mps", p.real(&c.seed004.max_speed_mps, 0.01, 2)}};
+    }));
+    h.emplace_back("seed003", p.sub("controller.seed003.", [&]() {
+      auto& s = c.seed003;
+      return Handlers{{"fx_px", p.real(&s.camera.fx_px, 1, 10000)},
+                      {"cx_px", p.real(&s.camera.cx_px, 0, 10000)},
+                      {"image_width_px", p.real(&s.camera.image_width_px, 1, 20000)},
+                      {"mount_x_m", p.real(&s.camera.mount.x_m, -2, 2)},
+                      {"mount_y_m", p.real(&s.camera.mount.y_m, -2, 2)},
+                      {"mount_yaw_deg", p.real_deg(&s.camera.mount.yaw_rad, -180, 180)}};
+    }));
+    return h;
+  };
+
+  auto task = [&]() {
+    auto& t = c.task;
+    return Handlers{
+        {"detect_wait_s", p.real(&t.detect_wait_s, 0, 60)},
+        {"swing_amplitude_deg", p.real_deg(&t.swing_amplitude_rad, 0, 180)},
+        {"swing_speed_radps", p.real(&t.swing_speed_radps, 0.01, 3)},
+        {"max_swings", p.integ(&t.max_swings, 0, 20)},
+        {"target_lost_after_s", p.real(&t.target_lost_after_s, 0.05, 60)},
+        {"target_lost_timeout_s", p.real(&t.target_lost_timeout_s, 0.1, 600)},
+        {"obstacle_timeout_s", p.real(&t.obstacle_timeout_s, 0.1, 600)},
+        {"charge_current_threshold_a", p.real(&t.charge_current_threshold_a, 0, 200)},
+        {"charge_confirm_hold_s", p.real(&t.charge_confirm_hold_s, 0, 60)},
+        {"charge_confirm_timeout_s", p.real(&t.charge_confirm_timeout_s, 0.1, 600)},
+        {"contact_lost_debounce_s", p.real(&t.contact_lost_debounce_s, 0, 60)},
+        {"max_retries", p.integ(&t.max_retries, 0, 20)},
+        {"staging_distance_m", p.real(&t.staging_distance_m, 0.1, 10)},
+        {"fallback_backoff_m", p.real(&t.fallback_backoff_m, 0, 5)},
+        {"backoff_speed_mps", p.real(&t.backoff_speed_mps, 0.01, 1)},
+        {"backoff_timeout_s", p.real(&t.backoff_timeout_s, 1, 600)},
+        {"charge_off_timeout_s", p.real(&t.charge_off_timeout_s, 0.1, 60)},
+        {"task_timeout_s", p.real(&t.task_timeout_s, 1, 3600)},
+        {"check_distance_error_tolerance_m", p.real(&t.deviation.check_distance_error_tolerance_m, 0, 100)},
+        {"push_distance_tolerance_m", p.real(&t.deviation.push_distance_tolerance_m, 0, 100)},
+        {"check_angle_error_tolerance_deg", p.real_deg(&t.deviation.check_angle_error_tolerance_rad, 0, 180)},
+    };
+  };
+
+  auto host = [&]() {
+    auto& h = c.host;
+    return Handlers{{"enabled", p.flag(&c.host_enabled)},
+                    {"bind", p.str(&h.bind_address)},
+                    {"port", p.integ(&h.port, 1, 65535)},
+                    {"allowlist", [&](const toml::node& n) {
+                       const toml::array* a = n.as_array();
+                       if (a == nullptr) p.fail(n.source(), p.key() + " must be an array of strings");
+                       h.allowlist.clear();
+                       for (const toml::node& e : *a) {
+                         const std::string s = p.string(e);
+                         std::uint32_t ad = 0, m = 0;
+                         if (!dockcore::drivers::parse_ipv4_cidr(s, ad, m)) {
+                           p.fail(e.source(), p.key() + ": '" + s + "' is not an IPv4 address or a.b.c.d/prefix");
+                         }
+                         h.allowlist.push_back(s);
+                       }
+                     }},
+                    {"max_subscribers", p.integ(&h.max_subscribers, 1, 64)},
+                    {"subscription_ms", p.integ(&h.subscription_ms, 1000, 600000)}};
+  };
+
+  auto camera = [&]() {
+    auto& k = c.camera;
+    return Handlers{{"enabled", p.flag(&c.camera_enabled)},
+                    {"bind", p.str(&k.bind_address)},
+                    {"port", p.integ(&k.port, 1, 65535)},
+                    {"target_id", p.integ(&k.target_id, -1, 65535)},
+                    {"max_age_ms", p.integ(&k.max_age_ms, 10, 10000)}};
+  };
+
+  auto record = [&]() {
+    return Handlers{{"dir", p.str(&c.record_dir)},
+                    {"max_bytes", p.integ(&c.record_max_bytes, 4096, std::int64_t{1} << 40)},
+                    {"max_files", p.integ(&c.record_max_files, 1, 1000)}};
+  };
+
+  auto watchdog = [&]() {
+    return Handlers{{"lidar_stale_ms", p.integ(&c.lidar_stale_ms, 40, 10000)},
+                    {"chassis_stale_ms", p.integ(&c.chassis_stale_ms, 40, 10000)},
+                    {"systemd_divider", p.integ(&c.systemd_watchdog_divider, 2, 10)}};
+  };
+
+  auto state = [&]() {
+    return Handlers{{"file", p.str(&c.state_file)},
+                    {"teach_scans", p.integ(&c.teach_scans, 1, 1000)},
+                    {"teach_timeout_s", p.num(&c.teach_timeout_s, 1, 600)}};
+  };
+
+  auto log = [&]() {
+    return Handlers{{"level", [&](const toml::node& n) {
+      parse_log_level(p.choice(n, {"error", "warn", "info", "debug"}), c.log_level);
+    }}};
+  };
+
+  const toml::node* docks_node = nullptr;
+  const Handlers top{
+      {"lidar", p.sub("lidar.", lidar)},
+      {"can", p.sub("can.", can)},
+      {"robot", p.sub("robot.", robot)},
+      {"dock", [&](const toml::node& n) {
+         // [dock] is the single-dock shorthand of [[docks]], plus default_id.
+         const toml::table& t = p.table(n);
+         DockEntry d;
+         const toml::node* profile_node = &n;
+         bool entry = false;
+         p.each(t, "dock.",
+                Handlers{{"default_id", p.integ(&c.default_dock_id, 0, 31)},
+                         {"id", [&](const toml::node& v) { d.id = static_cast<std::uint16_t>(p.integer(v, 0, 31)); entry = true; }},
+                         {"profile", [&](const toml::node& v) { d.profile_ref = p.string(v); profile_node = &v; entry = true; }}});
+         if (entry) {
+           for (const DockEntry& o : c.docks) {
+             if (o.id == d.id) p.fail(n.source(), "dock id " + std::to_string(d.id) + " appears twice");
+           }
+           c.docks.push_back(d);
+           dock_profile_nodes.push_back(profile_node);
+         }
+       }},
+      {"docks", [&](const toml::node& n) {
+         const toml::array* a = n.as_array();
+         if (a == nullptr) p.fail(n.source(), "docks must be an array of tables ([[docks]])");
+         docks_node = &n;
+         for (const toml::node& e : *a) dock_entry(e);
+       }},
+      {"controller", p.sub("controller.", controller)},
+      {"task", p.sub("task.", task)},
+      {"host", p.sub("host.", host)},
+      {"camera", p.sub("camera.", camera)},
+      {"record", p.sub("record.", record)},
+      {"watchdog", p.sub("watchdog.", watchdog)},
+      {"state", p.sub("state.", state)},
+      {"log", p.sub("log.", log)},
+  };
+  p.each(root, "", top);
+  (void)docks_node;
+
+  // Derived values and cross-key checks.
+  c.lidar.protocol = *dockcore::drivers::parse_lidar_protocol(lidar_protocol);
+  c.lidar.transport = lidar_transport == "udp" ? dockcore::drivers::LidarTransport::kUdp
+                                               : dockcore::drivers::LidarTransport::kSerial;
+  if (c.lidar.protocol == dockcore::drivers::LidarProtocol::kLakibeam &&
+      c.lidar.transport == dockcore::drivers::LidarTransport::kSerial) {
+    p.fail(lidar_protocol_node != nullptr ? lidar_protocol_node->source() : root.source(),
+           "lidar.protocol = \"lakibeam\" needs lidar.transport = \"udp\"");
+  }
+  if (c.lidar.reconnect_max_ms < c.lidar.reconnect_min_ms) {
+    p.fail(root.source(), "lidar.reconnect_max_ms must be >= lidar.reconnect_min_ms");
+  }
+  if (c.estimator.min_range_m >= c.estimator.max_range_m) p.fail(root.source(), "lidar.min_range_m must be < lidar.max_range_m");
+  c.can.protocol = *dockcore::drivers::parse_chassis_protocol(can_protocol);
+  c.drive.kind = drive_kind == "mecanum" ? dockcore::DriveKind::kMecanum : dockcore::DriveKind::kDifferential;
+  c.can.drive = c.drive;
+  c.pads_rear = pad_side == "rear";
+  c.footprint.shape = footprint_shape == "circle" ? dockcore::FootprintShape::kCircular : dockcore::FootprintShape::kSquare;
+  if (!pad_reach_set) {
+    c.pad_reach_m = footprint_shape == "circle" ? static_cast<double>(c.footprint.radius_m)
+                                                : static_cast<double>(c.footprint.half_length_m);
+  }
+  const Real reach = static_cast<Real>(c.pad_reach_m);
+  c.seed000.common.pad_reach_m = c.seed004.common.pad_reach_m = reach;
+  c.seed003.common.pad_reach_m = c.smooth.common.pad_reach_m = reach;
+  c.smooth.backwards = c.pads_rear;
+  c.seed003.holonomic = c.drive.kind == dockcore::DriveKind::kMecanum;
+  c.task.max_vx_mps = c.limits.max_vx_mps > 0 ? c.limits.max_vx_mps : c.task.max_vx_mps;
+  c.task.max_vy_mps = c.limits.max_vy_mps > 0 ? c.limits.max_vy_mps : c.task.max_vy_mps;
+  c.task.max_wz_radps = c.limits.max_wz_radps > 0 ? c.limits.max_wz_radps : c.task.max_wz_radps;
+  if (!c.host_enabled && c.host.allowlist.size() > 0) p.fail(root.source(), "host.allowlist given but host.enabled = false");
+  if (c.camera_enabled && c.host_enabled && c.camera.port == c.host.port && c.camera.bind_address == c.host.bind_address) {
+    p.fail(root.source(), "camera.port must differ from host.port");
+  }
+
+  if (c.docks.empty()) {
+    DockEntry d;
+    c.docks.push_back(d);
+    dock_profile_nodes.push_back(&root);
+  }
+  std::uint32_t mask = 0;
+  for (std::size_t i = 0; i < c.docks.size(); ++i) {
+    DockEntry& d = c.docks[i];
+    const std::string& ref = d.profile_ref;
+    const bool is_file = ref.find('/') != std::string::npos || (ref.size() > 5 && ref.compare(ref.size() - 5, 5, ".toml") == 0);
+    if (is_file) {
+      const std::string path = (!ref.empty() && ref[0] != '/') ? dir_of(source_name) + ref : ref;
+      d.profile = load_profile(p, *dock_profile_nodes[i], path);
+    } else if (dockcore::builtin_profile(ref.c_str(), d.profile) != dockcore::ProfileError::kOk) {
+      std::string names;
+      for (const char* const* n = dockcore::kBuiltinProfileNames; *n != nullptr; ++n) names += (names.empty() ? "" : ", ") + std::string(*n);
+      p.fail(dock_profile_nodes[i]->source(), "dock profile \"" + ref + "\" is neither a built-in (" + names +
+                                                  ") nor a .toml file");
+    }
+    mask |= 1u << d.id;
+  }
+  c.task.accepted_dock_ids = mask;
+  if (c.find_dock(c.default_dock_id) == nullptr) {
+    p.fail(root.source(), "dock.default_id = " + std::to_string(c.default_dock_id) + " is not a configured dock id");
+  }
+  return c;
+}
+
+DockdConfig load_config_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path + ": cannot open config file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw ConfigError(path + ": cannot read config file");
+  return parse_config_toml(ss.str(), path);
+}
+
+}  // namespace dockd

@@ -1,0 +1,731 @@
+#include "daemon.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+
+#include "dockcore/kinematics.hpp"
+
+namespace dockd {
+
+using dockcore::FaultCode;
+using dockcore::HostCommandType;
+using dockcore::Pose2;
+using dockcore::Real;
+using dockcore::TaskState;
+using dockcore::drivers::HostErrorCode;
+using dockcore::drivers::HostRequest;
+using dockcore::drivers::HostRequestKind;
+
+namespace {
+
+constexpr std::uint64_t kNominalTickUs = 20000;
+constexpr std::uint64_t kResumeHoldUs = 500000;  // data fresh this long before an interrupted command is re-issued
+constexpr std::uint8_t kMaxResumes = 3;          // per task: a flapping link ends in the fault, not in a loop
+
+double deg(Real rad) { return static_cast<double>(rad) * 180.0 / 3.14159265358979323846; }
+
+const char* level_name(LogLevel l) {
+  switch (l) {
+    case LogLevel::kError: return "error";
+    case LogLevel::kWarn: return "warn";
+    case LogLevel::kInfo: return "info";
+    case LogLevel::kDebug: return "debug";
+  }
+  return "?";
+}
+
+bool idle_state(TaskState s) { return s == TaskState::kNotTasking || s == TaskState::kFault; }
+
+}  // namespace
+
+const char* to_string_result(dockcore::TaskResult r) {
+  switch (r) {
+    case dockcore::TaskResult::kNone: return "none";
+    case dockcore::TaskResult::kDocked: return "docked";
+    case dockcore::TaskResult::kUndocked: return "undocked";
+    case dockcore::TaskResult::kCancelled: return "cancelled";
+    case dockcore::TaskResult::kFaulted: return "faulted";
+  }
+  return "?";
+}
+
+Daemon::Daemon(const DockdConfig& config, const DaemonIo& io)
+    : cfg_(config),
+      io_(io),
+      seed000_(config.seed000),
+      seed004_(config.seed004),
+      seed003_(config.seed003),
+      smooth_(config.smooth),
+      scan_(std::make_unique<dockcore::LaserScan>()),
+      teach_storage_(std::make_unique<Teach>()),
+      teach_(*teach_storage_) {
+  if (cfg_.controller == "seed000") controller_ = &seed000_;
+  else if (cfg_.controller == "seed004") controller_ = &seed004_;
+  else if (cfg_.controller == "seed003") controller_ = &seed003_;
+  else controller_ = &smooth_;
+  core_ = std::make_unique<dockcore::Dockcore>(*controller_);
+  core_cfg_.estimator = cfg_.estimator;
+  core_cfg_.task = cfg_.task;
+  core_cfg_.footprint = cfg_.footprint;
+  core_cfg_.lidar_mount = cfg_.lidar_mount;
+  // dockd's own watchdog (receive time, lidar_stale_ms) is the tight one; Dockcore's scan-stamp check is a backstop
+  // that must not fire first (a scan's stamp is its first sample, a whole turn before delivery).
+  core_cfg_.lidar_stale_s = static_cast<Real>(cfg_.lidar_stale_ms) * static_cast<Real>(1e-3) + static_cast<Real>(0.3);
+}
+
+Daemon::~Daemon() = default;
+
+dockcore::TaskState Daemon::state() const { return core_->task_manager().state(); }
+dockcore::FaultCode Daemon::fault() const { return core_->task_manager().fault(); }
+
+bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
+  const DockEntry* d = cfg_.find_dock(dock_id);
+  if (d == nullptr) return false;
+  dockcore::DockProfile prof = d->profile;
+  const Pose2 nominal = nominal_docked_target(cfg_);
+  if (!raw_profile) {
+    const TaughtTarget* t = state_.find(dock_id);
+    if (t != nullptr) {
+      prof = profile_for_target(d->profile, nominal, t->target);
+    } else if (d->has_target) {
+      prof = profile_for_target(d->profile, nominal, d->target);
+    }
+  }
+  if (!core_->configure(prof, core_cfg_)) return false;
+  active_dock_ = dock_id;
+  active_raw_ = raw_profile;
+  return true;
+}
+
+bool Daemon::start(std::string& error) {
+  const std::uint64_t now = io_.clock->now_us();
+  std::string msg;
+  const StateLoadStatus st = load_state(cfg_.state_file, state_, msg);
+  char line[768];
+  if (st == StateLoadStatus::kRecoveredBackup || st == StateLoadStatus::kCorruptNoBackup) {
+    const int n = std::snprintf(line, sizeof line, "{\"t_us\":%llu,\"event\":\"state_file\",\"level\":\"%s\",\"message\":\"%s\"}\n",
+                                static_cast<unsigned long long>(now), st == StateLoadStatus::kCorruptNoBackup ? "error" : "warn",
+                                msg.c_str());
+    if (n > 0) emit_event(st == StateLoadStatus::kCorruptNoBackup ? LogLevel::kError : LogLevel::kWarn, line,
+                          static_cast<std::size_t>(n) < sizeof line ? static_cast<std::size_t>(n) : sizeof line - 1);
+  }
+  if (!configure_core(cfg_.default_dock_id, false)) {
+    error = "dock profile of dock " + std::to_string(cfg_.default_dock_id) + " refused by the estimator";
+    return false;
+  }
+  start_us_ = now;
+  started_ = true;
+  const int n = std::snprintf(line, sizeof line,
+                              "{\"t_us\":%llu,\"event\":\"start\",\"controller\":\"%s\",\"docks\":%zu,\"taught\":%zu,"
+                              "\"default_dock\":%u}\n",
+                              static_cast<unsigned long long>(now), controller_->name(), cfg_.docks.size(),
+                              state_.targets.size(), cfg_.default_dock_id);
+  if (n > 0) emit_event(LogLevel::kInfo, line, static_cast<std::size_t>(n));
+  return true;
+}
+
+void Daemon::emit_event(LogLevel level, const char* line, std::size_t len) {
+  if (io_.event_log != nullptr) io_.event_log->write_line(line, len);
+  if (static_cast<int>(level) <= static_cast<int>(io_.stderr_level)) {
+    std::fprintf(stderr, "dockd %s: %.*s", level_name(level), static_cast<int>(len), line);
+  }
+}
+
+void Daemon::log_event(std::uint64_t now_us, const char* event, const char* fields, LogLevel level) {
+  char line[768];
+  const int n = std::snprintf(line, sizeof line, "{\"t_us\":%llu,\"event\":\"%s\"%s%s}\n",
+                              static_cast<unsigned long long>(now_us), event, fields[0] != '\0' ? "," : "", fields);
+  if (n > 0 && static_cast<std::size_t>(n) < sizeof line) emit_event(level, line, static_cast<std::size_t>(n));
+}
+
+void Daemon::send_wheels(const dockcore::hal::WheelCommand& w) {
+  last_wheels_ = w;
+  if (!io_.chassis->send_wheels(w)) ++counters_.wheel_send_failures;
+}
+
+void Daemon::send_zero(std::uint64_t, int frames) {
+  dockcore::hal::WheelCommand z;
+  z.count = static_cast<std::uint8_t>(dockcore::drive_wheel_count(cfg_.drive.kind));
+  for (int i = 0; i < frames; ++i) send_wheels(z);
+  prev_cmd_ = dockcore::Twist2{};
+}
+
+void Daemon::log_shutdown(std::uint64_t now_us, const char* reason) {
+  if (shutdown_logged_) return;
+  shutdown_logged_ = true;
+  char f[256];
+  std::snprintf(f, sizeof f, "\"reason\":\"%s\",\"state\":\"%s\",\"worst_tick_us\":%llu,\"overruns\":%llu", reason,
+                dockcore::to_string(state()), static_cast<unsigned long long>(stats_.worst_period_us),
+                static_cast<unsigned long long>(stats_.overruns));
+  log_event(now_us, "shutdown", f, LogLevel::kInfo);
+}
+
+// --- inputs ------------------------------------------------------------------------------------------------------
+
+void Daemon::poll_chassis(std::uint64_t) {
+  fb_ = io_.chassis->poll();
+  if (fb_.wheels_stamp_us == 0 || fb_.wheels_stamp_us == last_wheels_stamp_us_) return;
+  dockcore::WheelSpeeds w;
+  w.count = dockcore::drive_wheel_count(cfg_.drive.kind);
+  for (std::size_t i = 0; i < w.count; ++i) w.radps[i] = fb_.wheel_radps[i];
+  const dockcore::Twist2 tw = dockcore::wheels_to_twist(cfg_.drive, w);
+  if (have_wheels_ && fb_.wheels_stamp_us > last_wheels_stamp_us_) {
+    // Feedback gaps longer than 0.2 s are not integrated across (the wheels' history is unknown there).
+    const std::uint64_t gap = fb_.wheels_stamp_us - last_wheels_stamp_us_;
+    const Real dt = static_cast<Real>(gap < 200000u ? gap : 0u) * static_cast<Real>(1e-6);
+    // Midpoint rule on the previous and the new twist.
+    const Real vx = (odom_twist_.vx_mps + tw.vx_mps) / 2, vy = (odom_twist_.vy_mps + tw.vy_mps) / 2;
+    const Real wz = (odom_twist_.wz_radps + tw.wz_radps) / 2;
+    const Real yaw_mid = odom_.yaw_rad + wz * dt / 2;
+    odom_.x_m += (vx * std::cos(yaw_mid) - vy * std::sin(yaw_mid)) * dt;
+    odom_.y_m += (vx * std::sin(yaw_mid) + vy * std::cos(yaw_mid)) * dt;
+    odom_.yaw_rad = dockcore::wrap_angle(odom_.yaw_rad + wz * dt);
+  }
+  odom_twist_ = tw;
+  have_wheels_ = true;
+  last_wheels_stamp_us_ = fb_.wheels_stamp_us;
+  history_[history_next_] = OdomSample{fb_.wheels_stamp_us, odom_};
+  history_next_ = (history_next_ + 1) % (sizeof history_ / sizeof history_[0]);
+}
+
+Pose2 Daemon::odom_at(std::uint64_t stamp_us) const {
+  // The newest sample not after the scan time (64 samples at 50 Hz cover 1.3 s); the current pose otherwise.
+  const OdomSample* best = nullptr;
+  for (const OdomSample& s : history_) {
+    if (s.stamp_us == 0 || s.stamp_us > stamp_us) continue;
+    if (best == nullptr || s.stamp_us > best->stamp_us) best = &s;
+  }
+  return best != nullptr ? best->pose : odom_;
+}
+
+void Daemon::poll_lidar(std::uint64_t now_us) {
+  // Only the newest scan matters (poll_scan keeps the newest); bounded to a few per call.
+  for (int i = 0; i < 4 && io_.lidar->poll_scan(*scan_); ++i) {
+    ++counters_.scans;
+    have_scan_ = true;
+    last_scan_rx_us_ = now_us;
+    const std::uint64_t stamp = scan_->stamp_us != 0 ? scan_->stamp_us : now_us;
+    const dockcore::DockEstimate& e = core_->on_scan(scan_->view(), stamp, odom_at(stamp));
+    if (e.found) {
+      ++counters_.detections;
+      if (teach_.active) teach_sample(e);
+    }
+  }
+}
+
+void Daemon::poll_camera(std::uint64_t) {
+  if (io_.camera == nullptr) return;
+  dockcore::CameraTarget t;
+  if (io_.camera->poll_target(t)) camera_ = t;
+}
+
+bool Daemon::enqueue(const PendingCommand& c) {
+  if (queue_size_ >= kQueue) {
+    ++counters_.queue_overflows;
+    return false;
+  }
+  queue_[(queue_head_ + queue_size_) % kQueue] = c;
+  ++queue_size_;
+  return true;
+}
+
+void Daemon::reply_json(const HostRequest& r, const char* json, std::size_t len) {
+  if (io_.udp_host != nullptr && len > 0) io_.udp_host->reply(r.peer, json, len);
+}
+
+void Daemon::reply_error(const HostRequest& r, HostErrorCode code, const char* msg) {
+  char buf[512];
+  const std::size_t n = dockcore::drivers::format_host_error(buf, sizeof buf, r.has_seq, r.seq, code, msg);
+  reply_json(r, buf, n);
+  ++counters_.commands_rejected;
+  if (io_.udp_host != nullptr) io_.udp_host->count_rejected();
+  char f[256];
+  std::snprintf(f, sizeof f, "\"source\":\"udp\",\"cmd\":\"%s\",\"seq\":%u,\"error\":\"%s\"", to_string(r.kind), r.seq,
+                to_string(code));
+  log_event(r.stamp_us, "command_rejected", f, LogLevel::kWarn);
+}
+
+void Daemon::handle_udp_request(const HostRequest& r, std::uint64_t now_us) {
+  switch (r.kind) {
+    case HostRequestKind::kStatus: {
+      char buf[dockcore::drivers::kMaxHostReply];
+      std::size_t n = status_json(buf, sizeof buf - 64, now_us);
+      if (n == 0) return;
+      // Turn the status object into the reply: {"ok":true,"seq":N, ...status fields}.
+      char out[dockcore::drivers::kMaxHostReply];
+      const int m = std::snprintf(out, sizeof out, "{\"ok\":true,\"cmd\":\"status\",\"seq\":%u,%s", r.seq, buf + 1);
+      if (m > 0 && static_cast<std::size_t>(m) < sizeof out) reply_json(r, out, static_cast<std::size_t>(m));
+      return;
+    }
+    case HostRequestKind::kTeach:
+      start_teach(r, now_us);
+      return;
+    case HostRequestKind::kDock:
+    case HostRequestKind::kTest: {
+      const std::uint16_t id = r.has_dock_id ? r.dock_id : cfg_.default_dock_id;
+      if (cfg_.find_dock(id) == nullptr) {
+        char msg[96];
+        std::snprintf(msg, sizeof msg, "dock id %u is not in the dock database", id);
+        reply_error(r, HostErrorCode::kUnknownDockId, msg);
+        return;
+      }
+      PendingCommand c;
+      c.type = r.kind == HostRequestKind::kDock ? HostCommandType::kDock : HostCommandType::kTestMode;
+      c.dock_id = id;
+      c.from_udp = true;
+      c.request = r;
+      if (!enqueue(c)) reply_error(r, HostErrorCode::kBusy, "command queue full (8 pending): retry later");
+      return;
+    }
+    case HostRequestKind::kUndock:
+    case HostRequestKind::kStop: {
+      PendingCommand c;
+      c.type = r.kind == HostRequestKind::kUndock ? HostCommandType::kUndock : HostCommandType::kCancel;
+      c.dock_id = active_dock_;
+      c.from_udp = true;
+      c.request = r;
+      if (r.kind == HostRequestKind::kStop && teach_.active) finish_teach(false, "cancelled by stop", now_us);
+      if (!enqueue(c)) {
+        if (r.kind == HostRequestKind::kStop) {
+          // A stop must never be lost: it replaces the newest queued command.
+          queue_[(queue_head_ + queue_size_ - 1) % kQueue] = c;
+        } else {
+          reply_error(r, HostErrorCode::kBusy, "command queue full (8 pending): retry later");
+        }
+      }
+      return;
+    }
+    case HostRequestKind::kSubscribe:
+    case HostRequestKind::kUnsubscribe:
+      return;  // handled by the link
+  }
+}
+
+void Daemon::poll_hosts(std::uint64_t now_us) {
+  if (io_.udp_host != nullptr) {
+    HostRequest r;
+    // Bounded per tick: a flood is answered over several ticks instead of stalling this one.
+    for (int i = 0; i < 64 && io_.udp_host->poll_request(r, now_us); ++i) handle_udp_request(r, now_us);
+  }
+  if (io_.can_host != nullptr) {
+    dockcore::hal::HostCommandMessage m;
+    for (int i = 0; i < 16 && io_.can_host->poll_command(m); ++i) {
+      PendingCommand c;
+      c.type = static_cast<HostCommandType>(m.command);
+      c.dock_id = m.dock_id;
+      if (c.type == HostCommandType::kCancel && teach_.active) finish_teach(false, "cancelled by stop", now_us);
+      if (!enqueue(c)) {
+        ++counters_.commands_rejected;
+        if (c.type == HostCommandType::kCancel) queue_[(queue_head_ + queue_size_ - 1) % kQueue] = c;
+      }
+      char f[128];
+      std::snprintf(f, sizeof f, "\"source\":\"can\",\"command\":%u,\"dock_id\":%u,\"seq\":%u", m.command, m.dock_id,
+                    m.sequence);
+      log_event(now_us, "command", f);
+    }
+  }
+}
+
+void Daemon::on_lidar_readable(std::uint64_t now_us) { poll_lidar(now_us); }
+void Daemon::on_chassis_readable(std::uint64_t now_us) { poll_chassis(now_us); }
+void Daemon::on_host_readable(std::uint64_t now_us) { poll_hosts(now_us); }
+void Daemon::on_camera_readable(std::uint64_t now_us) { poll_camera(now_us); }
+
+// --- watchdogs -----------------------------------------------------------------------------------------------------
+
+void Daemon::watchdogs(std::uint64_t now_us) {
+  const std::uint64_t lidar_lim = static_cast<std::uint64_t>(cfg_.lidar_stale_ms) * 1000u;
+  const std::uint64_t chassis_lim = static_cast<std::uint64_t>(cfg_.chassis_stale_ms) * 1000u;
+  const bool lidar = !have_scan_ || now_us - last_scan_rx_us_ > lidar_lim;
+  const bool chassis = !have_wheels_ || now_us < last_wheels_stamp_us_ || now_us - last_wheels_stamp_us_ > chassis_lim;
+  if (lidar != lidar_stale_) {
+    if (lidar) ++counters_.lidar_stale_trips;
+    char f[96];
+    std::snprintf(f, sizeof f, "\"which\":\"lidar\",\"stale\":%s,\"fault\":%u", lidar ? "true" : "false",
+                  static_cast<unsigned>(FaultCode::kLidarStale));
+    log_event(now_us, "watchdog", f, lidar ? LogLevel::kWarn : LogLevel::kInfo);
+  }
+  if (chassis != chassis_stale_) {
+    if (chassis) ++counters_.chassis_stale_trips;
+    char f[96];
+    std::snprintf(f, sizeof f, "\"which\":\"chassis\",\"stale\":%s,\"fault\":%u", chassis ? "true" : "false",
+                  static_cast<unsigned>(FaultCode::kChassisStale));
+    log_event(now_us, "watchdog", f, chassis ? LogLevel::kWarn : LogLevel::kInfo);
+  }
+  lidar_stale_ = lidar;
+  chassis_stale_ = chassis;
+  if (lidar || chassis) fresh_since_us_ = now_us;
+}
+
+// --- teach ---------------------------------------------------------------------------------------------------------
+
+void Daemon::start_teach(const HostRequest& r, std::uint64_t now_us) {
+  const std::uint16_t id = r.has_dock_id ? r.dock_id : cfg_.default_dock_id;
+  if (cfg_.find_dock(id) == nullptr) {
+    char msg[96];
+    std::snprintf(msg, sizeof msg, "dock id %u is not in the dock database", id);
+    reply_error(r, HostErrorCode::kUnknownDockId, msg);
+    return;
+  }
+  if (teach_.active) {
+    reply_error(r, HostErrorCode::kBusy, "a teach is already running");
+    return;
+  }
+  const TaskState s = state();
+  if (!(s == TaskState::kNotTasking || s == TaskState::kFinishTasking || s == TaskState::kFault)) {
+    reply_error(r, HostErrorCode::kTeachFailed, "teach needs an idle robot (stop the running task first)");
+    return;
+  }
+  if (chassis_stale_ || !fb_.charging_contact) {
+    reply_error(r, HostErrorCode::kTeachFailed, "teach needs the robot on the charger: contacts are not closed");
+    return;
+  }
+  if (lidar_stale_) {
+    reply_error(r, HostErrorCode::kTeachFailed, "teach needs the lidar: no fresh scans");
+    return;
+  }
+  // Detections against the dock's own profile, without any earlier correction (that is what is being measured).
+  if (!configure_core(id, true)) {
+    reply_error(r, HostErrorCode::kTeachFailed, "dock profile refused");
+    return;
+  }
+  teach_.active = true;
+  teach_.dock_id = id;
+  teach_.wanted = r.scans != 0 ? r.scans : cfg_.teach_scans;
+  teach_.have = 0;
+  teach_.sx = teach_.sy = teach_.sc = teach_.ss = 0;
+  teach_.deadline_us = now_us + static_cast<std::uint64_t>(cfg_.teach_timeout_s * 1e6);
+  teach_.request = r;
+  char f[96];
+  std::snprintf(f, sizeof f, "\"dock_id\":%u,\"scans\":%u", id, teach_.wanted);
+  log_event(now_us, "teach_start", f);
+}
+
+void Daemon::teach_sample(const dockcore::DockEstimate& e) {
+  if (teach_.have >= teach_.wanted) return;
+  teach_.samples[teach_.have++] = e.pose;
+  teach_.sx += static_cast<double>(e.pose.x_m);
+  teach_.sy += static_cast<double>(e.pose.y_m);
+  teach_.sc += std::cos(static_cast<double>(e.pose.yaw_rad));
+  teach_.ss += std::sin(static_cast<double>(e.pose.yaw_rad));
+}
+
+void Daemon::finish_teach(bool ok, const char* why, std::uint64_t now_us) {
+  const HostRequest r = teach_.request;
+  const std::uint16_t id = teach_.dock_id;
+  teach_.active = false;
+  if (!ok) {
+    configure_core(active_dock_, false);
+    reply_error(r, HostErrorCode::kTeachFailed, why);
+    return;
+  }
+  const double n = teach_.have;
+  TaughtTarget t;
+  t.dock_id = id;
+  t.target = Pose2{static_cast<Real>(teach_.sx / n), static_cast<Real>(teach_.sy / n),
+                   static_cast<Real>(std::atan2(teach_.ss, teach_.sc))};
+  t.scans = teach_.have;
+  double spread = 0;
+  for (std::uint16_t i = 0; i < teach_.have; ++i) {
+    spread = std::fmax(spread, std::hypot(static_cast<double>(teach_.samples[i].x_m - t.target.x_m),
+                                          static_cast<double>(teach_.samples[i].y_m - t.target.y_m)));
+  }
+  t.spread_m = spread;
+  t.taught_unix_s = static_cast<std::uint64_t>(std::time(nullptr));
+  // A moving robot or a detection flipping between two fits would teach garbage: 2 cm is far beyond lidar noise
+  // averaged over a still robot.
+  if (spread > 0.02) {
+    configure_core(id, false);
+    char msg[128];
+    std::snprintf(msg, sizeof msg, "detections spread %.1f mm (> 20 mm): robot moving or dock ambiguous", spread * 1e3);
+    reply_error(r, HostErrorCode::kTeachFailed, msg);
+    return;
+  }
+  StateData next = state_;
+  next.put(t);
+  std::string err;
+  if (!save_state(cfg_.state_file, next, err)) {
+    configure_core(id, false);
+    reply_error(r, HostErrorCode::kTeachFailed, ("state file: " + err).c_str());
+    return;
+  }
+  state_ = next;
+  configure_core(id, false);
+  const Pose2 nom = nominal_docked_target(cfg_);
+  char buf[512];
+  const int m = std::snprintf(buf, sizeof buf,
+                              "{\"ok\":true,\"cmd\":\"teach\",\"seq\":%u,\"dock_id\":%u,\"scans\":%u,\"target_x_m\":%.4f,"
+                              "\"target_y_m\":%.4f,\"target_yaw_deg\":%.3f,\"spread_mm\":%.2f,\"offset_x_mm\":%.1f,"
+                              "\"offset_y_mm\":%.1f,\"offset_yaw_deg\":%.3f}",
+                              r.seq, id, t.scans, static_cast<double>(t.target.x_m), static_cast<double>(t.target.y_m),
+                              deg(t.target.yaw_rad), spread * 1e3, static_cast<double>(t.target.x_m - nom.x_m) * 1e3,
+                              static_cast<double>(t.target.y_m - nom.y_m) * 1e3,
+                              deg(dockcore::wrap_angle(t.target.yaw_rad - nom.yaw_rad)));
+  if (m > 0) reply_json(r, buf, static_cast<std::size_t>(m));
+  char f[256];
+  std::snprintf(f, sizeof f, "\"dock_id\":%u,\"scans\":%u,\"target_x_m\":%.4f,\"target_y_m\":%.4f,\"target_yaw_deg\":%.3f",
+                id, t.scans, static_cast<double>(t.target.x_m), static_cast<double>(t.target.y_m), deg(t.target.yaw_rad));
+  log_event(now_us, "teach_done", f);
+}
+
+void Daemon::teach_progress(std::uint64_t now_us) {
+  if (!teach_.active) return;
+  if (teach_.have >= teach_.wanted) {
+    finish_teach(true, "", now_us);
+  } else if (now_us >= teach_.deadline_us) {
+    char msg[128];
+    std::snprintf(msg, sizeof msg, "only %u of %u scans saw the dock within %.0f s", teach_.have, teach_.wanted,
+                  cfg_.teach_timeout_s);
+    finish_teach(false, msg, now_us);
+  }
+}
+
+// --- the tick ------------------------------------------------------------------------------------------------------
+
+void Daemon::on_tick(std::uint64_t now_us) {
+  if (prev_tick_us_ != 0 && now_us > prev_tick_us_) {
+    const std::uint64_t p = now_us - prev_tick_us_;
+    stats_.last_period_us = p;
+    if (p > stats_.worst_period_us) stats_.worst_period_us = p;
+    if (p * 2 > kNominalTickUs * 3) ++stats_.overruns;
+  }
+  prev_tick_us_ = now_us;
+  ++stats_.ticks;
+
+  poll_chassis(now_us);
+  poll_lidar(now_us);
+  poll_camera(now_us);
+  poll_hosts(now_us);
+  watchdogs(now_us);
+  teach_progress(now_us);
+
+  dockcore::TickInput in;
+  in.now_us = now_us;
+  in.odom_pose = odom_;
+  in.odom_twist = odom_twist_;
+  in.camera = camera_;
+  in.contact = fb_.charging_contact;
+  in.charge_current_a = fb_.battery_current_a;
+  in.chassis_ok = !chassis_stale_;
+  in.lidar_ok = !lidar_stale_;
+
+  // Watchdog resume: a command interrupted by a watchdog fault is re-issued once the data has been fresh for
+  // kResumeHoldUs, at most kMaxResumes times per task (docs/dockd.md, "Watchdogs").
+  const TaskState before = state();
+  PendingCommand cmd;
+  bool have_cmd = false;
+  if (!teach_.active && queue_size_ > 0) {
+    cmd = queue_[queue_head_];
+    queue_head_ = (queue_head_ + 1) % kQueue;
+    --queue_size_;
+    have_cmd = true;
+  } else if (!teach_.active && interrupted_ != HostCommandType::kNone && before == TaskState::kFault &&
+             !lidar_stale_ && !chassis_stale_ && now_us - fresh_since_us_ >= kResumeHoldUs) {
+    if (resumes_this_task_ < kMaxResumes) {
+      ++resumes_this_task_;
+      ++counters_.resumes;
+      cmd.type = interrupted_;
+      cmd.dock_id = interrupted_dock_;
+      cmd.resume = true;
+      have_cmd = true;
+      char f[96];
+      std::snprintf(f, sizeof f, "\"command\":%u,\"dock_id\":%u,\"resume\":%u", static_cast<unsigned>(cmd.type),
+                    cmd.dock_id, resumes_this_task_);
+      log_event(now_us, "resume", f);
+    } else {
+      log_event(now_us, "resume_given_up", "\"reason\":\"max resumes reached\"", LogLevel::kWarn);
+    }
+    interrupted_ = HostCommandType::kNone;
+  }
+  if (have_cmd) {
+    // A dock/test for another dock (or after a teach changed the correction) needs the core configured for it;
+    // that resets the task manager, so only while it is idle (otherwise the task manager answers "busy").
+    if ((cmd.type == HostCommandType::kDock || cmd.type == HostCommandType::kTestMode) && idle_state(before) &&
+        (cmd.dock_id != active_dock_ || active_raw_)) {
+      configure_core(cmd.dock_id, false);
+    }
+    // Dock (and undock on the contacts) are accepted from FAULT directly: the task manager clears the fault.
+    in.command = dockcore::HostCommand{cmd.type, cmd.dock_id};
+    ++counters_.commands;
+  }
+
+  const dockcore::TickOutput out = core_->tick(in);
+  const TaskState after = out.status.state;
+
+  if (have_cmd) {
+    const bool accepted = out.command_result == dockcore::CommandResult::kAccepted ||
+                          out.command_result == dockcore::CommandResult::kAlreadyDocked;
+    if (accepted && !cmd.resume) resumes_this_task_ = 0;
+    if (accepted && (cmd.type == HostCommandType::kDock || cmd.type == HostCommandType::kUndock)) {
+      running_cmd_ = cmd.type;
+      running_dock_ = cmd.dock_id;
+    }
+    if (cmd.type == HostCommandType::kCancel) {
+      running_cmd_ = HostCommandType::kNone;
+      interrupted_ = HostCommandType::kNone;
+    }
+    if (!accepted) ++counters_.commands_rejected;
+    if (cmd.from_udp) {
+      if (accepted) {
+        char buf[256];
+        const int m = std::snprintf(buf, sizeof buf,
+                                    "{\"ok\":true,\"cmd\":\"%s\",\"seq\":%u,\"result\":\"%s\",\"dock_id\":%u,\"state\":\"%s\"}",
+                                    to_string(cmd.request.kind), cmd.request.seq, dockcore::to_string(out.command_result),
+                                    cmd.dock_id, dockcore::to_string(after));
+        if (m > 0) reply_json(cmd.request, buf, static_cast<std::size_t>(m));
+      } else {
+        char msg[128];
+        std::snprintf(msg, sizeof msg, "task manager: %s (state %s)", dockcore::to_string(out.command_result),
+                      dockcore::to_string(before));
+        reply_error(cmd.request, HostErrorCode::kRejected, msg);
+      }
+    }
+    char f[192];
+    std::snprintf(f, sizeof f, "\"source\":\"%s\",\"command\":%u,\"dock_id\":%u,\"result\":\"%s\"",
+                  cmd.resume ? "resume" : (cmd.from_udp ? "udp" : "can"), static_cast<unsigned>(cmd.type), cmd.dock_id,
+                  dockcore::to_string(out.command_result));
+    log_event(now_us, "command_result", f, accepted ? LogLevel::kInfo : LogLevel::kWarn);
+  }
+
+  // A watchdog fault interrupting a running dock/undock remembers it for the resume.
+  if (after == TaskState::kFault && before != TaskState::kFault) {
+    const FaultCode f = out.status.fault;
+    if ((f == FaultCode::kChassisStale || f == FaultCode::kLidarStale) && running_cmd_ != HostCommandType::kNone) {
+      interrupted_ = running_cmd_;
+      interrupted_dock_ = running_dock_;
+    } else {
+      interrupted_ = HostCommandType::kNone;
+    }
+  }
+  if (after == TaskState::kNotTasking || after == TaskState::kFinishTasking) running_cmd_ = HostCommandType::kNone;
+
+  // Motion: zero when a watchdog holds, whatever the task manager says (it faults on the same tick anyway).
+  dockcore::Twist2 cmd_twist{};
+  const bool hold = lidar_stale_ || chassis_stale_;
+  if (!hold) {
+    cmd_twist = dockcore::saturate_twist(cfg_.drive, cfg_.limits, out.cmd);
+    cmd_twist = dockcore::limit_acceleration(cfg_.limits, prev_cmd_, cmd_twist, static_cast<Real>(kNominalTickUs) * static_cast<Real>(1e-6));
+    // A zero twist (stop, fault, idle) is sent at once: the drive's own limits do the braking.
+    if (out.cmd.vx_mps == 0 && out.cmd.vy_mps == 0 && out.cmd.wz_radps == 0) cmd_twist = dockcore::Twist2{};
+  }
+  prev_cmd_ = cmd_twist;
+  const dockcore::WheelSpeeds ws = dockcore::twist_to_wheels(cfg_.drive, cmd_twist);
+  dockcore::hal::WheelCommand wc;
+  wc.count = static_cast<std::uint8_t>(ws.count);
+  for (std::size_t i = 0; i < ws.count && i < 4; ++i) wc.radps[i] = ws.radps[i];
+  send_wheels(wc);
+
+  const bool charge = out.status.charge_enable;
+  if (charge != charge_requested_ || ++charge_refresh_ >= 50) {
+    io_.chassis->request_charging(charge);
+    charge_refresh_ = 0;
+    if (charge != charge_requested_) {
+      char f[48];
+      std::snprintf(f, sizeof f, "\"on\":%s", charge ? "true" : "false");
+      log_event(now_us, "charge_request", f);
+    }
+    charge_requested_ = charge;
+  }
+
+  // Events.
+  const dockcore::TaskStatus& s = out.status;
+  if (!prev_status_valid_ || s.state != prev_status_.state) {
+    char f[160];
+    std::snprintf(f, sizeof f, "\"from\":\"%s\",\"to\":\"%s\",\"dock_id\":%u,\"result\":\"%s\"",
+                  prev_status_valid_ ? dockcore::to_string(prev_status_.state) : "START", dockcore::to_string(s.state),
+                  s.dock_id, to_string_result(s.last_result));
+    log_event(now_us, "state", f);
+  }
+  if (s.state == TaskState::kAlign && (!prev_status_valid_ || s.phase != prev_status_.phase ||
+                                       prev_status_.state != TaskState::kAlign)) {
+    char f[96];
+    std::snprintf(f, sizeof f, "\"phase\":%u,\"name\":\"%s\"", s.phase, controller_->phase_name(s.phase));
+    log_event(now_us, "phase", f, LogLevel::kDebug);
+  }
+  if (s.fault != FaultCode::kNone && (!prev_status_valid_ || s.fault != prev_status_.fault)) {
+    char f[96];
+    std::snprintf(f, sizeof f, "\"code\":%u,\"name\":\"%s\"", static_cast<unsigned>(s.fault), dockcore::to_string(s.fault));
+    log_event(now_us, "fault", f, LogLevel::kWarn);
+  }
+  const bool changed = !prev_status_valid_ || s.state != prev_status_.state || s.fault != prev_status_.fault ||
+                       s.phase != prev_status_.phase || s.retries != prev_status_.retries ||
+                       s.last_command != prev_status_.last_command;
+  last_out_ = out;
+  prev_status_ = s;
+  prev_status_valid_ = true;
+  if (changed || now_us >= next_status_us_) {
+    publish_status(now_us);
+    next_status_us_ = now_us + static_cast<std::uint64_t>(1e6 / cfg_.status_rate_hz);
+  }
+
+  if (io_.clock != nullptr) {
+    const std::uint64_t end = io_.clock->now_us();
+    if (end > now_us && end - now_us > stats_.worst_work_us) stats_.worst_work_us = end - now_us;
+  }
+}
+
+void Daemon::publish_status(std::uint64_t now_us) {
+  const dockcore::TaskStatus& s = last_out_.status;
+  if (io_.can_host != nullptr) {
+    dockcore::hal::StatusMessage m;
+    m.task_state = static_cast<std::uint8_t>(s.state);
+    m.align_phase = s.phase;
+    // The watchdogs' codes are reported even while idle (the task manager faults only in active states).
+    m.fault_code = static_cast<std::uint16_t>(s.fault != FaultCode::kNone ? s.fault
+                                              : chassis_stale_        ? FaultCode::kChassisStale
+                                              : lidar_stale_          ? FaultCode::kLidarStale
+                                                                      : FaultCode::kNone);
+    m.retries = s.retries;
+    m.dock_valid = s.dock_valid;
+    m.dock_in_robot = s.dock_pose;
+    m.stamp_us = now_us;
+    io_.can_host->send_status(m);
+  }
+  if (io_.udp_host != nullptr && io_.udp_host->subscriber_count() > 0) {
+    char buf[dockcore::drivers::kMaxHostReply];
+    const std::size_t n = status_json(buf, sizeof buf, now_us);
+    if (n > 0) io_.udp_host->publish(buf, n, now_us);
+  }
+  ++counters_.status_sent;
+}
+
+std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_us) const {
+  const dockcore::TaskStatus& s = last_out_.status;
+  const FaultCode watchdog_fault = chassis_stale_ ? FaultCode::kChassisStale
+                                   : lidar_stale_ ? FaultCode::kLidarStale
+                                                  : FaultCode::kNone;
+  const dockcore::hal::LidarCounters& lc = io_.lidar->counters();
+  const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
+  const int n = std::snprintf(
+      buf, size,
+      "{\"type\":\"status\",\"stamp_us\":%llu,\"state\":\"%s\",\"state_code\":%u,\"phase\":%u,\"phase_name\":\"%s\","
+      "\"fault\":%u,\"fault_name\":\"%s\",\"watchdog_fault\":%u,\"retries\":%u,\"dock_id\":%u,\"dock_valid\":%s,"
+      "\"dock_x_m\":%.4f,\"dock_y_m\":%.4f,\"dock_yaw_deg\":%.2f,\"last_command\":\"%s\",\"last_result\":\"%s\","
+      "\"charge_enable\":%s,\"contact\":%s,\"charge_current_a\":%.2f,\"battery_v\":%.2f,\"soc\":%.3f,\"estop\":%s,"
+      "\"lidar_stale\":%s,\"chassis_stale\":%s,\"odom_x_m\":%.4f,\"odom_y_m\":%.4f,\"odom_yaw_deg\":%.2f,"
+      "\"cmd_vx_mps\":%.3f,\"cmd_wz_radps\":%.3f,\"teaching\":%s,\"taught\":%s,\"ticks\":%llu,"
+      "\"tick_worst_us\":%llu,\"tick_overruns\":%llu,\"tick_work_worst_us\":%llu,\"scans\":%u,\"detections\":%u,"
+      "\"lidar_crc_errors\":%u,\"lidar_resyncs\":%u,\"lidar_reconnects\":%u,\"can_bad_frames\":%u,"
+      "\"can_send_failures\":%u,\"commands\":%u,\"commands_rejected\":%u,\"resumes\":%u}",
+      static_cast<unsigned long long>(now_us), dockcore::to_string(s.state), static_cast<unsigned>(s.state), s.phase,
+      s.state == TaskState::kAlign ? controller_->phase_name(s.phase) : "", static_cast<unsigned>(s.fault),
+      dockcore::to_string(s.fault), static_cast<unsigned>(watchdog_fault), s.retries, s.dock_id,
+      s.dock_valid ? "true" : "false", static_cast<double>(s.dock_pose.x_m), static_cast<double>(s.dock_pose.y_m),
+      deg(s.dock_pose.yaw_rad), dockcore::to_string(s.last_command), to_string_result(s.last_result),
+      s.charge_enable ? "true" : "false", fb_.charging_contact ? "true" : "false",
+      static_cast<double>(fb_.battery_current_a), static_cast<double>(fb_.battery_voltage_v),
+      static_cast<double>(fb_.soc), fb_.estop ? "true" : "false", lidar_stale_ ? "true" : "false",
+      chassis_stale_ ? "true" : "false", static_cast<double>(odom_.x_m), static_cast<double>(odom_.y_m),
+      deg(odom_.yaw_rad), static_cast<double>(prev_cmd_.vx_mps), static_cast<double>(prev_cmd_.wz_radps),
+      teach_.active ? "true" : "false", state_.find(s.dock_id) != nullptr ? "true" : "false",
+      static_cast<unsigned long long>(stats_.ticks), static_cast<unsigned long long>(stats_.worst_period_us),
+      static_cast<unsigned long long>(stats_.overruns), static_cast<unsigned long long>(stats_.worst_work_us),
+      counters_.scans, counters_.detections, lc.crc_errors, lc.resyncs, lc.reconnects, cc.bad_frames,
+      cc.send_failures, counters_.commands, counters_.commands_rejected, counters_.resumes);
+  if (n < 0 || static_cast<std::size_t>(n) >= size) return 0;
+  return static_cast<std::size_t>(n);
+}
+
+}  // namespace dockd

@@ -1,0 +1,223 @@
+#pragma once
+/// @file dockd's logic, free of OS event handling so a host test can run it with in-memory fakes: the lidar, the
+/// chassis link, the host links (CAN host frames, UDP JSON), the camera and the clock come in as HAL references;
+/// main.cpp only builds the real drivers and runs the epoll loop around it.
+///
+/// Per control tick (on_tick, 50 Hz): chassis poll (odometry from the measured wheel speeds), lidar scans
+/// (Dockcore::on_scan with the odometry pose at the scan time), camera, host requests (at most one task command per
+/// tick reaches the task manager; the rest wait in a bounded queue), watchdogs, Dockcore::tick, kinematics
+/// (saturation keeping curvature, acceleration limit, twist → wheels), send_wheels, charge request, status (CAN +
+/// UDP stream at status_rate_hz and on every change), event log, teach progress, tick-period statistics.
+/// Watchdogs: lidar (no scan received for lidar_stale_ms) or chassis (no wheel feedback for chassis_stale_ms) stale
+/// → zero wheel command on that same tick, the task manager faults (185 / 184) and, when the data returns and stays
+/// fresh for resume_hold_ms, the interrupted command is re-issued (docs/dockd.md, "Watchdogs").
+/// Allocation: the object is large (Dockcore) — create it once at start-up (heap); no allocation per tick.
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "config.hpp"
+#include "session_record.hpp"
+#include "state_file.hpp"
+#include "dockcore/controllers.hpp"
+#include "dockcore/dockcore.hpp"
+#include "dockcore/hal/camera.hpp"
+#include "dockcore/hal/chassis.hpp"
+#include "dockcore/hal/clock.hpp"
+#include "dockcore/hal/host_link.hpp"
+#include "dockcore/hal/lidar.hpp"
+#include "dockcore/drivers/udp_host_link.hpp"
+
+namespace dockd {
+
+/// What the daemon talks to. lidar, chassis and clock are required; the rest may be null.
+struct DaemonIo {
+  dockcore::hal::LidarSource* lidar = nullptr;
+  dockcore::hal::ChassisLink* chassis = nullptr;
+  dockcore::hal::HostLink* can_host = nullptr;           ///< CAN host command / status frames.
+  dockcore::drivers::UdpHostLink* udp_host = nullptr;    ///< JSON requests and the status stream.
+  dockcore::hal::CameraTargetSource* camera = nullptr;
+  const dockcore::hal::Clock* clock = nullptr;
+  RotatingLog* event_log = nullptr;                      ///< JSON-lines event log (may be closed).
+  /// Also print events at or above this level to stderr (journal). kError..kDebug.
+  LogLevel stderr_level = LogLevel::kInfo;
+};
+
+/// Control-loop timing, measured between consecutive on_tick calls.
+struct TickStats {
+  std::uint64_t ticks = 0;
+  std::uint64_t last_period_us = 0;
+  std::uint64_t worst_period_us = 0;  ///< Longest period since start.
+  std::uint64_t overruns = 0;         ///< Periods longer than 1.5 × the nominal 20 ms.
+  std::uint64_t worst_work_us = 0;    ///< Longest time spent inside on_tick (clock before and after).
+};
+
+/// Counters the daemon itself keeps (the drivers keep theirs).
+struct DaemonCounters {
+  std::uint32_t commands = 0;          ///< Task commands handed to the task manager.
+  std::uint32_t commands_rejected = 0; ///< By the task manager or dockd (unknown dock id, queue full).
+  std::uint32_t queue_overflows = 0;
+  std::uint32_t scans = 0;
+  std::uint32_t detections = 0;
+  std::uint32_t lidar_stale_trips = 0;
+  std::uint32_t chassis_stale_trips = 0;
+  std::uint32_t resumes = 0;
+  std::uint32_t wheel_send_failures = 0;
+  std::uint32_t status_sent = 0;
+};
+
+class Daemon {
+ public:
+  /// `config` is copied. Call start() before anything else.
+  Daemon(const DockdConfig& config, const DaemonIo& io);
+  ~Daemon();
+
+  /// Loads the state file (taught targets; a corrupt file is reported and the backup used), configures Dockcore
+  /// for the default dock, logs "start". False + message when the core refuses the configuration.
+  bool start(std::string& error);
+
+  /// One control tick at CLOCK_MONOTONIC `now_us`. Bounded cost (see file comment).
+  void on_tick(std::uint64_t now_us);
+  /// Readiness hints from the event loop: drain that source now (the tick drains everything anyway).
+  void on_lidar_readable(std::uint64_t now_us);
+  void on_chassis_readable(std::uint64_t now_us);
+  void on_host_readable(std::uint64_t now_us);
+  void on_camera_readable(std::uint64_t now_us);
+
+  /// Stop path (SIGTERM/SIGINT, fatal errors, end of tests): sends `frames` zero wheel commands back to back
+  /// (main spaces them one tick apart by calling this once per frame) and logs the reason once. O(frames).
+  void send_zero(std::uint64_t now_us, int frames = 1);
+  /// Logs the shutdown event (reason) once; the caller sends the zero frames.
+  void log_shutdown(std::uint64_t now_us, const char* reason);
+  /// A free-form event (SIGHUP, reconnects) into the event log: `fields` is a JSON fragment without braces.
+  void log_event(std::uint64_t now_us, const char* event, const char* fields, LogLevel level = LogLevel::kInfo);
+
+  // Introspection (tests, status).
+  dockcore::TaskState state() const;
+  dockcore::FaultCode fault() const;
+  const dockcore::TaskStatus& last_status() const { return last_out_.status; }
+  const dockcore::hal::WheelCommand& last_wheels() const { return last_wheels_; }
+  bool lidar_stale() const { return lidar_stale_; }
+  bool chassis_stale() const { return chassis_stale_; }
+  const TickStats& tick_stats() const { return stats_; }
+  const DaemonCounters& counters() const { return counters_; }
+  const dockcore::Pose2& odom_pose() const { return odom_; }
+  const StateData& state_data() const { return state_; }
+  bool teaching() const { return teach_.active; }
+  /// The profile currently configured (after any taught/configured target correction) and its dock id.
+  std::uint16_t active_dock_id() const { return active_dock_; }
+  /// Current status as one JSON object (no newline). Returns the length (0 when it does not fit). O(1).
+  std::size_t status_json(char* buf, std::size_t size, std::uint64_t now_us) const;
+
+ private:
+  struct PendingCommand {
+    dockcore::HostCommandType type = dockcore::HostCommandType::kNone;
+    std::uint16_t dock_id = 0;
+    bool from_udp = false;
+    dockcore::drivers::HostRequest request{};
+    bool resume = false;  ///< Re-issued by the watchdog resume, not by a host.
+  };
+  struct OdomSample {
+    std::uint64_t stamp_us = 0;
+    dockcore::Pose2 pose{};
+  };
+  struct Teach {
+    bool active = false;
+    std::uint16_t dock_id = 0;
+    std::uint16_t wanted = 0;
+    std::uint16_t have = 0;
+    double sx = 0, sy = 0, sc = 0, ss = 0;  // sums of x, y, cos yaw, sin yaw
+    dockcore::Pose2 samples[1000];
+    std::uint64_t deadline_us = 0;
+    dockcore::drivers::HostRequest request{};
+  };
+
+  void poll_chassis(std::uint64_t now_us);
+  void poll_lidar(std::uint64_t now_us);
+  void poll_camera(std::uint64_t now_us);
+  void poll_hosts(std::uint64_t now_us);
+  void handle_udp_request(const dockcore::drivers::HostRequest& r, std::uint64_t now_us);
+  bool enqueue(const PendingCommand& c);
+  void reply_error(const dockcore::drivers::HostRequest& r, dockcore::drivers::HostErrorCode code, const char* msg);
+  void reply_json(const dockcore::drivers::HostRequest& r, const char* json, std::size_t len);
+  /// Configures Dockcore for `dock_id` (profile corrected by its taught / configured target). Resets the task
+  /// manager: only while idle.
+  bool configure_core(std::uint16_t dock_id, bool raw_profile);
+  dockcore::Pose2 odom_at(std::uint64_t stamp_us) const;
+  void watchdogs(std::uint64_t now_us);
+  void start_teach(const dockcore::drivers::HostRequest& r, std::uint64_t now_us);
+  void teach_sample(const dockcore::DockEstimate& e);
+  void teach_progress(std::uint64_t now_us);
+  void finish_teach(bool ok, const char* why, std::uint64_t now_us);
+  void publish_status(std::uint64_t now_us);
+  void send_wheels(const dockcore::hal::WheelCommand& w);
+  void emit_event(LogLevel level, const char* line, std::size_t len);
+
+  DockdConfig cfg_;
+  DaemonIo io_;
+  dockcore::Seed000Controller seed000_;
+  dockcore::Seed004Controller seed004_;
+  dockcore::Seed003Controller seed003_;
+  dockcore::SmoothController smooth_;
+  dockcore::DockingController* controller_ = nullptr;
+  std::unique_ptr<dockcore::Dockcore> core_;
+  std::unique_ptr<dockcore::LaserScan> scan_;
+  std::unique_ptr<Teach> teach_storage_;
+  Teach& teach_;
+  dockcore::DockcoreConfig core_cfg_{};
+  StateData state_;
+  std::uint16_t active_dock_ = 0;
+  bool active_raw_ = false;
+
+  // Odometry.
+  dockcore::Pose2 odom_{};
+  dockcore::Twist2 odom_twist_{};
+  bool have_wheels_ = false;
+  std::uint64_t last_wheels_stamp_us_ = 0;
+  OdomSample history_[64];
+  std::size_t history_next_ = 0;
+  dockcore::hal::ChassisFeedback fb_{};
+
+  // Lidar and camera.
+  bool have_scan_ = false;
+  std::uint64_t last_scan_rx_us_ = 0;
+  dockcore::CameraTarget camera_{};
+
+  // Commands.
+  static constexpr std::size_t kQueue = 8;
+  PendingCommand queue_[kQueue];
+  std::size_t queue_head_ = 0, queue_size_ = 0;
+
+  // Watchdogs and resume.
+  bool lidar_stale_ = true, chassis_stale_ = true;
+  bool started_ = false;
+  std::uint64_t start_us_ = 0;
+  dockcore::HostCommandType interrupted_ = dockcore::HostCommandType::kNone;
+  std::uint16_t interrupted_dock_ = 0;
+  std::uint64_t fresh_since_us_ = 0;
+  std::uint8_t resumes_this_task_ = 0;
+  dockcore::HostCommandType running_cmd_ = dockcore::HostCommandType::kNone;
+  std::uint16_t running_dock_ = 0;
+
+  // Output.
+  dockcore::TickOutput last_out_{};
+  dockcore::Twist2 prev_cmd_{};
+  dockcore::hal::WheelCommand last_wheels_{};
+  bool charge_requested_ = false;
+  std::uint32_t charge_refresh_ = 0;
+  std::uint64_t next_status_us_ = 0;
+  dockcore::TaskStatus prev_status_{};
+  bool prev_status_valid_ = false;
+
+  TickStats stats_{};
+  std::uint64_t prev_tick_us_ = 0;
+  DaemonCounters counters_{};
+  bool shutdown_logged_ = false;
+};
+
+/// Short stable name of a task result ("none", "docked", ...). Never null.
+const char* to_string_result(dockcore::TaskResult r);
+
+}  // namespace dockd

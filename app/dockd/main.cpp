@@ -1,0 +1,323 @@
+// dockd: builds the real drivers from the config and runs the epoll loop around dockd::Daemon (daemon.hpp).
+// Exit codes: 0 stopped by SIGTERM/SIGINT (after zero-velocity frames) or --check-config OK; 1 runtime failure
+// (event loop error; zero frames are sent first); 2 usage or config error (file:line:column: message);
+// 3 a device could not be opened at start (CAN interface, lidar options, UDP ports).
+#include <sys/epoll.h>
+#include <sys/signalfd.h>
+#include <sys/timerfd.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#ifdef DOCKD_HAVE_SYSTEMD
+#include <systemd/sd-daemon.h>
+#endif
+
+#include "config.hpp"
+#include "daemon.hpp"
+#include "session_record.hpp"
+#include "dockcore/drivers/can_link.hpp"
+#include "dockcore/drivers/lidar_driver.hpp"
+#include "dockcore/drivers/udp_camera.hpp"
+#include "dockcore/drivers/udp_host_link.hpp"
+
+namespace {
+
+std::uint64_t mono_us() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::uint64_t>(ts.tv_sec) * 1000000u + static_cast<std::uint64_t>(ts.tv_nsec) / 1000u;
+}
+
+class MonotonicClock final : public dockcore::hal::Clock {
+ public:
+  std::uint64_t now_us() const override { return mono_us(); }
+};
+
+// DEVELOPMENT ONLY ([can] interface = "fake" plus --allow-fake-can): a bus with nothing on it. Frames sent are
+// accepted (and recorded) but no chassis ever answers, so the chassis watchdog holds the robot at zero velocity and
+// any task faults with 184. It exists to run dockd's process-level tests on a kernel without CAN; it can never
+// make dockd drive.
+class NoChassisBus final : public dockcore::hal::CanBus {
+ public:
+  bool send(const dockcore::CanFrame&) override {
+    ++c_.frames_sent;
+    return true;
+  }
+  bool receive(dockcore::CanFrame&, std::uint64_t&) override { return false; }
+  int fd() const override { return -1; }
+  const dockcore::hal::CanBusCounters& counters() const override { return c_; }
+
+ private:
+  dockcore::hal::CanBusCounters c_{};
+};
+
+void notify(const char* what) {
+#ifdef DOCKD_HAVE_SYSTEMD
+  sd_notify(0, what);
+#else
+  (void)what;
+#endif
+}
+
+enum Tag : std::uint64_t { kTimer = 1, kSignal, kLidar, kCan, kHost, kCamera };
+
+struct Registration {
+  int fd = -1;
+};
+
+bool epoll_set(int ep, Registration& reg, int fd, Tag tag) {
+  if (reg.fd == fd) return true;
+  if (reg.fd >= 0) ::epoll_ctl(ep, EPOLL_CTL_DEL, reg.fd, nullptr);  // may already be closed: harmless
+  reg.fd = -1;
+  if (fd < 0) return true;
+  epoll_event ev{};
+  ev.events = EPOLLIN;
+  ev.data.u64 = tag;
+  if (::epoll_ctl(ep, EPOLL_CTL_ADD, fd, &ev) != 0) return false;
+  reg.fd = fd;
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"dockd: autonomous docking daemon (lidar + CAN chassis + host link). docs/dockd.md"};
+  std::string config_path, log_level, record_dir;
+  bool check_only = false, foreground = false, allow_fake_can = false;
+  app.add_option("--config,-c", config_path, "TOML configuration file")->required();
+  app.add_flag("--check-config", check_only, "validate the configuration and exit (0 valid, 2 invalid)");
+  app.add_option("--log-level", log_level, "error | warn | info | debug (overrides [log] level)")
+      ->check(CLI::IsMember({"error", "warn", "info", "debug"}));
+  app.add_option("--record-dir", record_dir, "session record directory (overrides [record] dir)");
+  app.add_flag("--foreground", foreground, "stay in the foreground (dockd never forks; accepted for init scripts)");
+  app.add_flag("--allow-fake-can", allow_fake_can,
+               "DEVELOPMENT ONLY: permit [can] interface = \"fake\" (no chassis; the robot never moves)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+
+  dockd::DockdConfig cfg;
+  try {
+    cfg = dockd::load_config_file(config_path);
+  } catch (const dockd::ConfigError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  }
+  if (!log_level.empty()) dockd::parse_log_level(log_level, cfg.log_level);
+  if (!record_dir.empty()) cfg.record_dir = record_dir;
+  if (cfg.can_interface == "fake" && !allow_fake_can) {
+    std::fprintf(stderr, "%s: [can] interface = \"fake\" is for development only and needs --allow-fake-can\n",
+                 config_path.c_str());
+    return 2;
+  }
+  if (check_only) {
+    std::printf("%s: valid (%zu dock(s), controller %s, CAN %s %s, lidar %s)\n", config_path.c_str(), cfg.docks.size(),
+                cfg.controller.c_str(), cfg.can_interface.c_str(), dockcore::drivers::to_string(cfg.can.protocol),
+                dockcore::drivers::to_string(cfg.lidar.protocol));
+    return 0;
+  }
+
+  // Signals go through signalfd: block them before any thread or fd exists.
+  sigset_t sigs;
+  sigemptyset(&sigs);
+  sigaddset(&sigs, SIGTERM);
+  sigaddset(&sigs, SIGINT);
+  sigaddset(&sigs, SIGHUP);
+  sigprocmask(SIG_BLOCK, &sigs, nullptr);
+  std::signal(SIGPIPE, SIG_IGN);
+
+  // Session record.
+  dockd::RotatingLog can_log, event_log;
+  if (!cfg.record_dir.empty()) {
+    std::string err;
+    if (!can_log.open(cfg.record_dir, "can.log", cfg.record_max_bytes, cfg.record_max_files, err) ||
+        !event_log.open(cfg.record_dir, "events.jsonl", cfg.record_max_bytes, cfg.record_max_files, err)) {
+      std::fprintf(stderr, "dockd: session record: %s\n", err.c_str());
+      return 3;
+    }
+  }
+
+  // CAN.
+  std::unique_ptr<dockcore::drivers::SocketCanBus> socketcan;
+  NoChassisBus fake_bus;
+  dockcore::hal::CanBus* raw_bus = nullptr;
+  if (cfg.can_interface == "fake") {
+    std::fprintf(stderr, "dockd: WARNING: [can] interface = \"fake\": DEVELOPMENT ONLY, no chassis attached; the "
+                         "robot will not move and every task faults (184)\n");
+    raw_bus = &fake_bus;
+  } else {
+    std::uint32_t ids[64];
+    const std::size_t n = dockcore::drivers::can_link_rx_ids(cfg.can, ids, 64);
+    std::string err;
+    socketcan = dockcore::drivers::open_socketcan(cfg.can_interface, ids, n, err);
+    if (!socketcan) {
+      std::fprintf(stderr, "dockd: cannot open CAN interface '%s': %s\n", cfg.can_interface.c_str(), err.c_str());
+      return 3;
+    }
+    raw_bus = socketcan.get();
+  }
+  dockd::RecordingCanBus bus(*raw_bus, can_log, cfg.can_interface);
+  std::unique_ptr<dockcore::drivers::CanLink> can = dockcore::drivers::make_can_link(bus, cfg.can);
+
+  // Lidar.
+  std::string err;
+  std::unique_ptr<dockcore::drivers::LidarDriver> lidar = dockcore::drivers::make_lidar_driver(cfg.lidar, err);
+  if (!lidar) {
+    std::fprintf(stderr, "dockd: lidar: %s\n", err.c_str());
+    return 3;
+  }
+  if (!lidar->connected()) {
+    std::fprintf(stderr, "dockd: lidar %s not connected yet (%s); retrying\n", cfg.lidar.device.c_str(),
+                 lidar->last_error());
+  }
+
+  // Host and camera.
+  std::unique_ptr<dockcore::drivers::UdpHostLink> host;
+  if (cfg.host_enabled) {
+    host = dockcore::drivers::open_udp_host_link(cfg.host, err);
+    if (!host) {
+      std::fprintf(stderr, "dockd: %s\n", err.c_str());
+      return 3;
+    }
+  }
+  std::unique_ptr<dockcore::drivers::UdpCamera> camera;
+  if (cfg.camera_enabled) {
+    camera = dockcore::drivers::open_udp_camera(cfg.camera, err);
+    if (!camera) {
+      std::fprintf(stderr, "dockd: %s\n", err.c_str());
+      return 3;
+    }
+  }
+
+  MonotonicClock clock;
+  dockd::DaemonIo io;
+  io.lidar = lidar.get();
+  io.chassis = can.get();
+  io.can_host = can.get();
+  io.udp_host = host.get();
+  io.camera = camera.get();
+  io.clock = &clock;
+  io.event_log = &event_log;
+  io.stderr_level = cfg.log_level;
+  auto daemon = std::make_unique<dockd::Daemon>(cfg, io);
+  if (!daemon->start(err)) {
+    std::fprintf(stderr, "dockd: %s\n", err.c_str());
+    return 2;
+  }
+
+  // Event loop.
+  const int ep = ::epoll_create1(EPOLL_CLOEXEC);
+  const int tfd = ::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
+  const int sfd = ::signalfd(-1, &sigs, SFD_NONBLOCK | SFD_CLOEXEC);
+  if (ep < 0 || tfd < 0 || sfd < 0) {
+    std::fprintf(stderr, "dockd: epoll/timerfd/signalfd: %s\n", std::strerror(errno));
+    daemon->send_zero(mono_us(), 5);
+    return 1;
+  }
+  itimerspec its{};
+  its.it_interval.tv_nsec = 20 * 1000 * 1000;  // 50 Hz
+  its.it_value.tv_nsec = 20 * 1000 * 1000;
+  ::timerfd_settime(tfd, 0, &its, nullptr);
+  Registration r_timer, r_sig, r_lidar, r_can, r_host, r_cam;
+  bool ok = epoll_set(ep, r_timer, tfd, kTimer) && epoll_set(ep, r_sig, sfd, kSignal) &&
+            epoll_set(ep, r_can, bus.fd(), kCan) && epoll_set(ep, r_lidar, lidar->fd(), kLidar);
+  if (host) ok = ok && epoll_set(ep, r_host, host->fd(), kHost);
+  if (camera) ok = ok && epoll_set(ep, r_cam, camera->fd(), kCamera);
+  if (!ok) {
+    std::fprintf(stderr, "dockd: epoll_ctl: %s\n", std::strerror(errno));
+    daemon->send_zero(mono_us(), 5);
+    return 1;
+  }
+
+  std::uint64_t watchdog_usec = 0;
+#ifdef DOCKD_HAVE_SYSTEMD
+  if (sd_watchdog_enabled(0, &watchdog_usec) <= 0) watchdog_usec = 0;
+#endif
+  const std::uint64_t watchdog_every = watchdog_usec / cfg.systemd_watchdog_divider;
+  std::uint64_t next_watchdog = mono_us();
+  notify("READY=1\nSTATUS=docking daemon running");
+  std::fprintf(stderr, "dockd: running (CAN %s, lidar %s %s, host udp %s:%u)\n", cfg.can_interface.c_str(),
+               dockcore::drivers::to_string(cfg.lidar.protocol),
+               cfg.lidar.transport == dockcore::drivers::LidarTransport::kSerial ? cfg.lidar.device.c_str() : "udp",
+               cfg.host.bind_address.c_str(), host ? host->bound_port() : 0);
+
+  int exit_code = 0;
+  const char* stop_reason = nullptr;
+  while (stop_reason == nullptr) {
+    epoll_event evs[8];
+    const int n = ::epoll_wait(ep, evs, 8, 100);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      std::fprintf(stderr, "dockd: epoll_wait: %s\n", std::strerror(errno));
+      stop_reason = "epoll_failure";
+      exit_code = 1;
+      break;
+    }
+    for (int i = 0; i < n && stop_reason == nullptr; ++i) {
+      const std::uint64_t now = mono_us();
+      switch (evs[i].data.u64) {
+        case kTimer: {
+          std::uint64_t expirations = 0;
+          if (::read(tfd, &expirations, sizeof expirations) < 0) break;
+          if (socketcan) socketcan->service(now);
+          can->service(now);
+          lidar->service(now);
+          daemon->on_tick(now);
+          // Drivers may have reopened their devices: follow the new descriptors.
+          epoll_set(ep, r_lidar, lidar->fd(), kLidar);
+          epoll_set(ep, r_can, bus.fd(), kCan);
+          if (watchdog_every > 0 && now >= next_watchdog) {
+            notify("WATCHDOG=1");
+            next_watchdog = now + watchdog_every;
+          }
+          break;
+        }
+        case kSignal: {
+          signalfd_siginfo si{};
+          while (::read(sfd, &si, sizeof si) == static_cast<ssize_t>(sizeof si)) {
+            if (si.ssi_signo == SIGTERM) stop_reason = "SIGTERM";
+            else if (si.ssi_signo == SIGINT) stop_reason = "SIGINT";
+            else if (si.ssi_signo == SIGHUP) {
+              daemon->log_event(now, "sighup", "\"action\":\"ignored: config reload is not supported; restart dockd\"",
+                                dockd::LogLevel::kWarn);
+            }
+          }
+          break;
+        }
+        case kLidar: daemon->on_lidar_readable(now); break;
+        case kCan: daemon->on_chassis_readable(now); break;
+        case kHost: daemon->on_host_readable(now); break;
+        case kCamera: daemon->on_camera_readable(now); break;
+        default: break;
+      }
+    }
+  }
+
+  // Every exit path from the loop commands zero: several frames, one tick apart, so a base that misses one (bus
+  // load, its own filtering of duplicates) still sees the stop.
+  notify("STOPPING=1");
+  daemon->log_shutdown(mono_us(), stop_reason);
+  for (int i = 0; i < 5; ++i) {
+    daemon->send_zero(mono_us(), 1);
+    timespec ts{0, 20 * 1000 * 1000};
+    ::nanosleep(&ts, nullptr);
+  }
+  std::fprintf(stderr, "dockd: stopped (%s), zero velocity sent\n", stop_reason);
+  ::close(tfd);
+  ::close(sfd);
+  ::close(ep);
+  return exit_code;
+}

@@ -1,0 +1,197 @@
+#include "state_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cinttypes>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace dockd {
+
+const TaughtTarget* StateData::find(std::uint16_t dock_id) const {
+  for (const TaughtTarget& t : targets) {
+    if (t.dock_id == dock_id) return &t;
+  }
+  return nullptr;
+}
+
+void StateData::put(const TaughtTarget& t) {
+  for (TaughtTarget& o : targets) {
+    if (o.dock_id == t.dock_id) {
+      o = t;
+      return;
+    }
+  }
+  targets.push_back(t);
+}
+
+std::uint32_t crc32_ieee(const char* data, std::size_t len) {
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (std::size_t i = 0; i < len; ++i) {
+    c ^= static_cast<std::uint8_t>(data[i]);
+    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+  }
+  return ~c;
+}
+
+std::string serialize_state(const StateData& s) {
+  std::string body = "dockd-state 1\n";
+  for (const TaughtTarget& t : s.targets) {
+    char line[256];
+    std::snprintf(line, sizeof line, "target %u %.9f %.9f %.9f %u %.6f %" PRIu64 "\n", t.dock_id,
+                  static_cast<double>(t.target.x_m), static_cast<double>(t.target.y_m),
+                  static_cast<double>(t.target.yaw_rad), t.scans, t.spread_m, t.taught_unix_s);
+    body += line;
+  }
+  char crc[32];
+  std::snprintf(crc, sizeof crc, "crc32 %08x\n", crc32_ieee(body.data(), body.size()));
+  return body + crc;
+}
+
+bool parse_state(const std::string& text, StateData& out, std::string& error) {
+  const std::size_t pos = text.rfind("crc32 ");
+  if (pos == std::string::npos || (pos > 0 && text[pos - 1] != '\n')) {
+    error = "no checksum line (truncated?)";
+    return false;
+  }
+  unsigned crc = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str() + pos, "crc32 %8x%c", &crc, &tail) != 2 || tail != '\n' || pos + 15 != text.size()) {
+    error = "malformed checksum line";
+    return false;
+  }
+  if (crc32_ieee(text.data(), pos) != crc) {
+    error = "checksum mismatch (file corrupted)";
+    return false;
+  }
+  std::istringstream in(text.substr(0, pos));
+  std::string line;
+  if (!std::getline(in, line) || line != "dockd-state 1") {
+    error = "unknown header '" + line + "'";
+    return false;
+  }
+  StateData s;
+  while (std::getline(in, line)) {
+    TaughtTarget t;
+    unsigned id = 0, scans = 0;
+    double x = 0, y = 0, yaw = 0, spread = 0;
+    std::uint64_t when = 0;
+    int used = 0;
+    if (std::sscanf(line.c_str(), "target %u %lf %lf %lf %u %lf %" SCNu64 "%n", &id, &x, &y, &yaw, &scans, &spread,
+                    &when, &used) != 7 ||
+        static_cast<std::size_t>(used) != line.size() || id > 65535 || scans > 65535) {
+      error = "bad line '" + line + "'";
+      return false;
+    }
+    t.dock_id = static_cast<std::uint16_t>(id);
+    t.target = dockcore::Pose2{static_cast<dockcore::Real>(x), static_cast<dockcore::Real>(y),
+                               static_cast<dockcore::Real>(yaw)};
+    t.scans = static_cast<std::uint16_t>(scans);
+    t.spread_m = spread;
+    t.taught_unix_s = when;
+    s.put(t);
+  }
+  out = s;
+  return true;
+}
+
+namespace {
+
+enum class ReadResult { kOk, kMissing, kBad };
+
+ReadResult read_file(const std::string& path, StateData& out, std::string& why) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    if (errno == ENOENT) return ReadResult::kMissing;
+    why = std::string("cannot open: ") + std::strerror(errno);
+    return ReadResult::kBad;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_state(ss.str(), out, why) ? ReadResult::kOk : ReadResult::kBad;
+}
+
+std::string dir_of(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string(".") : (slash == 0 ? std::string("/") : path.substr(0, slash));
+}
+
+}  // namespace
+
+StateLoadStatus load_state(const std::string& path, StateData& out, std::string& message) {
+  std::string why;
+  const ReadResult r = read_file(path, out, why);
+  if (r == ReadResult::kOk) return StateLoadStatus::kOk;
+  std::string bak_why;
+  StateData bak;
+  const ReadResult rb = read_file(path + ".bak", bak, bak_why);
+  if (r == ReadResult::kMissing) {
+    if (rb == ReadResult::kOk) {
+      // A crash between the two renames of save_state leaves only the backup.
+      out = bak;
+      message = "state file " + path + " missing; using the backup " + path + ".bak";
+      return StateLoadStatus::kRecoveredBackup;
+    }
+    out = StateData{};
+    return StateLoadStatus::kMissing;
+  }
+  // Keep the bad file for inspection, out of the way of the next save.
+  std::rename(path.c_str(), (path + ".corrupt").c_str());
+  if (rb == ReadResult::kOk) {
+    out = bak;
+    message = "state file " + path + " is corrupt (" + why + "), moved to " + path + ".corrupt; using the last good copy " +
+              path + ".bak";
+    return StateLoadStatus::kRecoveredBackup;
+  }
+  out = StateData{};
+  message = "state file " + path + " is corrupt (" + why + "), moved to " + path + ".corrupt; no good backup: taught targets lost";
+  return StateLoadStatus::kCorruptNoBackup;
+}
+
+bool save_state(const std::string& path, const StateData& s, std::string& error) {
+  const std::string text = serialize_state(s);
+  const std::string tmp = path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    error = "cannot create " + tmp + ": " + std::strerror(errno);
+    return false;
+  }
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      error = "cannot write " + tmp + ": " + std::strerror(errno);
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      return false;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    error = "cannot fsync " + tmp + ": " + std::strerror(errno);
+    ::unlink(tmp.c_str());
+    return false;
+  }
+  // The current file becomes the backup only if it is good: a corrupt file must never replace a good backup.
+  StateData current;
+  std::string why;
+  if (read_file(path, current, why) == ReadResult::kOk) std::rename(path.c_str(), (path + ".bak").c_str());
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    error = "cannot rename " + tmp + " to " + path + ": " + std::strerror(errno);
+    return false;
+  }
+  const int dfd = ::open(dir_of(path).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+  return true;
+}
+
+}  // namespace dockd
