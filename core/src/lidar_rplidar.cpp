@@ -150,7 +150,12 @@ void RplidarParser::process() {
 
 void RplidarParser::on_node(const RplidarNode& n, std::uint64_t stamp_us) {
   ++counters_.packets;
-  if (n.start) {
+  // Turn boundary: the S bit, but only once the turn has reached angles more than 180 deg above this node's.
+  // Without a checksum a misaligned node after corruption can carry a stray S=1 mid-turn; it would split the turn.
+  const bool wrapped = turn_open_ && n.angle_q6 + kFullTurnQ6 / 2 < prev_q6_;
+  if (n.start && turn_open_ && !wrapped) ++counters_.stray_start;
+  if (n.start && (!turn_open_ || wrapped)) {
+    prev_q6_ = 0;
     if (turn_open_) out_.publish(counters_);
     out_.building().begin(stamp_us);
     turn_open_ = true;
@@ -159,6 +164,7 @@ void RplidarParser::on_node(const RplidarNode& n, std::uint64_t stamp_us) {
     ++counters_.samples_discarded;
     return;
   }
+  if (n.angle_q6 > prev_q6_) prev_q6_ = n.angle_q6;  // the turn's largest angle so far
   const Real deg = static_cast<Real>(n.angle_q6) / static_cast<Real>(64);
   const Real range_m = static_cast<Real>(n.distance_q2) / static_cast<Real>(4000);
   out_.building().add(cfg_.convention.to_core(deg_to_rad(deg)), range_m, static_cast<Real>(n.quality));

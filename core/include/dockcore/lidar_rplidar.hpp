@@ -59,8 +59,10 @@ struct RplidarConfig {
 /// Byte-at-a-time RPLIDAR parser. At every position it tries, in order: a known 7-byte response descriptor (scan,
 /// health, info; health and info are followed by their payload), then — once a scan descriptor was seen — a 5-byte
 /// node passing the S/!S and check-bit tests. When neither fits, the first byte is dropped and the rest rescanned
-/// (counted: dropped_bytes, and resyncs when the stream had been in sync). A new turn starts at an S=1 node; nodes
-/// before the first S=1 are discarded (samples_discarded). Storage ~130 KiB; O(1) amortised per byte, worst case
+/// (counted: dropped_bytes, and resyncs when the stream had been in sync). A new turn starts at an S=1 node once the turn
+/// in progress has reached angles more than 180 deg above it; a stray S=1 mid-turn (a misaligned node after
+/// corruption) is ignored and counted (stray_start). Nodes before the first turn start are discarded
+/// (samples_discarded). Storage ~130 KiB; O(1) amortised per byte, worst case
 /// O(27) per byte on garbage, plus O(bins) per published scan. No checksum exists in this mode, so corrupted node
 /// bytes that still pass the bit tests are decoded: the grid keeps the nearest return per bin.
 class RplidarParser {
@@ -98,6 +100,7 @@ class RplidarParser {
   bool synced_ = false;
   bool scanning_ = false;
   bool turn_open_ = false;
+  std::uint16_t prev_q6_ = 0;  ///< Largest angle of the turn in progress.
 };
 
 /// Encodes scans as the sensor streams them: M = round(2 pi / |increment|) nodes per turn clockwise from sensor

@@ -32,6 +32,7 @@ struct LidarParserCounters {
   std::uint32_t samples = 0;        ///< Samples put into scans.
   std::uint32_t samples_discarded = 0; ///< Samples of a partial first turn, or before the first RPLIDAR S=1 node.
   std::uint32_t bin_collisions = 0; ///< Samples that fell into an already filled grid bin (see LidarScanAssembler).
+  std::uint32_t stray_start = 0;    ///< RPLIDAR: S=1 nodes ignored because the turn had not wrapped yet.
   std::uint32_t scans_overwritten = 0; ///< A ready scan was replaced by a newer one before take_scan() read it.
 };
 

@@ -3,12 +3,17 @@
 /// (bound socket). The byte decoding is core's (byte-at-a-time parsers); drivers only move bytes and stamp scans.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 
 #include "dockcore/hal/lidar.hpp"
+#include "dockcore/lidar_lakibeam.hpp"
+#include "dockcore/lidar_ld06.hpp"
+#include "dockcore/lidar_rplidar.hpp"
+#include "dockcore/lidar_scan_assembler.hpp"
 
 namespace dockcore::drivers {
 
@@ -34,6 +39,12 @@ struct LidarDriverOptions {
   std::uint16_t udp_port = 2368;              ///< UDP transport: local port to bind.
   std::uint32_t reconnect_min_ms = 100;       ///< First reopen delay after the device vanished; doubles per failure.
   std::uint32_t reconnect_max_ms = 2000;      ///< Cap on the reopen delay.
+  /// Grid of the published scans (bins per full turn); 0 = the protocol's default (LD06 450, RPLIDAR 360,
+  /// Lakibeam 1440). At most kMaxScanPoints.
+  std::uint32_t bins_per_turn = 0;
+  /// Called with every chunk of raw bytes (serial) or every datagram (UDP) before decoding; empty = none.
+  /// lidar-dump --record uses it. Called from service()/poll_scan() on the caller's thread.
+  std::function<void(const std::uint8_t* data, std::size_t n)> raw_tap;
 };
 
 /// A lidar source with the Linux-side lifecycle dockd needs on top of hal::LidarSource.
@@ -47,7 +58,48 @@ class LidarDriver : public hal::LidarSource {
   virtual bool connected() const = 0;
   /// Human-readable reason of the last open/read failure ("" when none). Never null.
   virtual const char* last_error() const = 0;
+  /// The parser's full counters (superset of counters(): bad span, health packets, bin collisions ...).
+  virtual LidarParserCounters parser_counters() const { return LidarParserCounters{}; }
+  /// UDP transport: the local port actually bound (useful with udp_port 0); 0 for serial.
+  virtual std::uint16_t bound_port() const { return 0; }
 };
+
+/// The protocol's core parser behind one interface (used by the drivers and by lidar-dump). Owns ~130 KiB on the
+/// heap, allocated once here.
+class LidarDecoder {
+ public:
+  explicit LidarDecoder(LidarProtocol protocol);
+  ~LidarDecoder();
+  LidarDecoder(const LidarDecoder&) = delete;
+  LidarDecoder& operator=(const LidarDecoder&) = delete;
+  /// Sets bins per turn (keeps the protocol's other defaults); false when out of [1, kMaxScanPoints].
+  bool configure_grid(std::uint32_t bins_per_turn);
+  /// RPLIDAR only: whether nodes need a scan descriptor first (default true; false to read captures that start
+  /// mid-stream).
+  void set_require_descriptor(bool require);
+  /// Byte-stream protocols (LD06, RPLIDAR): n bytes whose last arrived at last_byte_us; byte i is stamped
+  /// last_byte_us - (n-1-i) * byte_period_us (the wire time of the bytes behind it). Returns scans completed.
+  /// Lakibeam ignores this call (use feed_datagram).
+  std::size_t feed_bytes(const std::uint8_t* data, std::size_t n, std::uint64_t last_byte_us,
+                         std::uint32_t byte_period_us);
+  /// One UDP datagram: Lakibeam parses it whole, LD06 takes its bytes. Returns scans completed.
+  std::size_t feed_datagram(const std::uint8_t* data, std::size_t n, std::uint64_t stamp_us);
+  /// Newest complete scan; false when none is waiting.
+  bool take_scan(LaserScan& out);
+  /// Forget partial packets and the turn in progress (after a reconnect); counters are kept.
+  void reset();
+  const LidarParserCounters& counters() const;
+  LidarProtocol protocol() const { return protocol_; }
+
+ private:
+  LidarProtocol protocol_;
+  std::unique_ptr<Ld06Parser> ld06_;
+  std::unique_ptr<RplidarParser> rplidar_;
+  std::unique_ptr<LakibeamParser> lakibeam_;
+};
+
+/// CLOCK_MONOTONIC in microseconds.
+std::uint64_t monotonic_us();
 
 /// Creates a driver and tries to open it at once. A serial device that does not exist yet is not an error (it is
 /// retried by service()); bad options (unsupported baud, bad address, Lakibeam over serial) return nullptr with a
