@@ -73,6 +73,7 @@ inline LineKind parse_candump_line(std::string_view s, CandumpLine& out) {
   while (i < s.size() && s[i] == ' ') ++i;
   std::size_t n = 0;
   while (i < s.size() && s[i] != ' ' && s[i] != '\t') {
+    if (s[i] < '!' || s[i] > '~') return bad(out, "interface name has a control character");
     if (n < 16) out.iface[n++] = s[i];
     ++i;
   }
