@@ -1,0 +1,67 @@
+# Helpers for HIL cases; sourced inside the VM (bash, vcan0 up, host tree read-only, $OUT writable, /tmp tmpfs).
+# A case prints PASS/FAIL lines through check(); hil_end exits non-zero when any check failed.
+HIL_FAILS=0
+HIL_PIDS=()
+
+hil_begin() {
+  HIL_T0=$(date +%s.%N)
+  trap hil_cleanup EXIT
+  echo "INFO case $CASE on $(uname -r), $(nproc) cpus"
+}
+
+hil_cleanup() {
+  local p
+  for p in "${HIL_PIDS[@]}"; do kill -TERM "$p" 2>/dev/null; done
+  sleep 0.3
+  for p in "${HIL_PIDS[@]}"; do kill -KILL "$p" 2>/dev/null; done
+}
+
+hil_end() {
+  hil_cleanup
+  HIL_PIDS=()
+  trap - EXIT
+  if [ "$HIL_FAILS" -eq 0 ]; then echo "INFO case $CASE passed"; exit 0; fi
+  echo "INFO case $CASE: $HIL_FAILS check(s) failed"; exit 1
+}
+
+# Seconds since the case began (float).
+hil_now() { awk -v a="$HIL_T0" -v b="$(date +%s.%N)" 'BEGIN{printf "%.2f", b-a}'; }
+
+# check NAME COMMAND...: runs the command, prints PASS/FAIL NAME.
+check() {
+  local name="$1"; shift
+  if "$@"; then echo "PASS $name"; else echo "FAIL $name"; HIL_FAILS=$((HIL_FAILS + 1)); fi
+}
+
+# bg NAME COMMAND...: starts a background process with its output in $OUT/NAME.log; remembers its pid in
+# the variable PID_<NAME>.
+bg() {
+  local name="$1"; shift
+  "$@" > "$OUT/$name.log" 2>&1 &
+  local pid=$!
+  HIL_PIDS+=("$pid")
+  printf -v "PID_${name//-/_}" '%s' "$pid"
+}
+
+# wait_for TIMEOUT_S COMMAND...: polls the command every 0.2 s until it succeeds; false on timeout.
+wait_for() {
+  local timeout="$1"; shift
+  local end=$(( $(date +%s) + ${timeout%.*} ))
+  while [ "$(date +%s)" -lt "$end" ]; do
+    "$@" && return 0
+    sleep 0.2
+  done
+  return 1
+}
+
+# Stops a process started with bg by signal (default TERM) and waits for it; prints its exit status.
+stop_bg() {
+  local pid="$1" sig="${2:-TERM}"
+  kill "-$sig" "$pid" 2>/dev/null
+  local st=0
+  wait "$pid" 2>/dev/null || st=$?
+  echo "$st"
+}
+
+# Starts candump on vcan0 into $OUT/candump.log (candump -L format, what dock-decode reads).
+start_candump() { bg candump candump -L vcan0; }
