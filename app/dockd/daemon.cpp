@@ -96,6 +96,11 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
   if (!core_->configure(prof, core_cfg_)) return false;
   active_dock_ = dock_id;
   active_raw_ = raw_profile;
+  // configure() forgets the scan: hand the latest one back so the next tick does not see a lidar without data.
+  if (have_scan_) {
+    const std::uint64_t stamp = scan_->stamp_us != 0 ? scan_->stamp_us : last_scan_rx_us_;
+    core_->on_scan(scan_->view(), stamp, odom_at(stamp));
+  }
   return true;
 }
 
@@ -592,7 +597,9 @@ void Daemon::on_tick(std::uint64_t now_us) {
   // A watchdog fault interrupting a running dock/undock remembers it for the resume.
   if (after == TaskState::kFault && before != TaskState::kFault) {
     const FaultCode f = out.status.fault;
-    if ((f == FaultCode::kChassisStale || f == FaultCode::kLidarStale) && running_cmd_ != HostCommandType::kNone) {
+    // Only faults caused by dockd's own watchdogs resume (not, e.g., the core's backstop scan-age check).
+    if ((f == FaultCode::kChassisStale || f == FaultCode::kLidarStale) && (lidar_stale_ || chassis_stale_) &&
+        running_cmd_ != HostCommandType::kNone) {
       interrupted_ = running_cmd_;
       interrupted_dock_ = running_dock_;
     } else {

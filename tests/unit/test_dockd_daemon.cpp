@@ -1,0 +1,394 @@
+// dockd's Daemon with in-memory fakes closing the loop through dockcore_sim: the simulated chassis (motors, slip,
+// encoders, contacts, charger) behind hal::ChassisLink and the lidar simulator behind hal::LidarSource, in the
+// default scenario's world. Checks a whole dock -> charging -> undock, both watchdogs (zero wheels on the tick the
+// data goes stale, fault code, resume), a UDP command flood, and teach -> state file -> later docking.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include "config.hpp"
+#include "daemon.hpp"
+#include "dockcore/drivers/udp_host_link.hpp"
+#include "docksim/chassis.hpp"
+#include "docksim/lidar_sim.hpp"
+#include "docksim/rng.hpp"
+#include "docksim/scenario.hpp"
+#include "docksim/sim_run.hpp"
+
+#include "CppUTest/TestHarness.h"
+
+using dockcore::TaskState;
+
+namespace {
+
+std::string scenario_path() { return std::string(DOCKCORE_SOURCE_DIR) + "/tools/scenarios/default.toml"; }
+
+struct SimClock final : dockcore::hal::Clock {
+  std::uint64_t t = 1000000;
+  std::uint64_t now_us() const override { return t; }
+};
+
+struct SimChassis final : dockcore::hal::ChassisLink {
+  docksim::Chassis* ch = nullptr;
+  const SimClock* clock = nullptr;
+  bool silent = false;  // feedback stops (the base or the bus died)
+  dockcore::hal::ChassisFeedback fb{};
+  dockcore::hal::ChassisCounters c{};
+  dockcore::hal::WheelCommand last{};
+  int sends = 0;
+  bool send_wheels(const dockcore::hal::WheelCommand& w) override {
+    last = w;
+    ++sends;
+    docksim::WheelRadps r{};
+    for (std::size_t i = 0; i < w.count && i < 4; ++i) r[i] = static_cast<double>(w.radps[i]);
+    ch->command_wheels(r);
+    return true;
+  }
+  bool request_charging(bool on) override {
+    ch->set_charging_inhibited(!on);  // the base's charger relay
+    return true;
+  }
+  const dockcore::hal::ChassisFeedback& poll() override {
+    const docksim::ChassisState& s = ch->state();
+    if (!silent && s.responding) {
+      for (std::size_t i = 0; i < 4; ++i) fb.wheel_radps[i] = static_cast<dockcore::Real>(s.wheel_measured_radps[i]);
+      fb.wheels_stamp_us = clock->t;
+      fb.charging_contact = s.contact;
+      fb.battery_current_a = static_cast<dockcore::Real>(s.charge_current_a);
+      fb.battery_voltage_v = static_cast<dockcore::Real>(s.battery_voltage_v);
+      fb.soc = static_cast<dockcore::Real>(s.battery_soc);
+      fb.power_stamp_us = fb.status_stamp_us = clock->t;
+    }
+    return fb;
+  }
+  int fd() const override { return -1; }
+  const dockcore::hal::ChassisCounters& counters() const override { return c; }
+};
+
+struct SimLidar final : dockcore::hal::LidarSource {
+  std::unique_ptr<dockcore::LaserScan> scan = std::make_unique<dockcore::LaserScan>();
+  bool pending = false;
+  dockcore::hal::LidarCounters c{};
+  bool poll_scan(dockcore::LaserScan& out) override {
+    if (!pending) return false;
+    out = *scan;
+    pending = false;
+    return true;
+  }
+  int fd() const override { return -1; }
+  const dockcore::hal::LidarCounters& counters() const override { return c; }
+};
+
+struct FakeHost final : dockcore::hal::HostLink {
+  bool has = false;
+  dockcore::hal::HostCommandMessage next{};
+  dockcore::hal::StatusMessage last{};
+  int statuses = 0;
+  void command(std::uint8_t cmd, std::uint16_t dock) {
+    next.command = cmd;
+    next.dock_id = dock;
+    ++next.sequence;
+    has = true;
+  }
+  bool poll_command(dockcore::hal::HostCommandMessage& out) override {
+    if (!has) return false;
+    out = next;
+    has = false;
+    return true;
+  }
+  bool send_status(const dockcore::hal::StatusMessage& s) override {
+    last = s;
+    ++statuses;
+    return true;
+  }
+  int fd() const override { return -1; }
+};
+
+dockcore::DriveGeometry core_geometry(const docksim::DriveGeometry& g) {
+  dockcore::DriveGeometry c;
+  c.kind = g.kind == docksim::DriveKind::kMecanum ? dockcore::DriveKind::kMecanum : dockcore::DriveKind::kDifferential;
+  c.wheel_radius_m = static_cast<dockcore::Real>(g.wheel_radius_m);
+  c.wheel_base_m = static_cast<dockcore::Real>(g.wheel_base_m);
+  c.lx_m = static_cast<dockcore::Real>(g.lx_m);
+  c.ly_m = static_cast<dockcore::Real>(g.ly_m);
+  return c;
+}
+
+/// The default scenario's robot and dock, as a dockd config, plus the simulated world around a Daemon.
+struct Rig {
+  docksim::Scenario sc = docksim::load_scenario_file(scenario_path());
+  dockd::DockdConfig cfg;
+  SimClock clock;
+  std::unique_ptr<docksim::Chassis> chassis;
+  SimChassis link;
+  SimLidar lidar;
+  FakeHost host;
+  docksim::World world;
+  docksim::Rng rng{7};
+  std::unique_ptr<dockd::Daemon> daemon;
+  bool lidar_blocked = false;
+  std::uint64_t next_scan_us = 0;
+  std::string state_file;
+  std::unique_ptr<dockcore::drivers::UdpHostLink> udp;
+
+  explicit Rig(const char* state_name, bool with_udp = false, double start_distance = 1.2) {
+    state_file = std::string("/tmp/dockd_test_") + std::to_string(::getpid()) + "_" + state_name;
+    std::remove(state_file.c_str());
+    std::remove((state_file + ".bak").c_str());
+    cfg.drive = core_geometry(sc.chassis.geometry);
+    cfg.limits = sc.limits;
+    cfg.footprint = sc.safety;
+    cfg.lidar_mount = sc.lidar_mount;
+    cfg.estimator = sc.estimator;
+    cfg.task = sc.task;
+    cfg.smooth = sc.smooth;
+    cfg.pad_reach_m = static_cast<double>(sc.smooth.common.pad_reach_m);
+    cfg.pads_rear = sc.smooth.backwards;
+    cfg.state_file = state_file;
+    cfg.teach_scans = 10;
+    dockd::DockEntry d0;
+    d0.id = 0;
+    d0.profile = sc.profile;
+    dockd::DockEntry d3 = d0;
+    d3.id = 3;
+    cfg.docks = {d0, d3};
+    cfg.task.accepted_dock_ids = (1u << 0) | (1u << 3);
+    chassis = std::make_unique<docksim::Chassis>(sc.chassis, 11);
+    docksim::DockPlacement dp;
+    dp.pose_world = sc.dock_pose;
+    dp.face_half_width_m = sc.dock_face_half_width_m;
+    chassis->set_dock(dp);
+    const docksim::StartPose sp = docksim::start_from(sc, start_distance, 0.2, 0.1);
+    chassis->set_true_pose(sp.robot_world);
+    link.ch = chassis.get();
+    link.clock = &clock;
+    world = docksim::scenario_world(sc, true);
+    dockd::DaemonIo io;
+    io.lidar = &lidar;
+    io.chassis = &link;
+    io.can_host = &host;
+    io.clock = &clock;
+    io.stderr_level = std::getenv("DOCKD_TEST_LOG") ? dockd::LogLevel::kDebug : dockd::LogLevel::kError;
+    if (with_udp) {
+      dockcore::drivers::UdpHostLinkOptions o;
+      o.port = 0;
+      std::string err;
+      udp = dockcore::drivers::open_udp_host_link(o, err);
+      io.udp_host = udp.get();
+    }
+    daemon = std::make_unique<dockd::Daemon>(cfg, io);
+    std::string err;
+    CHECK_TRUE(daemon->start(err));
+  }
+  ~Rig() {
+    std::remove(state_file.c_str());
+    std::remove((state_file + ".bak").c_str());
+  }
+
+  /// One 20 ms tick of the world: 4 chassis steps of 5 ms, a 10 Hz scan, then the daemon's tick.
+  void tick() {
+    for (int i = 0; i < 4; ++i) chassis->step();
+    clock.t += 20000;
+    if (clock.t >= next_scan_us) {
+      next_scan_us = clock.t + 100000;
+      if (!lidar_blocked) {
+        const dockcore::Pose2 lp = chassis->state().true_pose.compose(sc.lidar_mount);
+        docksim::simulate_scan(world, lp, sc.lidar, rng, lidar.scan.get(), clock.t);
+        lidar.pending = true;
+      }
+    }
+    daemon->on_tick(clock.t);
+  }
+  /// Ticks until `pred` or `max_s` of simulated time; true when pred held.
+  template <typename P>
+  bool run_until(P pred, double max_s) {
+    const int n = static_cast<int>(max_s / 0.02);
+    for (int i = 0; i < n; ++i) {
+      tick();
+      if (pred()) return true;
+    }
+    return false;
+  }
+  bool wheels_zero() const {
+    for (int i = 0; i < link.last.count; ++i) {
+      if (link.last.radps[i] != 0) return false;
+    }
+    return true;
+  }
+};
+
+}  // namespace
+
+// The scenario parser's static name table is built on first use; build it before CppUTest's per-test leak check.
+static const bool kNamesWarm = !docksim::controller_names().empty();
+
+TEST_GROUP(DockdDaemon){};
+
+TEST(DockdDaemon, DocksChargesAndUndocksInSimulation) {
+  Rig r("dock");
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
+  CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
+  r.host.command(1, 0);  // CAN host frame: dock at dock 0
+  bool moved = false;
+  CHECK_TRUE(r.run_until([&] {
+    moved = moved || !r.wheels_zero();
+    return r.daemon->state() == TaskState::kFinishTasking;
+  }, 60.0));
+  CHECK_TRUE(moved);
+  CHECK_TRUE(r.chassis->state().charging);
+  CHECK_TRUE(r.wheels_zero());
+  CHECK_EQUAL(static_cast<int>(TaskState::kFinishTasking), r.host.last.task_state);
+  // Odometry from the measured wheels follows the chassis' own dead reckoning (same encoders).
+  const dockcore::Pose2 co = r.chassis->state().odom_pose;
+  const dockcore::Pose2 dodom = r.daemon->odom_pose();
+  const double dist = std::hypot(static_cast<double>(co.x_m), static_cast<double>(co.y_m));
+  CHECK(dist > 0.3);
+  const double pos_err = std::hypot(static_cast<double>(dodom.x_m - co.x_m), static_cast<double>(dodom.y_m - co.y_m));
+  CHECK(pos_err < 0.05 * dist + 0.01);
+
+  r.host.command(3, 0);  // undock
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kNotTasking; }, 40.0));
+  CHECK_EQUAL(static_cast<int>(dockcore::TaskResult::kUndocked), static_cast<int>(r.daemon->last_status().last_result));
+  CHECK_FALSE(r.chassis->state().contact);
+  CHECK(r.daemon->tick_stats().ticks > 100);
+}
+
+TEST(DockdDaemon, ChassisStaleStopsWithinOneTickFaultsAndResumes) {
+  Rig r("chassis");
+  r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kAlign && !r.wheels_zero(); }, 20.0));
+  r.link.silent = true;
+  // 200 ms stale limit: the first tick past it commands zero and the task manager faults with 184.
+  int ticks = 0;
+  while (!r.daemon->chassis_stale() && ticks < 50) {
+    r.tick();
+    ++ticks;
+    if (!r.daemon->chassis_stale()) CHECK_FALSE(r.wheels_zero() && r.daemon->state() == TaskState::kFault);
+  }
+  CHECK_TRUE(r.daemon->chassis_stale());
+  CHECK(ticks >= 10 && ticks <= 12);
+  CHECK_TRUE(r.wheels_zero());
+  CHECK_EQUAL(static_cast<int>(TaskState::kFault), static_cast<int>(r.daemon->state()));
+  CHECK_EQUAL(184, static_cast<int>(r.daemon->fault()));
+  CHECK_EQUAL(184, r.host.last.fault_code);
+  for (int i = 0; i < 25; ++i) {
+    r.tick();
+    CHECK_TRUE(r.wheels_zero());
+  }
+  // Data returns: after 0.5 s of fresh data the interrupted docking restarts and completes.
+  r.link.silent = false;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
+  CHECK_EQUAL(1u, r.daemon->counters().resumes);
+  CHECK_EQUAL(1u, r.daemon->counters().chassis_stale_trips);
+}
+
+TEST(DockdDaemon, LidarStaleStopsWithinOneTickAndFaults) {
+  Rig r("lidar");
+  r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kAlign && !r.wheels_zero(); }, 20.0));
+  r.lidar_blocked = true;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->lidar_stale(); }, 1.0));
+  CHECK_TRUE(r.wheels_zero());
+  CHECK_EQUAL(185, static_cast<int>(r.daemon->fault()));
+  // A stop while faulted forgets the interrupted command: no resume when the lidar returns.
+  r.host.command(2, 0);
+  r.tick();
+  r.lidar_blocked = false;
+  r.run_until([] { return false; }, 2.0);
+  CHECK_EQUAL(0u, r.daemon->counters().resumes);
+  CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
+  CHECK_TRUE(r.wheels_zero());
+}
+
+TEST(DockdDaemon, UdpFloodStaysConsistentAndUnknownDockIsRejected) {
+  Rig r("flood", true);
+  r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+  const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  to.sin_port = htons(r.udp->bound_port());
+  auto send = [&](const std::string& m) {
+    ::sendto(s, m.data(), m.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+  };
+  send("{\"cmd\":\"dock\",\"dock_id\":9,\"seq\":1}");
+  r.tick();
+  char buf[2048];
+  ssize_t n = ::recv(s, buf, sizeof buf - 1, MSG_DONTWAIT);
+  CHECK(n > 0);
+  buf[n] = 0;
+  STRCMP_CONTAINS("\"unknown_dock_id\"", buf);
+  CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
+  // 1000 commands/s for 2 s: dock / stop / garbage / status mixed. The state must stay a valid task state, the
+  // robot must never move while a stop is the last command, and the loop keeps ticking.
+  int seq = 10;
+  for (int t = 0; t < 100; ++t) {
+    for (int k = 0; k < 20; ++k) {
+      switch ((t * 20 + k) % 4) {
+        case 0: send("{\"cmd\":\"dock\",\"seq\":" + std::to_string(seq++) + "}"); break;
+        case 1: send("{\"cmd\":\"stop\",\"seq\":" + std::to_string(seq++) + "}"); break;
+        case 2: send("{\"cmd\":\"dock\",\"seq\":"); break;
+        default: send("{\"cmd\":\"status\",\"seq\":" + std::to_string(seq++) + "}"); break;
+      }
+    }
+    r.tick();
+    while (::recv(s, buf, sizeof buf, MSG_DONTWAIT) > 0) {
+    }
+    CHECK(static_cast<int>(r.daemon->state()) <= 9);
+  }
+  send("{\"cmd\":\"stop\",\"seq\":99999}");
+  r.run_until([] { return false; }, 0.5);
+  CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
+  CHECK_TRUE(r.wheels_zero());
+  CHECK(r.udp->counters().malformed >= 400);
+  CHECK(r.daemon->counters().commands > 100);
+  ::close(s);
+}
+
+TEST(DockdDaemon, TeachStoresTargetUsedByLaterDockings) {
+  Rig r("teach", true);
+  // Dock first, so the robot sits on the charger (as if placed there by hand).
+  r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+  r.host.command(1, 3);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
+  const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  to.sin_port = htons(r.udp->bound_port());
+  const std::string m = "{\"cmd\":\"teach\",\"dock_id\":3,\"scans\":8,\"seq\":5}";
+  ::sendto(s, m.data(), m.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+  char buf[2048];
+  ssize_t n = -1;
+  for (int i = 0; i < 200 && n <= 0; ++i) {
+    r.tick();
+    n = ::recv(s, buf, sizeof buf - 1, MSG_DONTWAIT);
+  }
+  CHECK(n > 0);
+  buf[n] = 0;
+  STRCMP_CONTAINS("{\"ok\":true,\"cmd\":\"teach\"", buf);
+  const dockd::TaughtTarget* t = r.daemon->state_data().find(3);
+  CHECK(t != nullptr);
+  CHECK_EQUAL(8, t->scans);
+  // The taught target is where the dock is seen from the docked robot: near the nominal one (pads at the
+  // contacts, within the controller's docking accuracy).
+  const dockcore::Pose2 nom = dockd::nominal_docked_target(r.cfg);
+  CHECK(std::fabs(static_cast<double>(t->target.x_m - nom.x_m)) < 0.03);
+  CHECK(std::fabs(static_cast<double>(t->target.y_m - nom.y_m)) < 0.03);
+  // It survives a restart: a new daemon loads it from the state file.
+  dockd::StateData loaded;
+  std::string msg;
+  CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kOk), static_cast<int>(dockd::load_state(r.state_file, loaded, msg)));
+  CHECK(loaded.find(3) != nullptr);
+  DOUBLES_EQUAL(static_cast<double>(t->target.x_m), static_cast<double>(loaded.find(3)->target.x_m), 1e-6);
+  ::close(s);
+}
