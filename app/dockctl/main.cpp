@@ -53,6 +53,7 @@ bool reply_ok(const std::string& r) { return r.rfind("{\"ok\":true", 0) == 0; }
 int main(int argc, char** argv) {
   CLI::App app{"dockctl: command dockd over its UDP link (docs/dockd.md)"};
   app.require_subcommand(1);
+  app.fallthrough();  // global options may also follow the subcommand
   std::string host = "127.0.0.1";
   int port = 7300;
   double timeout_s = 2.0;
