@@ -1,0 +1,73 @@
+// dockd's config: every error names file:line:column; defaults and derived values; the docked-target correction.
+#include <cmath>
+#include <string>
+
+#include "config.hpp"
+
+#include "CppUTest/TestHarness.h"
+
+namespace {
+std::string error_of(const std::string& text) {
+  try {
+    dockd::parse_config_toml(text, "t.toml");
+  } catch (const dockd::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST_GROUP(DockdConfig){};
+
+TEST(DockdConfig, DefaultsAreUsable) {
+  const dockd::DockdConfig c = dockd::parse_config_toml("", "t.toml");
+  STRCMP_EQUAL("can0", c.can_interface.c_str());
+  CHECK_EQUAL(200u, c.lidar_stale_ms);
+  CHECK_EQUAL(200u, c.chassis_stale_ms);
+  STRCMP_EQUAL("127.0.0.1", c.host.bind_address.c_str());
+  CHECK_EQUAL(1u, c.docks.size());
+  CHECK_EQUAL(1u, c.task.accepted_dock_ids);
+  STRCMP_EQUAL("smooth", c.controller.c_str());
+}
+
+TEST(DockdConfig, ErrorsCarryLineAndColumn) {
+  STRCMP_CONTAINS("t.toml:2:1: unknown key 'lidar.speed'", error_of("[lidar]\nspeed = 1\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:12: lidar.protocol = \"ld07\" is not one of", error_of("[lidar]\nprotocol = \"ld07\"\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:11: robot.track_m = 9 is out of range", error_of("[robot]\ntrack_m = 9\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:8: host.port must be an integer, not a float", error_of("[host]\nport = 1.5\n").c_str());
+  STRCMP_CONTAINS("t.toml:1:1: unknown key 'hosts'", error_of("hosts = 1\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:15: host.allowlist: '10.0.0.300'", error_of("[host]\nallowlist = [\"10.0.0.300\"]\n").c_str());
+  STRCMP_CONTAINS("t.toml:4:", error_of("[[docks]]\nid = 1\n[[docks]]\nid = 1\n").c_str());
+  STRCMP_CONTAINS("dock profile \"round\" is neither", error_of("[[docks]]\nid = 1\nprofile = \"round\"\n").c_str());
+  STRCMP_CONTAINS("t.toml:1:", error_of("[can\n").c_str());
+  STRCMP_CONTAINS("dock.default_id = 4 is not a configured dock id", error_of("[dock]\ndefault_id = 4\n").c_str());
+}
+
+TEST(DockdConfig, DockDatabaseAndDerivedValues) {
+  const dockd::DockdConfig c = dockd::parse_config_toml(
+      "[robot]\npad_reach_m = 0.3\n[dock]\ndefault_id = 5\n[[docks]]\nid = 5\nprofile = \"v-marker\"\n"
+      "target_x_m = 0.31\ntarget_y_m = 0.002\ntarget_yaw_deg = 179\n[[docks]]\nid = 2\n",
+      "t.toml");
+  CHECK_EQUAL(2u, c.docks.size());
+  CHECK_EQUAL((1u << 5) | (1u << 2), c.task.accepted_dock_ids);
+  const dockd::DockEntry* d = c.find_dock(5);
+  CHECK_TRUE(d != nullptr && d->has_target);
+  DOUBLES_EQUAL(0.3, static_cast<double>(c.smooth.common.pad_reach_m), 1e-6);
+}
+
+TEST(DockdConfig, TargetCorrectionMovesTheEstimateOntoTheNominalPose) {
+  // A dock seen at `target` from the docked robot must be reported at `nominal` by an estimator using the corrected
+  // profile: the corrected vertices placed at nominal equal the true vertices placed at target.
+  dockcore::DockProfile p;
+  CHECK_EQUAL(static_cast<int>(dockcore::ProfileError::kOk), static_cast<int>(dockcore::builtin_profile("plate-v", p)));
+  const dockcore::Pose2 nominal{static_cast<dockcore::Real>(0.225), 0, dockcore::kPi};
+  const dockcore::Pose2 target{static_cast<dockcore::Real>(0.235), static_cast<dockcore::Real>(-0.006),
+                               static_cast<dockcore::Real>(3.10)};
+  const dockcore::DockProfile q = dockd::profile_for_target(p, nominal, target);
+  for (std::size_t i = 0; i < p.vertex_count; ++i) {
+    const dockcore::Vec2 a = target.transform(p.vertices_m[i]);
+    const dockcore::Vec2 b = nominal.transform(q.vertices_m[i]);
+    DOUBLES_EQUAL(static_cast<double>(a.x()), static_cast<double>(b.x()), 1e-9);
+    DOUBLES_EQUAL(static_cast<double>(a.y()), static_cast<double>(b.y()), 1e-9);
+  }
+}
