@@ -37,7 +37,7 @@ TEST(DockdConfig, ErrorsCarryLineAndColumn) {
   STRCMP_CONTAINS("t.toml:2:8: host.port must be an integer, not a float", error_of("[host]\nport = 1.5\n").c_str());
   STRCMP_CONTAINS("t.toml:1:1: unknown key 'hosts'", error_of("hosts = 1\n").c_str());
   STRCMP_CONTAINS("t.toml:2:14: host.allowlist: '10.0.0.300'", error_of("[host]\nallowlist = [\"10.0.0.300\"]\n").c_str());
-  STRCMP_CONTAINS("t.toml:4:", error_of("[[docks]]\nid = 1\n[[docks]]\nid = 1\n").c_str());
+  STRCMP_CONTAINS("t.toml:3:1: dock id 1 appears twice", error_of("[[docks]]\nid = 1\n[[docks]]\nid = 1\n").c_str());
   STRCMP_CONTAINS("dock profile \"round\" is neither", error_of("[[docks]]\nid = 1\nprofile = \"round\"\n").c_str());
   STRCMP_CONTAINS("t.toml:1:", error_of("[can\n").c_str());
   STRCMP_CONTAINS("dock.default_id = 4 is not a configured dock id", error_of("[dock]\ndefault_id = 4\n").c_str());
