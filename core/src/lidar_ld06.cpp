@@ -24,13 +24,36 @@ std::size_t ld06_length(std::uint8_t kind) {
 
 }  // namespace
 
+namespace {
+// 256-byte table built at compile time from the polynomial (no copied vendor table): one lookup per byte instead of
+// 8 shift steps, which made the CRC two thirds of the parser's cost.
+struct CrcTable {
+  std::uint8_t v[256] = {};
+  constexpr CrcTable() {
+    for (unsigned i = 0; i < 256; ++i) {
+      unsigned crc = i;
+      for (int b = 0; b < 8; ++b) crc = (crc & 0x80u) ? ((crc << 1) ^ 0x4Du) & 0xFFu : (crc << 1) & 0xFFu;
+      v[i] = static_cast<std::uint8_t>(crc);
+    }
+  }
+};
+constexpr CrcTable kCrcTable{};
+
+void decode_fields(const std::uint8_t* in, Ld06Packet& out) {
+  out.speed_dps = rd16(in + 2);
+  out.start_cdeg = rd16(in + 4);
+  for (std::size_t i = 0; i < kLd06PointsPerPacket; ++i) {
+    out.distance_mm[i] = rd16(in + 6 + 3 * i);
+    out.intensity[i] = in[8 + 3 * i];
+  }
+  out.end_cdeg = rd16(in + 42);
+  out.timestamp_ms = rd16(in + 44);
+}
+}  // namespace
+
 std::uint8_t ld06_crc8(const std::uint8_t* data, std::size_t n) {
   std::uint8_t crc = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    crc = static_cast<std::uint8_t>(crc ^ data[i]);
-    for (int b = 0; b < 8; ++b)
-      crc = static_cast<std::uint8_t>((crc & 0x80u) ? ((crc << 1) ^ 0x4Du) : (crc << 1));
-  }
+  for (std::size_t i = 0; i < n; ++i) crc = kCrcTable.v[crc ^ data[i]];
   return crc;
 }
 
@@ -50,14 +73,7 @@ void ld06_encode_packet(const Ld06Packet& p, std::uint8_t out[kLd06PacketBytes])
 
 bool ld06_decode_packet(const std::uint8_t in[kLd06PacketBytes], Ld06Packet& out) {
   if (in[0] != kLd06Header || in[1] != kLd06DataKind || ld06_crc8(in, 46) != in[46]) return false;
-  out.speed_dps = rd16(in + 2);
-  out.start_cdeg = rd16(in + 4);
-  for (std::size_t i = 0; i < kLd06PointsPerPacket; ++i) {
-    out.distance_mm[i] = rd16(in + 6 + 3 * i);
-    out.intensity[i] = in[8 + 3 * i];
-  }
-  out.end_cdeg = rd16(in + 42);
-  out.timestamp_ms = rd16(in + 44);
+  decode_fields(in, out);
   return true;
 }
 
@@ -146,7 +162,7 @@ void Ld06Parser::process() {
     }
     if (buf_[1] == kLd06DataKind) {
       Ld06Packet p;
-      ld06_decode_packet(buf_, p);
+      decode_fields(buf_, p);  // CRC already checked above
       const std::uint64_t stamp = stamp_[0];
       consume(need);
       on_data_packet(p, stamp);

@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   std::uint64_t count = 0;
   double duration = 0;
   bool csv = false, mid_stream = false;
+  int bench = 0;
   app.add_option("--protocol", protocol, "ld06 | rplidar | lakibeam")->capture_default_str();
   auto* o_dev = app.add_option("--device", device, "Serial device (ld06: 230400 baud, rplidar: 115200 by default)");
   auto* o_udp = app.add_option("--udp", udp_port, "UDP port to bind (lakibeam, ld06 over UDP)");
@@ -70,6 +71,7 @@ int main(int argc, char** argv) {
   app.add_option("--json-counters", json_counters, "Write the counters as JSON to FILE ('-' = stdout, after the scans)");
   app.add_option("--count", count, "Stop after N scans");
   app.add_option("--duration", duration, "Stop after S seconds (device / UDP)");
+  app.add_option("--bench", bench, "--file: decode the capture N times without printing; report ns per byte");
   app.add_flag("--mid-stream", mid_stream, "rplidar --file: accept nodes without a scan descriptor");
   try {
     app.parse(argc, argv);
@@ -108,6 +110,26 @@ int main(int argc, char** argv) {
     }
     std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (rec.is_open()) rec.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (bench > 0) {
+      dockcore::drivers::LidarDecoder bd(*proto);
+      if (mid_stream) bd.set_require_descriptor(false);
+      const std::size_t step = *proto == LidarProtocol::kLakibeam ? dockcore::kLakibeamDatagramBytes : bytes.size();
+      const std::uint64_t t0 = dockcore::drivers::monotonic_us();
+      for (int r = 0; r < bench; ++r) {
+        for (std::size_t off = 0; off < bytes.size(); off += step) {
+          const std::size_t n = std::min(step, bytes.size() - off);
+          if (*proto == LidarProtocol::kLakibeam) bd.feed_datagram(bytes.data() + off, n, 0);
+          else bd.feed_bytes(bytes.data() + off, n, 0, 0);
+          while (bd.take_scan(*scan)) {
+          }
+        }
+      }
+      const double us = static_cast<double>(dockcore::drivers::monotonic_us() - t0);
+      const double total = static_cast<double>(bytes.size()) * bench;
+      std::printf("{\"bytes\":%.0f,\"ns_per_byte\":%.2f,\"scans\":%u,\"us_per_scan\":%.1f}\n", total,
+                  us * 1000.0 / total, bd.counters().scans, us / std::max(1u, bd.counters().scans));
+      return 0;
+    }
     dockcore::drivers::LidarDecoder dec(*proto);
     if (bins > 0 && !dec.configure_grid(bins)) {
       std::fprintf(stderr, "lidar-dump: --bins must be in 1..%zu\n", dockcore::kMaxScanPoints);
