@@ -344,7 +344,8 @@ void Daemon::watchdogs(std::uint64_t now_us) {
   const std::uint64_t lidar_lim = static_cast<std::uint64_t>(cfg_.lidar_stale_ms) * 1000u;
   const std::uint64_t chassis_lim = static_cast<std::uint64_t>(cfg_.chassis_stale_ms) * 1000u;
   const bool lidar = !have_scan_ || now_us - last_scan_rx_us_ > lidar_lim;
-  const bool chassis = !have_wheels_ || now_us < last_wheels_stamp_us_ || now_us - last_wheels_stamp_us_ > chassis_lim;
+  // A receive stamp after now_us is a frame read during this tick (now_us is taken when the tick starts): fresh.
+  const bool chassis = !have_wheels_ || (now_us > last_wheels_stamp_us_ && now_us - last_wheels_stamp_us_ > chassis_lim);
   if (lidar != lidar_stale_) {
     if (lidar) ++counters_.lidar_stale_trips;
     char f[96];
