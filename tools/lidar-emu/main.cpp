@@ -111,7 +111,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "lidar-emu: --pose wants X,Y,YAW_DEG\n");
       return 2;
     }
-    robot = dockcore::Pose2{x, y, yaw * dockcore::kPi / 180.0};
+    robot = dockcore::Pose2{static_cast<dockcore::Real>(x), static_cast<dockcore::Real>(y),
+                            static_cast<dockcore::Real>(yaw * dockcore::kPi / 180.0)};
   } else {
     const dockcore::Vec2 p = sc.dock_pose.transform(dockcore::Vec2(1.0, 0.0));
     robot = dockcore::Pose2{p.x(), p.y(), dockcore::wrap_angle(sc.dock_pose.yaw_rad + dockcore::kPi)};
