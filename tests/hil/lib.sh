@@ -65,3 +65,18 @@ stop_bg() {
 
 # Starts candump on vcan0 into $OUT/candump.log (candump -L format, what dock-decode reads).
 start_candump() { bg candump candump -L vcan0; }
+
+# Writes the HIL dockd config (tests/hil/dockd-hil.toml with this case's paths) to $OUT/dockd.toml, applying
+# extra `sed` expressions given as arguments.
+make_dockd_config() {
+  sed -e "s|@OUT@|$OUT|g" "$@" "$SRC/tests/hil/dockd-hil.toml" > "$OUT/dockd.toml"
+}
+
+DOCKCTL() { "$BUILD/app/dockctl" --port 7300 --timeout 2 "$@"; }
+
+# Current task state name from dockd over UDP ("" when dockd does not answer).
+dock_state() { DOCKCTL status 2>/dev/null | sed -n 's/.*"state":"\([A-Z_]*\)".*/\1/p'; }
+state_is() { [ "$(dock_state)" = "$1" ]; }
+
+# chassis-sim from this build.
+chassis-sim-run() { "$BUILD/tools/chassis-sim/chassis-sim" "$@"; }
