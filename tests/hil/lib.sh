@@ -54,13 +54,13 @@ wait_for() {
   return 1
 }
 
-# Stops a process started with bg by signal (default TERM) and waits for it; prints its exit status.
+# stop_bg PID [SIGNAL]: stops a process started with bg (default TERM), waits for it and leaves its exit status in
+# STOP_STATUS. Not in $(...): a subshell cannot wait for this shell's children.
 stop_bg() {
   local pid="$1" sig="${2:-TERM}"
   kill "-$sig" "$pid" 2>/dev/null
-  local st=0
-  wait "$pid" 2>/dev/null || st=$?
-  echo "$st"
+  STOP_STATUS=0
+  wait "$pid" 2>/dev/null || STOP_STATUS=$?
 }
 
 # Starts candump on vcan0 into $OUT/candump.log (candump -L format, what dock-decode reads).

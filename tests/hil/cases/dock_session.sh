@@ -35,10 +35,10 @@ check run2_undock_accepted DOCKCTL undock
 check run2_undocked wait_for 60 state_is NOT_TASKING
 
 # Shutdown: SIGTERM -> zero-velocity frames, exit 0.
-st=$(stop_bg "$PID_dockd" TERM)
-check dockd_sigterm_exit_0 test "$st" -eq 0
+stop_bg "$PID_dockd" TERM
+check dockd_sigterm_exit_0 test "$STOP_STATUS" -eq 0
 sleep 0.3
-stop_bg "$PID_candump" INT > /dev/null
+stop_bg "$PID_candump" INT
 "$BUILD/tools/dock-decode/dock-decode" --json "$OUT/candump.log" > "$OUT/decode.json"
 "$BUILD/tools/dock-decode/dock-decode" -q "$OUT/candump.log" > "$OUT/decode.txt" 2>&1
 check dock_decode_strict_no_errors "$BUILD/tools/dock-decode/dock-decode" -q --strict "$OUT/candump.log"
