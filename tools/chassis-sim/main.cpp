@@ -77,6 +77,7 @@ struct Options {
   std::string truth_path;
   double silent_at_s = -1, silent_for_s = 0;
   bool no_charge = false;
+  double break_contact_after_s = -1;  ///< Contacts break (robot nudged 3 cm back) this long after charging began.
   bool charge_needs_request = true;
   LidarOutOptions lidar;
 };
@@ -85,8 +86,12 @@ struct Options {
 void write_truth(std::FILE* f, double t_s, double motion_t_s, const docksim::ChassisState& cs, bool relay,
                  bool silent, const char* event) {
   if (f == nullptr) return;
+  // "wall" is CLOCK_REALTIME, the clock candump stamps frames with, so a test can line events up with the CAN log.
+  timespec wall{};
+  clock_gettime(CLOCK_REALTIME, &wall);
+  std::fprintf(f, "{\"wall\":%lld.%06ld,", static_cast<long long>(wall.tv_sec), wall.tv_nsec / 1000);
   std::fprintf(f,
-               "{\"t\":%.3f,\"motion_t\":%.3f,\"x\":%.4f,\"y\":%.4f,\"yaw\":%.5f,\"contact\":%s,\"charging\":%s,"
+               "\"t\":%.3f,\"motion_t\":%.3f,\"x\":%.4f,\"y\":%.4f,\"yaw\":%.5f,\"contact\":%s,\"charging\":%s,"
                "\"current_a\":%.3f,\"pad_lateral_m\":%.4f,\"press_m\":%.4f,\"pad_yaw_rad\":%.5f,"
                "\"wheel_target\":[%.3f,%.3f],\"relay\":%s,\"silent\":%s%s%s%s}\n",
                t_s, motion_t_s, static_cast<double>(cs.true_pose.x_m), static_cast<double>(cs.true_pose.y_m), static_cast<double>(cs.true_pose.yaw_rad), cs.contact ? "true" : "false",
@@ -217,6 +222,8 @@ int run(const Options& opt) {
   std::uint32_t bad_frames = 0, frames_rx = 0, scans_sent = 0;
   v1::CounterTracker cmd_tracker;
   bool lidar_unplugged = false;
+  double charging_since_t = -1;
+  bool contact_broken = false;
   // A LaserScan is ~64 kB: keep it off the stack.
   auto scan_owner = std::make_unique<dockcore::LaserScan>();
   dockcore::LaserScan& scan = *scan_owner;
@@ -337,6 +344,15 @@ int run(const Options& opt) {
       max_catch_up = std::max(max_catch_up, catch_up);
     }
     const docksim::ChassisState& cs = chassis.state();
+    if (cs.charging && charging_since_t < 0) charging_since_t = t;
+    if (opt.break_contact_after_s >= 0 && charging_since_t >= 0 && !contact_broken &&
+        t - charging_since_t >= opt.break_contact_after_s) {
+      // Someone bumps the robot: 3 cm straight back from the contacts, which opens them.
+      const double yaw = static_cast<double>(cs.true_pose.yaw_rad);
+      chassis.apply_pose_jump(-0.03 * std::cos(yaw), -0.03 * std::sin(yaw), 0.0);
+      contact_broken = true;
+      write_truth(truth, t, mt, cs, relay, silent, "contact_break");
+    }
 
     // 4. Transmit at the documented periods (20 ms feedback, 100 ms power/status); nothing while silent.
     if (!silent) {
@@ -475,6 +491,8 @@ int main(int argc, char** argv) {
   app.add_option("--silent-at", o.silent_at_s, "Stop answering this many seconds after motion start");
   app.add_option("--silent-for", o.silent_for_s, "... for this long");
   app.add_flag("--no-charge", o.no_charge, "The charger never delivers current");
+  app.add_option("--break-contact-after", o.break_contact_after_s,
+                 "Nudge the robot 3 cm back this many seconds after charging began (contacts break)");
   add_lidar_out_options(app, o.lidar);
   try {
     app.parse(argc, argv);
