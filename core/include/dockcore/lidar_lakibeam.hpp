@@ -74,7 +74,6 @@ class LakibeamEncoder {
  private:
   LidarAngleConvention conv_{false, -kPi};
   std::uint8_t dgram_[kLakibeamDatagramBytes] = {};
-  std::uint16_t azimuth_[kLakibeamPointsPerDatagram] = {};
   std::size_t pending_ = 0;
 };
 
