@@ -9,6 +9,8 @@
 #include "docksim/battery.hpp"
 #include "docksim/chassis.hpp"
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using namespace docksim;
@@ -111,26 +113,26 @@ TEST(ChassisKinematics, HelpersMatchHandFormulas) {
   g.wheel_base_m = kB;
   // v = 0.5, w = 1: left surface 0.5 - 0.15 = 0.35 → 7 rad/s, right 0.65 → 13 rad/s.
   WheelRadps w = body_twist_to_wheel_radps(g, BodyTwist{0.5, 0.0, 1.0});
-  DOUBLES_EQUAL(7.0, w[0], 1e-12);
-  DOUBLES_EQUAL(13.0, w[1], 1e-12);
+  REAL_EQUAL(7.0, w[0], 1e-12);
+  REAL_EQUAL(13.0, w[1], 1e-12);
   BodyTwist t = wheel_radps_to_body_twist(g, w);
-  DOUBLES_EQUAL(0.5, t.vx_mps, 1e-12);
-  DOUBLES_EQUAL(0.0, t.vy_mps, 1e-12);
-  DOUBLES_EQUAL(1.0, t.wz_radps, 1e-12);
+  REAL_EQUAL(0.5, t.vx_mps, 1e-12);
+  REAL_EQUAL(0.0, t.vy_mps, 1e-12);
+  REAL_EQUAL(1.0, t.wz_radps, 1e-12);
 
   g.kind = DriveKind::kMecanum;
   g.lx_m = kLx;
   g.ly_m = kLy;
   // vx 0.2, vy 0.1, w 0.5, lx+ly = 0.35: FL 0.2-0.1-0.175 = -0.075, FR 0.475, RL 0.125, RR 0.275 (m/s) / 0.05.
   w = body_twist_to_wheel_radps(g, BodyTwist{0.2, 0.1, 0.5});
-  DOUBLES_EQUAL(-1.5, w[0], 1e-12);
-  DOUBLES_EQUAL(9.5, w[1], 1e-12);
-  DOUBLES_EQUAL(2.5, w[2], 1e-12);
-  DOUBLES_EQUAL(5.5, w[3], 1e-12);
+  REAL_EQUAL(-1.5, w[0], 1e-12);
+  REAL_EQUAL(9.5, w[1], 1e-12);
+  REAL_EQUAL(2.5, w[2], 1e-12);
+  REAL_EQUAL(5.5, w[3], 1e-12);
   t = wheel_radps_to_body_twist(g, w);
-  DOUBLES_EQUAL(0.2, t.vx_mps, 1e-12);
-  DOUBLES_EQUAL(0.1, t.vy_mps, 1e-12);
-  DOUBLES_EQUAL(0.5, t.wz_radps, 1e-12);
+  REAL_EQUAL(0.2, t.vx_mps, 1e-12);
+  REAL_EQUAL(0.1, t.vy_mps, 1e-12);
+  REAL_EQUAL(0.5, t.wz_radps, 1e-12);
 }
 
 TEST(ChassisKinematics, DiffStraightLineFromRotatedStart) {
@@ -140,19 +142,19 @@ TEST(ChassisKinematics, DiffStraightLineFromRotatedStart) {
   c.run_for(2.0);
   // With no lag the wheels reach speed within the first step (trapezoid: half a step of travel lost).
   const double d = 0.5 * (2.0 - kDt / 2);
-  DOUBLES_EQUAL(1.0 + d * std::cos(0.3), px(c.state()), 1e-9);
-  DOUBLES_EQUAL(2.0 + d * std::sin(0.3), py(c.state()), 1e-9);
-  DOUBLES_EQUAL(0.3, pyaw(c.state()), 1e-12);
-  DOUBLES_EQUAL(2.0, c.state().time_s, 1e-9);
+  REAL_EQUAL(1.0 + d * std::cos(0.3), px(c.state()), 1e-9);
+  REAL_EQUAL(2.0 + d * std::sin(0.3), py(c.state()), 1e-9);
+  REAL_EQUAL(0.3, pyaw(c.state()), 1e-12);
+  REAL_EQUAL(2.0, c.state().time_s, 1e-9);
 }
 
 TEST(ChassisKinematics, DiffPureRotation) {
   Chassis c(ideal(DriveKind::kDifferential), 1);
   c.command_wheels(diff_cmd(-3.0, 3.0));  // surface ±0.15 m/s over 0.3 m → 1 rad/s
   c.run_for(1.0);
-  DOUBLES_EQUAL(1.0 - kDt / 2, pyaw(c.state()), 1e-9);
-  DOUBLES_EQUAL(0.0, px(c.state()), 1e-12);
-  DOUBLES_EQUAL(0.0, py(c.state()), 1e-12);
+  REAL_EQUAL(1.0 - kDt / 2, pyaw(c.state()), 1e-9);
+  REAL_EQUAL(0.0, px(c.state()), 1e-12);
+  REAL_EQUAL(0.0, py(c.state()), 1e-12);
 }
 
 TEST(ChassisKinematics, DiffArcIsExactCircle) {
@@ -164,9 +166,9 @@ TEST(ChassisKinematics, DiffArcIsExactCircle) {
   const double th1 = th0 + 2.0;
   // Circle of radius v/w = 0.5 about the centre to the robot's left.
   const double cx = x0 - 0.5 * std::sin(th0), cy = y0 + 0.5 * std::cos(th0);
-  DOUBLES_EQUAL(cx + 0.5 * std::sin(th1), px(c.state()), 1e-9);
-  DOUBLES_EQUAL(cy - 0.5 * std::cos(th1), py(c.state()), 1e-9);
-  DOUBLES_EQUAL(th1, pyaw(c.state()), 1e-9);
+  REAL_EQUAL(cx + 0.5 * std::sin(th1), px(c.state()), 1e-9);
+  REAL_EQUAL(cy - 0.5 * std::cos(th1), py(c.state()), 1e-9);
+  REAL_EQUAL(th1, pyaw(c.state()), 1e-9);
 }
 
 TEST(ChassisKinematics, MecanumSidewaysAndRotation) {
@@ -174,23 +176,23 @@ TEST(ChassisKinematics, MecanumSidewaysAndRotation) {
   // vy = +0.3 m/s (left): FL -, FR +, RL +, RR - at 0.3/0.05 = 6 rad/s.
   c.command_wheels(all4(-6.0, 6.0, 6.0, -6.0));
   c.run_for(1.0);
-  DOUBLES_EQUAL(0.0, px(c.state()), 1e-12);
-  DOUBLES_EQUAL(0.3 * (1.0 - kDt / 2), py(c.state()), 1e-9);
-  DOUBLES_EQUAL(0.0, pyaw(c.state()), 1e-12);
+  REAL_EQUAL(0.0, px(c.state()), 1e-12);
+  REAL_EQUAL(0.3 * (1.0 - kDt / 2), py(c.state()), 1e-9);
+  REAL_EQUAL(0.0, pyaw(c.state()), 1e-12);
 
   Chassis r(ideal(DriveKind::kMecanum), 1);
   // w = 1 rad/s: surface ±(lx+ly) = ±0.35 m/s → 7 rad/s; FL and RL backwards.
   r.command_wheels(all4(-7.0, 7.0, -7.0, 7.0));
   r.run_for(1.0);
-  DOUBLES_EQUAL(1.0 - kDt / 2, pyaw(r.state()), 1e-9);
-  DOUBLES_EQUAL(0.0, px(r.state()), 1e-12);
-  DOUBLES_EQUAL(0.0, py(r.state()), 1e-12);
+  REAL_EQUAL(1.0 - kDt / 2, pyaw(r.state()), 1e-9);
+  REAL_EQUAL(0.0, px(r.state()), 1e-12);
+  REAL_EQUAL(0.0, py(r.state()), 1e-12);
 
   Chassis f(ideal(DriveKind::kMecanum), 1);
   f.command_wheels(all4(4.0, 4.0, 4.0, 4.0));  // 0.2 m/s forward
   f.run_for(1.5);
-  DOUBLES_EQUAL(0.2 * (1.5 - kDt / 2), px(f.state()), 1e-9);
-  DOUBLES_EQUAL(0.0, py(f.state()), 1e-12);
+  REAL_EQUAL(0.2 * (1.5 - kDt / 2), px(f.state()), 1e-9);
+  REAL_EQUAL(0.0, py(f.state()), 1e-12);
 }
 
 TEST_GROUP(ChassisDynamics){};
@@ -201,13 +203,13 @@ TEST(ChassisDynamics, DeadbandStopsSmallCommands) {
   Chassis c(p, 1);
   c.command_wheels(diff_cmd(0.29, -0.29));
   c.run_for(1.0);
-  DOUBLES_EQUAL(0.0, px(c.state()), 0.0);
-  DOUBLES_EQUAL(0.0, pyaw(c.state()), 0.0);
+  REAL_EQUAL(0.0, px(c.state()), 0.0);
+  REAL_EQUAL(0.0, pyaw(c.state()), 0.0);
   LONGS_EQUAL(0, c.state().encoder_counts[0]);
-  DOUBLES_EQUAL(0.0, c.state().wheel_target_radps[0], 0.0);
+  REAL_EQUAL(0.0, c.state().wheel_target_radps[0], 0.0);
   c.command_wheels(diff_cmd(0.31, 0.31));
   c.run_for(1.0);
-  DOUBLES_EQUAL(0.31 * kR * (1.0 - kDt / 2), px(c.state()), 1e-9);
+  REAL_EQUAL(0.31 * kR * (1.0 - kDt / 2), px(c.state()), 1e-9);
 }
 
 TEST(ChassisDynamics, LatencyDelaysResponseByExactSteps) {
@@ -225,11 +227,11 @@ TEST(ChassisDynamics, LatencyDelaysResponseByExactSteps) {
   }
   for (int k = 0; k < 7; ++k) {
     late.step();
-    DOUBLES_EQUAL(0.0, late.state().wheel_true_radps[0], 0.0);
+    REAL_EQUAL(0.0, late.state().wheel_true_radps[0], 0.0);
   }
   for (int k = 0; k < 53; ++k) {
     late.step();
-    DOUBLES_EQUAL(ref_speed[k], late.state().wheel_true_radps[0], 0.0);
+    REAL_EQUAL(ref_speed[k], late.state().wheel_true_radps[0], 0.0);
   }
   CHECK(ref_speed[0] > 0.5);
 }
@@ -240,10 +242,10 @@ TEST(ChassisDynamics, FirstOrderLagReaches63PercentAtTau) {
   Chassis c(p, 1);
   c.command_wheels(diff_cmd(10.0, 10.0));
   c.step();
-  DOUBLES_EQUAL(10.0 * (1.0 - std::exp(-0.1)), c.state().wheel_true_radps[0], 1e-9);
+  REAL_EQUAL(10.0 * (1.0 - std::exp(-0.1)), c.state().wheel_true_radps[0], 1e-9);
   for (int k = 1; k < 10; ++k) c.step();
-  DOUBLES_EQUAL(10.0 * (1.0 - std::exp(-1.0)), c.state().wheel_true_radps[0], 1e-9);  // 6.321
-  DOUBLES_EQUAL(6.321, c.state().wheel_true_radps[1], 1e-3);
+  REAL_EQUAL(10.0 * (1.0 - std::exp(-1.0)), c.state().wheel_true_radps[0], 1e-9);  // 6.321
+  REAL_EQUAL(6.321, c.state().wheel_true_radps[1], 1e-3);
 }
 
 TEST(ChassisDynamics, AccelerationLimitRespected) {
@@ -258,10 +260,10 @@ TEST(ChassisDynamics, AccelerationLimitRespected) {
     CHECK(w - prev <= 20.0 * kDt + 1e-12);
     CHECK(w <= 10.0 + 1e-12);
     prev = w;
-    if (k == 50) DOUBLES_EQUAL(5.0, w, 1e-9);  // 20 rad/s² × 0.25 s
+    if (k == 50) REAL_EQUAL(5.0, w, 1e-9);  // 20 rad/s² × 0.25 s
   }
-  DOUBLES_EQUAL(10.0, c.state().wheel_true_radps[0], 1e-9);
-  DOUBLES_EQUAL(-10.0, c.state().wheel_true_radps[1], 1e-9);
+  REAL_EQUAL(10.0, c.state().wheel_true_radps[0], 1e-9);
+  REAL_EQUAL(-10.0, c.state().wheel_true_radps[1], 1e-9);
 }
 
 TEST(ChassisDynamics, CommandTimeoutStopsMotors) {
@@ -270,9 +272,9 @@ TEST(ChassisDynamics, CommandTimeoutStopsMotors) {
   Chassis c(p, 1);
   c.command_wheels(diff_cmd(5.0, 5.0));
   c.run_for(0.5);
-  DOUBLES_EQUAL(5.0, c.state().wheel_true_radps[0], 1e-12);
+  REAL_EQUAL(5.0, c.state().wheel_true_radps[0], 1e-12);
   c.step();
-  DOUBLES_EQUAL(0.0, c.state().wheel_true_radps[0], 1e-12);
+  REAL_EQUAL(0.0, c.state().wheel_true_radps[0], 1e-12);
 }
 
 TEST_GROUP(ChassisSensing){};
@@ -286,8 +288,8 @@ TEST(ChassisSensing, EncoderCountsMatchDistance) {
   const double dist = px(c.state());
   const double expect = dist / (2 * kPi * kR) * 4096;  // ≈ 11079 counts
   CHECK(expect > 10000);
-  DOUBLES_EQUAL(expect, c.state().encoder_counts[0], 1.0);
-  DOUBLES_EQUAL(expect, c.state().encoder_counts[1], 1.0);
+  REAL_EQUAL(expect, c.state().encoder_counts[0], 1.0);
+  REAL_EQUAL(expect, c.state().encoder_counts[1], 1.0);
 }
 
 TEST(ChassisSensing, EncodersWrapLikeInt32AndOdometryFollows) {
@@ -301,8 +303,8 @@ TEST(ChassisSensing, EncodersWrapLikeInt32AndOdometryFollows) {
   const std::int64_t expect = static_cast<std::int64_t>(2147483647 - 1000) + static_cast<std::int64_t>(counted) -
                               (std::int64_t{1} << 32);
   CHECK(c.state().encoder_counts[0] < 0);
-  DOUBLES_EQUAL(static_cast<double>(expect), c.state().encoder_counts[0], 1.0);
-  DOUBLES_EQUAL(px(c.state()), static_cast<double>(c.state().odom_pose.x_m), 2 * 2 * kPi * kR / 4096);
+  REAL_EQUAL(static_cast<double>(expect), c.state().encoder_counts[0], 1.0);
+  REAL_EQUAL(px(c.state()), static_cast<double>(c.state().odom_pose.x_m), 2 * 2 * kPi * kR / 4096);
 }
 
 TEST(ChassisSensing, MeasuredSpeedFromEncoders) {
@@ -313,8 +315,8 @@ TEST(ChassisSensing, MeasuredSpeedFromEncoders) {
   c.command_wheels(diff_cmd(6.0, -6.0));
   c.run_for(0.5);
   // One count over an 8-step window is 2π/4096/0.04 = 0.038 rad/s of resolution.
-  DOUBLES_EQUAL(6.0, c.state().wheel_measured_radps[0], 0.04);
-  DOUBLES_EQUAL(-6.0, c.state().wheel_measured_radps[1], 0.04);
+  REAL_EQUAL(6.0, c.state().wheel_measured_radps[0], 0.04);
+  REAL_EQUAL(-6.0, c.state().wheel_measured_radps[1], 0.04);
 }
 
 TEST(ChassisSensing, OdometryRadiusErrorScalesDistance) {
@@ -324,8 +326,8 @@ TEST(ChassisSensing, OdometryRadiusErrorScalesDistance) {
   c.command_wheels(diff_cmd(10.0, 10.0));
   c.run_for(2.0);
   const double truth = px(c.state());
-  DOUBLES_EQUAL(1.02 * truth, static_cast<double>(c.state().odom_pose.x_m), 1e-5);
-  DOUBLES_EQUAL(0.02 * truth, static_cast<double>(c.state().odom_pose.x_m) - truth, 1e-5);  // ≈ 2 cm
+  REAL_EQUAL(1.02 * truth, static_cast<double>(c.state().odom_pose.x_m), 1e-5);
+  REAL_EQUAL(0.02 * truth, static_cast<double>(c.state().odom_pose.x_m) - truth, 1e-5);  // ≈ 2 cm
 }
 
 TEST(ChassisSensing, OdometryBaseErrorScalesRotation) {
@@ -334,7 +336,7 @@ TEST(ChassisSensing, OdometryBaseErrorScalesRotation) {
   Chassis c(p, 1);
   c.command_wheels(diff_cmd(-3.0, 3.0));
   c.run_for(1.0);
-  DOUBLES_EQUAL(pyaw(c.state()) / 1.05, static_cast<double>(c.state().odom_pose.yaw_rad), 1e-6);
+  REAL_EQUAL(pyaw(c.state()) / 1.05, static_cast<double>(c.state().odom_pose.yaw_rad), 1e-6);
 }
 
 TEST(ChassisSensing, OdometryRadiusDifferenceCurvesStraightLine) {
@@ -344,11 +346,11 @@ TEST(ChassisSensing, OdometryRadiusDifferenceCurvesStraightLine) {
   c.command_wheels(diff_cmd(10.0, 10.0));
   c.run_for(2.0);
   const double d = px(c.state());
-  DOUBLES_EQUAL(0.0, pyaw(c.state()), 1e-12);
+  REAL_EQUAL(0.0, pyaw(c.state()), 1e-12);
   // Believed heading change = (s_R - s_L)/b = -0.01·d/b.
-  DOUBLES_EQUAL(-0.01 * d / kB, static_cast<double>(c.state().odom_pose.yaw_rad), 1e-6);
+  REAL_EQUAL(-0.01 * d / kB, static_cast<double>(c.state().odom_pose.yaw_rad), 1e-6);
   CHECK(static_cast<double>(c.state().odom_pose.y_m) < -0.01);  // curves right by ≈ d²·0.01/(2b) = 1.7 cm
-  DOUBLES_EQUAL(-0.01 * d * d / (2 * kB), static_cast<double>(c.state().odom_pose.y_m), 1e-4);
+  REAL_EQUAL(-0.01 * d * d / (2 * kB), static_cast<double>(c.state().odom_pose.y_m), 1e-4);
 }
 
 TEST(ChassisSensing, MecanumOdometryBaseError) {
@@ -357,7 +359,7 @@ TEST(ChassisSensing, MecanumOdometryBaseError) {
   Chassis c(p, 1);
   c.command_wheels(all4(-7.0, 7.0, -7.0, 7.0));
   c.run_for(1.0);
-  DOUBLES_EQUAL(pyaw(c.state()) / 0.96, static_cast<double>(c.state().odom_pose.yaw_rad), 1e-6);
+  REAL_EQUAL(pyaw(c.state()) / 0.96, static_cast<double>(c.state().odom_pose.yaw_rad), 1e-6);
 }
 
 TEST(ChassisSensing, WhiteSlipSpreadMatchesSigma) {
@@ -380,8 +382,8 @@ TEST(ChassisSensing, WhiteSlipSpreadMatchesSigma) {
   const double mean = sum / runs;
   const double sd = std::sqrt(sum2 / runs - mean * mean);
   const double expect = 0.5 * kDt * 0.05 * std::sqrt(steps / 2.0);  // 1.77 mm
-  DOUBLES_EQUAL(expect, sd, 0.2 * expect);
-  DOUBLES_EQUAL(0.0, mean, 4 * expect / std::sqrt(static_cast<double>(runs)));
+  REAL_EQUAL(expect, sd, 0.2 * expect);
+  REAL_EQUAL(0.0, mean, 4 * expect / std::sqrt(static_cast<double>(runs)));
 }
 
 TEST_GROUP(ChassisDock){};
@@ -394,12 +396,12 @@ TEST(ChassisDock, CannotPassThroughAndStalls) {
   c.command_wheels(diff_cmd(4.0, 4.0));  // 0.2 m/s
   c.run_for(12.0);                        // would travel 2.4 m
   // Pad (0.225 ahead) stops at the hard stop 8 mm past the contact plane: body x = 2.008 - 0.225.
-  DOUBLES_EQUAL(2.0 + 0.008 - 0.225, px(c.state()), 1e-9);
+  REAL_EQUAL(2.0 + 0.008 - 0.225, px(c.state()), 1e-9);
   CHECK_TRUE(c.state().stalled);
   CHECK_TRUE(c.state().at_hard_stop);
-  DOUBLES_EQUAL(4.0, c.state().wheel_target_radps[0], 0.0);
-  DOUBLES_EQUAL(0.0, c.state().wheel_measured_radps[0], 0.05);
-  DOUBLES_EQUAL(0.008, c.state().press_m, 1e-9);
+  REAL_EQUAL(4.0, c.state().wheel_target_radps[0], 0.0);
+  REAL_EQUAL(0.0, c.state().wheel_measured_radps[0], 0.05);
+  REAL_EQUAL(0.008, c.state().press_m, 1e-9);
   CHECK_TRUE(c.state().contact);
   // Backing off releases the stall.
   c.command_wheels(diff_cmd(-4.0, -4.0));
@@ -433,8 +435,8 @@ TEST(ChassisDock, RearPadsBackwardsDocking) {
   c.set_true_pose(Pose2{0.0, 0.0, kPi});  // rear (pads) towards the dock
   c.command_wheels(diff_cmd(-4.0, -4.0));
   c.run_for(12.0);
-  DOUBLES_EQUAL(2.0 + 0.008 - 0.225, px(c.state()), 1e-9);
-  DOUBLES_EQUAL(0.0, c.state().pad_yaw_error_rad, 1e-9);
+  REAL_EQUAL(2.0 + 0.008 - 0.225, px(c.state()), 1e-9);
+  REAL_EQUAL(0.0, c.state().pad_yaw_error_rad, 1e-9);
   CHECK_TRUE(c.state().contact);
   CHECK_TRUE(c.state().stalled);
 }
@@ -469,9 +471,9 @@ TEST(ChassisDock, ContactToleranceEdges) {
     c.set_dock(DockPlacement{dock, 0.15, false});
     c.set_true_pose(pose_for_pad(dock, k.press, k.lateral, k.yaw));
     c.step();  // no command: stays put
-    DOUBLES_EQUAL(k.press, c.state().press_m, 1e-9);
-    DOUBLES_EQUAL(k.lateral, c.state().pad_lateral_m, 1e-9);
-    DOUBLES_EQUAL(k.yaw, c.state().pad_yaw_error_rad, 1e-9);
+    REAL_EQUAL(k.press, c.state().press_m, 1e-9);
+    REAL_EQUAL(k.lateral, c.state().pad_lateral_m, 1e-9);
+    REAL_EQUAL(k.yaw, c.state().pad_yaw_error_rad, 1e-9);
     CHECK_EQUAL(k.contact, c.state().contact);
   }
 }
@@ -488,12 +490,12 @@ TEST(ChassisDock, ChargingAfterDelayNotWithDeadDockOrInhibited) {
   for (int k = 0; k < 99; ++k) {
     c.step();
     CHECK_FALSE(c.state().charging);
-    DOUBLES_EQUAL(0.0, c.state().charge_current_a, 0.0);
+    REAL_EQUAL(0.0, c.state().charge_current_a, 0.0);
   }
   c.step();  // t = 0.505 s: 0.5 s after contact
   CHECK_TRUE(c.state().charging);
-  DOUBLES_EQUAL(5.0, c.state().charge_current_a, 1e-12);
-  DOUBLES_EQUAL(5.0 - 0.8, c.state().battery_current_a, 1e-12);
+  REAL_EQUAL(5.0, c.state().charge_current_a, 1e-12);
+  REAL_EQUAL(5.0 - 0.8, c.state().battery_current_a, 1e-12);
   c.set_charging_inhibited(true);
   c.step();
   CHECK_FALSE(c.state().charging);
@@ -510,7 +512,7 @@ TEST(ChassisDock, ChargingAfterDelayNotWithDeadDockOrInhibited) {
   dead.run_for(3.0);
   CHECK_TRUE(dead.state().contact);
   CHECK_FALSE(dead.state().charging);
-  DOUBLES_EQUAL(-0.8, dead.state().battery_current_a, 1e-12);
+  REAL_EQUAL(-0.8, dead.state().battery_current_a, 1e-12);
 }
 
 TEST(ChassisDock, MecanumStallsAgainstDock) {
@@ -518,7 +520,7 @@ TEST(ChassisDock, MecanumStallsAgainstDock) {
   c.set_dock(DockPlacement{Pose2{1.0, 0.0, kPi}, 0.15, false});
   c.command_wheels(all4(4.0, 4.0, 4.0, 4.0));
   c.run_for(8.0);
-  DOUBLES_EQUAL(1.008 - 0.225, px(c.state()), 1e-9);
+  REAL_EQUAL(1.008 - 0.225, px(c.state()), 1e-9);
   CHECK_TRUE(c.state().stalled);
   CHECK_TRUE(c.state().contact);
 }
@@ -527,10 +529,10 @@ TEST_GROUP(ChassisBattery){};
 
 TEST(ChassisBattery, OcvTableInterpolates) {
   BatteryParams bp;
-  DOUBLES_EQUAL(21.0, battery_ocv_v(bp, 0.0), 1e-12);
-  DOUBLES_EQUAL(29.4, battery_ocv_v(bp, 1.0), 1e-12);
-  DOUBLES_EQUAL(0.5 * (25.90 + 26.25), battery_ocv_v(bp, 0.45), 1e-12);
-  DOUBLES_EQUAL(29.4, battery_ocv_v(bp, 1.5), 1e-12);
+  REAL_EQUAL(21.0, battery_ocv_v(bp, 0.0), 1e-12);
+  REAL_EQUAL(29.4, battery_ocv_v(bp, 1.0), 1e-12);
+  REAL_EQUAL(0.5 * (25.90 + 26.25), battery_ocv_v(bp, 0.45), 1e-12);
+  REAL_EQUAL(29.4, battery_ocv_v(bp, 1.5), 1e-12);
 }
 
 TEST(ChassisBattery, SocRisesWhenChargingFallsWhenDriving) {
@@ -541,18 +543,18 @@ TEST(ChassisBattery, SocRisesWhenChargingFallsWhenDriving) {
   c.set_dock(DockPlacement{dock, 0.15, false});
   c.set_true_pose(pose_for_pad(dock, 0.005, 0.0, 0.0));
   const double soc0 = c.state().battery_soc;
-  DOUBLES_EQUAL(0.5, soc0, 0.0);
+  REAL_EQUAL(0.5, soc0, 0.0);
   c.run_for(60.0);
   // Net +4.2 A for 60 s into 20 Ah.
-  DOUBLES_EQUAL(soc0 + 4.2 * 60 / 3600 / 20, c.state().battery_soc, 1e-9);
+  REAL_EQUAL(soc0 + 4.2 * 60 / 3600 / 20, c.state().battery_soc, 1e-9);
   const BatteryParams& bp = p.battery;
-  DOUBLES_EQUAL(battery_ocv_v(bp, c.state().battery_soc) + 4.2 * 0.08, c.state().battery_voltage_v, 1e-9);
+  REAL_EQUAL(battery_ocv_v(bp, c.state().battery_soc) + 4.2 * 0.08, c.state().battery_voltage_v, 1e-9);
 
   Chassis d(p, 1);
   d.command_wheels(diff_cmd(10.0, 10.0));  // 0.5 m/s: 0.8 + 4·0.5 = 2.8 A
   d.run_for(60.0);
-  DOUBLES_EQUAL(0.5 - 2.8 * 60 / 3600 / 20, d.state().battery_soc, 1e-6);
-  DOUBLES_EQUAL(-2.8, d.state().battery_current_a, 1e-9);
+  REAL_EQUAL(0.5 - 2.8 * 60 / 3600 / 20, d.state().battery_soc, 1e-6);
+  REAL_EQUAL(-2.8, d.state().battery_current_a, 1e-9);
   CHECK(d.state().battery_voltage_v < battery_ocv_v(bp, d.state().battery_soc));
 }
 
@@ -565,7 +567,7 @@ TEST(ChassisBattery, ChargeTapersNearFull) {
   c.set_true_pose(pose_for_pad(dock, 0.005, 0.0, 0.0));
   c.set_battery_soc(0.975);  // halfway through the 0.95..1 taper
   c.step();
-  DOUBLES_EQUAL(2.5, c.state().charge_current_a, 1e-6);
+  REAL_EQUAL(2.5, c.state().charge_current_a, 1e-6);
 }
 
 TEST_GROUP(ChassisHooks){};
@@ -574,10 +576,10 @@ TEST(ChassisHooks, PoseJumpMovesTruthNotOdometry) {
   Chassis c(ideal(DriveKind::kDifferential), 1);
   c.apply_pose_jump(0.1, -0.05, 0.2);
   c.step();
-  DOUBLES_EQUAL(0.1, px(c.state()), 1e-12);
-  DOUBLES_EQUAL(-0.05, py(c.state()), 1e-12);
-  DOUBLES_EQUAL(0.2, pyaw(c.state()), 1e-12);
-  DOUBLES_EQUAL(0.0, static_cast<double>(c.state().odom_pose.x_m), 0.0);
+  REAL_EQUAL(0.1, px(c.state()), 1e-12);
+  REAL_EQUAL(-0.05, py(c.state()), 1e-12);
+  REAL_EQUAL(0.2, pyaw(c.state()), 1e-12);
+  REAL_EQUAL(0.0, static_cast<double>(c.state().odom_pose.x_m), 0.0);
 }
 
 TEST(ChassisHooks, FreezeHoldsReportsAndIgnoresCommands) {
@@ -590,21 +592,21 @@ TEST(ChassisHooks, FreezeHoldsReportsAndIgnoresCommands) {
   c.command_wheels(diff_cmd(0.0, 0.0));  // lost
   c.run_for(0.5);
   CHECK_FALSE(c.state().responding);
-  DOUBLES_EQUAL(0.5 * (1.0 - kDt / 2), px(c.state()), 1e-9);  // kept driving
+  REAL_EQUAL(0.5 * (1.0 - kDt / 2), px(c.state()), 1e-9);  // kept driving
   LONGS_EQUAL(before.encoder_counts[0], c.state().encoder_counts[0]);
-  DOUBLES_EQUAL(static_cast<double>(before.odom_pose.x_m), static_cast<double>(c.state().odom_pose.x_m), 0.0);
+  REAL_EQUAL(static_cast<double>(before.odom_pose.x_m), static_cast<double>(c.state().odom_pose.x_m), 0.0);
   c.set_frozen(false);
   c.step();
   CHECK_TRUE(c.state().responding);
   // Odometry catches up in one go from the true counters.
-  DOUBLES_EQUAL(px(c.state()), static_cast<double>(c.state().odom_pose.x_m), 1e-5);
+  REAL_EQUAL(px(c.state()), static_cast<double>(c.state().odom_pose.x_m), 1e-5);
 
   Chassis s(ideal(DriveKind::kDifferential), 1);
   s.command_wheels(diff_cmd(10.0, 10.0));
   s.run_for(0.5);
   s.set_frozen(true, FreezeMotion::kStop);
   s.run_for(0.5);
-  DOUBLES_EQUAL(0.5 * (0.5 - kDt / 2) + 0.5 * kDt / 2, px(s.state()), 1e-9);  // braked within one step
+  REAL_EQUAL(0.5 * (0.5 - kDt / 2) + 0.5 * kDt / 2, px(s.state()), 1e-9);  // braked within one step
 }
 
 TEST_GROUP(ChassisDeterminism){};

@@ -6,6 +6,8 @@
 #include "docksim/lidar_sim.hpp"
 #include "docksim/scenes.hpp"
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
@@ -145,8 +147,8 @@ TEST(DockPoseEstimator, TwoDocksNearestOrByHint) {
   const DockProfile prof = profile("plate-v");
   g_est.configure(prof, EstimatorParams{});
   const double back_m = -prof.vertices_m[0].x();
-  const Pose2 near_dock{1.2 - back_m, 0.3, kPi};
-  const Pose2 far_dock{1.2 - back_m, -0.8, kPi};
+  const Pose2 near_dock = dockcore_test::pose(1.2 - back_m, 0.3, kPi);
+  const Pose2 far_dock = dockcore_test::pose(1.2 - back_m, -0.8, kPi);
   docksim::World w;
   w.add_polyline({Vec2(1.2, -3.0), Vec2(1.2, 3.0)});
   w.add_dock(prof, near_dock);
@@ -160,7 +162,7 @@ TEST(DockPoseEstimator, TwoDocksNearestOrByHint) {
   EstimatorParams p;
   p.select = DockSelect::kHint;
   g_est.configure(prof, p);
-  const Pose2 hint{far_dock.x_m + 0.05, far_dock.y_m - 0.05, far_dock.yaw_rad + 0.1};
+  const Pose2 hint = dockcore_test::pose(far_dock.x_m + 0.05, far_dock.y_m - 0.05, far_dock.yaw_rad + 0.1);
   const DockEstimate by_hint = g_est.estimate(g_scan.view(), Pose2{}, &hint);
   check_close(far_dock, by_hint, 0.015, deg_to_rad(3.0));
 }
@@ -207,7 +209,7 @@ TEST(DockPoseEstimator, ConvergesFromPoorHint) {
   const DockProfile prof = profile("plate-v");
   g_est.configure(prof, EstimatorParams{});
   const Truth t = simulate(prof, 0.8, 0.1, 0.2, ld06(0.005), 21);
-  const Pose2 poor{t.dock_in_lidar.x_m + 0.08, t.dock_in_lidar.y_m - 0.07, t.dock_in_lidar.yaw_rad - deg_to_rad(15)};
+  const Pose2 poor = dockcore_test::pose(t.dock_in_lidar.x_m + 0.08, t.dock_in_lidar.y_m - 0.07, t.dock_in_lidar.yaw_rad - deg_to_rad(15));
   const DockEstimate e = g_est.estimate(g_scan.view(), Pose2{}, &poor);
   check_close(t.dock_in_lidar, e, 0.015, deg_to_rad(3.0));
 }

@@ -1,6 +1,8 @@
 #include "dockcore/dock_pose_filter.hpp"
 #include "docksim/rng.hpp"
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
@@ -23,12 +25,12 @@ TEST(DockPoseFilter, FirstDetectionInitialisesInOdomFrame) {
   CHECK_EQUAL(static_cast<int>(FilterUpdate::kInitialised),
               static_cast<int>(f.update(det, diag_cov(0.005, 0.01), odom, 100)));
   // Robot at (1,2) facing +y: the dock lies at (1, 2.5), its x axis pointing -y.
-  DOUBLES_EQUAL(1.0, f.dock_in_odom().x_m, 1e-12);
-  DOUBLES_EQUAL(2.5, f.dock_in_odom().y_m, 1e-12);
-  DOUBLES_EQUAL(-kPi / 2, f.dock_in_odom().yaw_rad, 1e-12);
+  REAL_EQUAL(1.0, f.dock_in_odom().x_m, 1e-12);
+  REAL_EQUAL(2.5, f.dock_in_odom().y_m, 1e-12);
+  REAL_EQUAL(-kPi / 2, f.dock_in_odom().yaw_rad, 1e-12);
   const Pose2 back = f.dock_in_robot(odom);
-  DOUBLES_EQUAL(0.5, back.x_m, 1e-12);
-  DOUBLES_EQUAL(0.0, back.y_m, 1e-12);
+  REAL_EQUAL(0.5, back.x_m, 1e-12);
+  REAL_EQUAL(0.0, back.y_m, 1e-12);
 }
 
 TEST(DockPoseFilter, AveragingReducesNoiseAsOneOverRootN) {
@@ -41,7 +43,7 @@ TEST(DockPoseFilter, AveragingReducesNoiseAsOneOverRootN) {
   for (int t = 0; t < trials; ++t) {
     f.reset();
     for (int k = 0; k < 16; ++k) {
-      const Pose2 det{0.8 + rng.normal(0, sigma), 0.1 + rng.normal(0, sigma), kPi + rng.normal(0, 0.01)};
+      const Pose2 det = dockcore_test::pose(0.8 + rng.normal(0, sigma), 0.1 + rng.normal(0, sigma), kPi + rng.normal(0, 0.01));
       f.update(det, diag_cov(sigma, 0.01), odom, static_cast<std::uint64_t>(k));
     }
     const double e = f.dock_in_odom().x_m - 0.8;
@@ -73,9 +75,9 @@ TEST(DockPoseFilter, OdometryMotionKeepsDockFixedAndGrowsCovariance) {
   f.predict(odom);
   CHECK(f.covariance_odom()(0, 0) > before);
   const Pose2 d = f.dock_in_robot(odom);
-  DOUBLES_EQUAL(0.0, d.x_m, 1e-12);
-  DOUBLES_EQUAL(-0.5, d.y_m, 1e-12);
-  DOUBLES_EQUAL(kPi / 2, d.yaw_rad, 1e-12);
+  REAL_EQUAL(0.0, d.x_m, 1e-12);
+  REAL_EQUAL(-0.5, d.y_m, 1e-12);
+  REAL_EQUAL(kPi / 2, d.yaw_rad, 1e-12);
 }
 
 TEST(DockPoseFilter, JumpIsGatedThenReinitialises) {
@@ -84,11 +86,11 @@ TEST(DockPoseFilter, JumpIsGatedThenReinitialises) {
   for (int k = 0; k < 5; ++k) f.update(Pose2{1.0, 0.0, kPi}, diag_cov(0.005, 0.01), odom, 0);
   const Pose2 pushed{1.0, 0.4, kPi - 0.5};
   CHECK_EQUAL(static_cast<int>(FilterUpdate::kGated), static_cast<int>(f.update(pushed, diag_cov(0.005, 0.01), odom, 1)));
-  DOUBLES_EQUAL(0.0, f.dock_in_odom().y_m, 1e-9);
+  REAL_EQUAL(0.0, f.dock_in_odom().y_m, 1e-9);
   CHECK_EQUAL(static_cast<int>(FilterUpdate::kGated), static_cast<int>(f.update(pushed, diag_cov(0.005, 0.01), odom, 2)));
   CHECK_EQUAL(static_cast<int>(FilterUpdate::kReinitialised),
               static_cast<int>(f.update(pushed, diag_cov(0.005, 0.01), odom, 3)));
-  DOUBLES_EQUAL(0.4, f.dock_in_odom().y_m, 1e-12);
+  REAL_EQUAL(0.4, f.dock_in_odom().y_m, 1e-12);
   CHECK_EQUAL(1u, f.reinitialisations());
   CHECK_EQUAL(2u, f.gated());
 }
@@ -98,6 +100,6 @@ TEST(DockPoseFilter, NonFiniteInputChangesNothing) {
   f.update(Pose2{1.0, 0.0, kPi}, diag_cov(0.005, 0.01), Pose2{}, 0);
   CHECK_EQUAL(static_cast<int>(FilterUpdate::kInvalid),
               static_cast<int>(f.update(Pose2{std::nan(""), 0, 0}, diag_cov(0.005, 0.01), Pose2{}, 1)));
-  DOUBLES_EQUAL(1.0, f.dock_in_odom().x_m, 1e-12);
+  REAL_EQUAL(1.0, f.dock_in_odom().x_m, 1e-12);
   CHECK_EQUAL(1u, f.fused());
 }

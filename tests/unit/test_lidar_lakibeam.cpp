@@ -10,6 +10,8 @@
 #include "dockcore/lidar_lakibeam.hpp"
 #include "dockcore/lidar_ld06.hpp"
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
@@ -86,8 +88,8 @@ TEST(Lakibeam, InterpolatesAzimuthAndSplitsAtTheWrap) {
   // Point 1440 + 10 (datagram 7, block 6, k 10 -> 2000 + 106 mm) sits at sensor 2.5 deg.
   Real r = 0, i = 0;
   CHECK(scan_lookup(s.view(), deg_to_rad(2.5 - 180), &r, &i));
-  DOUBLES_EQUAL(2.106, r, 1e-9);
-  DOUBLES_EQUAL(77.0, i, 1e-9);
+  REAL_EQUAL(2.106, r, 1e-9);
+  REAL_EQUAL(77.0, i, 1e-9);
 }
 
 TEST(Lakibeam, LastBlockReusesThePreviousStep) {
@@ -157,13 +159,13 @@ TEST(Lakibeam, EncoderRoundTrip) {
   for (std::size_t i = 0; i < in.count; ++i) {
     Real r = -1, it = -1;
     CHECK(scan_lookup(out.view(), in.view().angle_rad(i), &r, &it));
-    DOUBLES_EQUAL(in.ranges_m[i], r, 0.0005 + 1e-12);
-    DOUBLES_EQUAL(in.ranges_m[i] > 0 ? in.intensities[i] : 0.0, it, 1e-9);
+    REAL_EQUAL(in.ranges_m[i], r, 0.0005 + 1e-12);
+    REAL_EQUAL(in.ranges_m[i] > 0 ? in.intensities[i] : 0.0, it, 1e-9);
   }
   // Outside the 270 deg field of view: no return.
   Real r = -1, it = -1;
   CHECK(scan_lookup(out.view(), kPi, &r, &it));
-  DOUBLES_EQUAL(0.0, r, 0.0);
+  REAL_EQUAL(0.0, r, 0.0);
 }
 
 TEST(Lakibeam, Ld06PacketsOverUdpFeedTheLd06Parser) {
@@ -206,6 +208,6 @@ TEST(Lakibeam, RecordedCaptureGivesExactCounters) {
   for (int j = 0; j < 1440; ++j) {
     Real r = -1, i = -1;
     CHECK(scan_lookup(scans[0].view(), deg_to_rad(0.25 * j - 180), &r, &i));
-    DOUBLES_EQUAL(capture_dist_mm(j) / 1000.0, r, 1e-9);
+    REAL_EQUAL(capture_dist_mm(j) / 1000.0, r, 1e-9);
   }
 }

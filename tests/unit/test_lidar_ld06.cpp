@@ -9,6 +9,8 @@
 
 #include "dockcore/lidar_ld06.hpp"
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
@@ -101,23 +103,23 @@ TEST(Ld06, PacketLayoutIsLittleEndianWithCrc) {
 }
 
 TEST(Ld06, AngleInterpolationWrapsAt360) {
-  DOUBLES_EQUAL(1000.0, ld06_point_angle_cdeg(1000, 1880, 0), 1e-9);
-  DOUBLES_EQUAL(1080.0, ld06_point_angle_cdeg(1000, 1880, 1), 1e-9);
-  DOUBLES_EQUAL(1880.0, ld06_point_angle_cdeg(1000, 1880, 11), 1e-9);
+  REAL_EQUAL(1000.0, ld06_point_angle_cdeg(1000, 1880, 0), 1e-9);
+  REAL_EQUAL(1080.0, ld06_point_angle_cdeg(1000, 1880, 1), 1e-9);
+  REAL_EQUAL(1880.0, ld06_point_angle_cdeg(1000, 1880, 11), 1e-9);
   // 355.00 -> 3.80 deg: span 880 across the wrap; point 7 is at 355 + 560/100 = 360.6 -> 0.6 deg.
-  DOUBLES_EQUAL(35580.0, ld06_point_angle_cdeg(35500, 380, 1), 1e-9);
-  DOUBLES_EQUAL(60.0, ld06_point_angle_cdeg(35500, 380, 7), 1e-9);
-  DOUBLES_EQUAL(380.0, ld06_point_angle_cdeg(35500, 380, 11), 1e-9);
+  REAL_EQUAL(35580.0, ld06_point_angle_cdeg(35500, 380, 1), 1e-9);
+  REAL_EQUAL(60.0, ld06_point_angle_cdeg(35500, 380, 7), 1e-9);
+  REAL_EQUAL(380.0, ld06_point_angle_cdeg(35500, 380, 11), 1e-9);
 }
 
 TEST(Ld06, ClockwiseSensorAngleBecomesCounterClockwiseCoreAngle) {
   const LidarAngleConvention c{true, 0};
   // Sensor 90 deg clockwise = the lidar's right = core -90 deg.
-  DOUBLES_EQUAL(-kPi / 2, c.to_core(kPi / 2), 1e-12);
-  DOUBLES_EQUAL(3 * kPi / 2, c.to_sensor(kPi / 2), 1e-12);
+  REAL_EQUAL(-kPi / 2, c.to_core(kPi / 2), 1e-12);
+  REAL_EQUAL(3 * kPi / 2, c.to_sensor(kPi / 2), 1e-12);
   const LidarAngleConvention rp{true, kPi};
-  DOUBLES_EQUAL(kPi, rp.to_core(0), 1e-12);       // RPLIDAR 0 deg points backwards
-  DOUBLES_EQUAL(kPi / 2, rp.to_core(kPi / 2), 1e-12);  // its 90 deg (clockwise from the back) is the left
+  REAL_EQUAL(kPi, rp.to_core(0), 1e-12);       // RPLIDAR 0 deg points backwards
+  REAL_EQUAL(kPi / 2, rp.to_core(kPi / 2), 1e-12);  // its 90 deg (clockwise from the back) is the left
 }
 
 TEST(Ld06, StreamAssemblesTurnsAtTheWrap) {
@@ -146,8 +148,8 @@ TEST(Ld06, StreamAssemblesTurnsAtTheWrap) {
     const Real core = -deg_to_rad(0.8 * (j - 450));
     Real r = 0, inten = 0;
     CHECK(scan_lookup(scan.view(), core, &r, &inten));
-    DOUBLES_EQUAL((1000 + j / 12 + j % 12) / 1000.0, r, 1e-9);
-    DOUBLES_EQUAL(100 + j % 12, inten, 1e-9);
+    REAL_EQUAL((1000 + j / 12 + j % 12) / 1000.0, r, 1e-9);
+    REAL_EQUAL(100 + j % 12, inten, 1e-9);
   }
 }
 
@@ -181,9 +183,9 @@ TEST(Ld06, PacketStraddlingZeroIsSplitExactly) {
   CHECK(p->take_scan(scan));
   Real r = 0, inten = 0;
   CHECK(scan_lookup(scan.view(), -deg_to_rad(359.2), &r, &inten));
-  DOUBLES_EQUAL(3.005, r, 1e-9);  // point 5 of the wrap packet went into the closing turn
+  REAL_EQUAL(3.005, r, 1e-9);  // point 5 of the wrap packet went into the closing turn
   CHECK(scan_lookup(scan.view(), 0, &r, &inten));
-  DOUBLES_EQUAL(2.0, r, 1e-9);  // 0 deg holds the first turn's point, not the wrap packet's point 6
+  REAL_EQUAL(2.0, r, 1e-9);  // 0 deg holds the first turn's point, not the wrap packet's point 6
 }
 
 TEST(Ld06, CrcErrorRescansSoTheNextPacketSurvives) {
@@ -294,11 +296,11 @@ TEST(Ld06, EncoderRoundTripWithinQuantisation) {
   LaserScan out;
   CHECK(p->take_scan(out));
   CHECK_EQUAL(in.count, out.count);
-  DOUBLES_EQUAL(in.angle_min_rad, out.angle_min_rad, 1e-12);
+  REAL_EQUAL(in.angle_min_rad, out.angle_min_rad, 1e-12);
   for (std::size_t i = 0; i < 450; ++i) {
-    DOUBLES_EQUAL(in.ranges_m[i], out.ranges_m[i], 0.0005 + 1e-12);
+    REAL_EQUAL(in.ranges_m[i], out.ranges_m[i], 0.0005 + 1e-12);
     // A no-return carries no intensity.
-    DOUBLES_EQUAL(in.ranges_m[i] > 0 ? in.intensities[i] : 0.0, out.intensities[i], 1e-9);
+    REAL_EQUAL(in.ranges_m[i] > 0 ? in.intensities[i] : 0.0, out.intensities[i], 1e-9);
   }
   CHECK_EQUAL(0u, p->counters().bin_collisions);
 }
@@ -329,14 +331,14 @@ TEST(Ld06, RecordedCaptureGivesExactCounters) {
   for (int j = 0; j < 450; ++j) {
     Real r = -1, inten = -1;
     CHECK(scan_lookup(scans[0].view(), -deg_to_rad(0.8 * j), &r, &inten));
-    DOUBLES_EQUAL(capture_dist_mm(j) / 1000.0, r, 1e-9);
+    REAL_EQUAL(capture_dist_mm(j) / 1000.0, r, 1e-9);
   }
   // Turn 2 lost packet 50 (points 600..611 = turn points 150..161): no return there.
   Real r = -1, inten = -1;
   CHECK(scan_lookup(scans[1].view(), -deg_to_rad(0.8 * 155), &r, &inten));
-  DOUBLES_EQUAL(0.0, r, 0.0);
+  REAL_EQUAL(0.0, r, 0.0);
   CHECK(scan_lookup(scans[1].view(), -deg_to_rad(0.8 * 149), &r, &inten));
-  DOUBLES_EQUAL(capture_dist_mm(149) / 1000.0, r, 1e-9);
+  REAL_EQUAL(capture_dist_mm(149) / 1000.0, r, 1e-9);
 }
 
 TEST(Ld06, ResetCountsBufferedBytesAndPartialTurn) {

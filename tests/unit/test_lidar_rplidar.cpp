@@ -9,6 +9,8 @@
 
 #include "dockcore/lidar_rplidar.hpp"
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
@@ -138,11 +140,11 @@ TEST(Rplidar, TurnsStartAtTheSBitAndAnglesConvert) {
   // Sensor 0 deg (clockwise from the back) = core 180 deg; sensor 90 deg = core +90 deg (left).
   Real r = 0, i = 0;
   CHECK(scan_lookup(scan.view(), kPi, &r, &i));
-  DOUBLES_EQUAL(0.5, r, 1e-9);
+  REAL_EQUAL(0.5, r, 1e-9);
   CHECK(scan_lookup(scan.view(), kPi / 2, &r, &i));
-  DOUBLES_EQUAL(0.59, r, 1e-9);
+  REAL_EQUAL(0.59, r, 1e-9);
   CHECK(scan_lookup(scan.view(), -kPi / 2, &r, &i));
-  DOUBLES_EQUAL(0.77, r, 1e-9);
+  REAL_EQUAL(0.77, r, 1e-9);
   check_accounting(*p);
 }
 
@@ -182,7 +184,7 @@ TEST(Rplidar, TruncatedNodeResynchronises) {
   for (int j = 0; j < 360; ++j) {
     Real r = 0, i = 0;
     CHECK(scan_lookup(scan.view(), kPi - deg_to_rad(j), &r, &i));
-    DOUBLES_EQUAL((500 + j) / 1000.0, r, 1e-9);
+    REAL_EQUAL((500 + j) / 1000.0, r, 1e-9);
   }
   check_accounting(*p);
 }
@@ -227,8 +229,8 @@ TEST(Rplidar, EncoderRoundTrip) {
   LaserScan out;
   CHECK(p->take_scan(out));
   for (std::size_t i = 0; i < 360; ++i) {
-    DOUBLES_EQUAL(in.ranges_m[i], out.ranges_m[i], 0.000125 + 1e-12);
-    DOUBLES_EQUAL(in.ranges_m[i] > 0 ? in.intensities[i] : 0.0, out.intensities[i], 1e-9);
+    REAL_EQUAL(in.ranges_m[i], out.ranges_m[i], 0.000125 + 1e-12);
+    REAL_EQUAL(in.ranges_m[i] > 0 ? in.intensities[i] : 0.0, out.intensities[i], 1e-9);
   }
   CHECK_EQUAL(0u, p->counters().bin_collisions);
 }
@@ -256,6 +258,6 @@ TEST(Rplidar, RecordedCaptureGivesExactCounters) {
   for (int j = 0; j < 360; ++j) {
     Real r = -1, i = -1;
     CHECK(scan_lookup(scans[1].view(), kPi - deg_to_rad(j), &r, &i));
-    DOUBLES_EQUAL(capture_dist_mm(j) / 1000.0, r, 1e-9);
+    REAL_EQUAL(capture_dist_mm(j) / 1000.0, r, 1e-9);
   }
 }

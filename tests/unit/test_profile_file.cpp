@@ -8,6 +8,8 @@
 #include "dockcore/dock_profile.hpp"
 #include "docksim/profile_file.hpp"
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using dockcore::DockProfile;
@@ -51,20 +53,20 @@ TEST(ProfileFile, GoodFileWithOffsetAndName) {
   STRCMP_EQUAL("wings", p.name);
   LONGS_EQUAL(4, p.vertex_count);
   // Every x shifted by -0.02 so the contacts sit at the origin.
-  DOUBLES_EQUAL(-0.07, p.vertices_m[0].x(), 1e-12);
-  DOUBLES_EQUAL(-0.20, p.vertices_m[0].y(), 1e-12);
-  DOUBLES_EQUAL(0.0, p.vertices_m[1].x(), 1e-12);
-  DOUBLES_EQUAL(0.15, p.vertices_m[2].y(), 1e-12);
-  DOUBLES_EQUAL(0.40, p.width_m(), 1e-12);
+  REAL_EQUAL(-0.07, p.vertices_m[0].x(), 1e-12);
+  REAL_EQUAL(-0.20, p.vertices_m[0].y(), 1e-12);
+  REAL_EQUAL(0.0, p.vertices_m[1].x(), 1e-12);
+  REAL_EQUAL(0.15, p.vertices_m[2].y(), 1e-12);
+  REAL_EQUAL(0.40, p.width_m(), 1e-12);
   // Face segment 1 runs -y -> +y at x = 0: outward normal +x.
-  DOUBLES_EQUAL(1.0, p.normal(1).x(), 1e-12);
+  REAL_EQUAL(1.0, p.normal(1).x(), 1e-12);
 }
 
 TEST(ProfileFile, IntegersAcceptedAndDefaultName) {
   const DockProfile p = parse_profile_toml("points = [[0, -1], [0, 1]]\n", "x.toml", "fallback");
   STRCMP_EQUAL("fallback", p.name);
   LONGS_EQUAL(2, p.vertex_count);
-  DOUBLES_EQUAL(2.0, p.length_m(), 1e-12);
+  REAL_EQUAL(2.0, p.length_m(), 1e-12);
 }
 
 TEST(ProfileFile, RoundTripOfBuiltins) {
@@ -138,7 +140,7 @@ TEST(ProfileFile, ResolveBuiltinFileAndUnknown) {
   }
   const DockProfile p = docksim::resolve_profile(path);
   STRCMP_EQUAL("test_profile_file_tmp", p.name);
-  DOUBLES_EQUAL(0.2, p.width_m(), 1e-12);
+  REAL_EQUAL(0.2, p.width_m(), 1e-12);
   std::remove(path.c_str());
 
   try {

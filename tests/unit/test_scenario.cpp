@@ -5,6 +5,8 @@
 
 #include "docksim/scenario.hpp"
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 namespace {
@@ -92,38 +94,38 @@ TEST(Scenario, GoodFile) {
   STRCMP_EQUAL("t", sc.name.c_str());
   CHECK_EQUAL(42u, sc.seed);
   CHECK(sc.chassis.geometry.kind == docksim::DriveKind::kMecanum);
-  DOUBLES_EQUAL(0.06, sc.chassis.geometry.wheel_radius_m, 1e-12);
+  REAL_EQUAL(0.06, sc.chassis.geometry.wheel_radius_m, 1e-12);
   CHECK(sc.chassis.footprint.shape == docksim::FootprintShape::kCircle);
-  DOUBLES_EQUAL(0.1, static_cast<double>(sc.lidar_mount.x_m), 1e-9);
-  DOUBLES_EQUAL(90 * kDeg, static_cast<double>(sc.lidar_mount.yaw_rad), 1e-9);
+  REAL_EQUAL(0.1, static_cast<double>(sc.lidar_mount.x_m), 1e-9);
+  REAL_EQUAL(90 * kDeg, static_cast<double>(sc.lidar_mount.yaw_rad), 1e-9);
   CHECK(sc.camera.enabled);
-  DOUBLES_EQUAL(600, static_cast<double>(sc.camera.model.fx_px), 1e-9);
+  REAL_EQUAL(600, static_cast<double>(sc.camera.model.fx_px), 1e-9);
   // seed003 gets the scenario's camera and, on mecanum, the holonomic law.
-  DOUBLES_EQUAL(600, static_cast<double>(sc.seed003.camera.fx_px), 1e-9);
+  REAL_EQUAL(600, static_cast<double>(sc.seed003.camera.fx_px), 1e-9);
   CHECK(sc.seed003.holonomic);
-  DOUBLES_EQUAL(2.5, static_cast<double>(sc.seed003.x_kp), 1e-9);
+  REAL_EQUAL(2.5, static_cast<double>(sc.seed003.x_kp), 1e-9);
   // Lidar overrides on top of the LD06 model.
   STRCMP_EQUAL("ld06", sc.lidar.name.c_str());
   CHECK_EQUAL(450u, sc.lidar.beams);
-  DOUBLES_EQUAL(0.02, sc.lidar.sigma_const_m, 1e-12);
-  DOUBLES_EQUAL(0.05, sc.lidar.dropout_prob, 1e-12);
+  REAL_EQUAL(0.02, sc.lidar.sigma_const_m, 1e-12);
+  REAL_EQUAL(0.05, sc.lidar.dropout_prob, 1e-12);
   STRCMP_EQUAL("v-marker", sc.profile.name);
-  DOUBLES_EQUAL(1.0, static_cast<double>(sc.dock_pose.x_m), 1e-9);
+  REAL_EQUAL(1.0, static_cast<double>(sc.dock_pose.x_m), 1e-9);
   CHECK_EQUAL(1u, sc.boxes.size());
   CHECK_EQUAL(1u, sc.circles.size());
-  DOUBLES_EQUAL(-10 * kDeg, sc.start.bearing_min_rad, 1e-12);
-  DOUBLES_EQUAL(20 * kDeg, sc.start.bearing_max_rad, 1e-12);
+  REAL_EQUAL(-10 * kDeg, sc.start.bearing_min_rad, 1e-12);
+  REAL_EQUAL(20 * kDeg, sc.start.bearing_max_rad, 1e-12);
   // Events sorted by time.
   CHECK_EQUAL(2u, sc.events.size());
   CHECK(sc.events[0].kind == docksim::EventKind::kPush);
-  DOUBLES_EQUAL(0.3, sc.events[0].dx_m, 1e-12);
-  DOUBLES_EQUAL(10 * kDeg, sc.events[0].dyaw_rad, 1e-12);
+  REAL_EQUAL(0.3, sc.events[0].dx_m, 1e-12);
+  REAL_EQUAL(10 * kDeg, sc.events[0].dyaw_rad, 1e-12);
   CHECK(sc.events[1].kind == docksim::EventKind::kOccludeDock);
-  DOUBLES_EQUAL(1.0, sc.events[1].duration_s, 1e-12);
+  REAL_EQUAL(1.0, sc.events[1].duration_s, 1e-12);
   STRCMP_EQUAL("seed003", sc.controller.c_str());
   // Pads on a 0.25 m circle: every controller's pad reach follows the footprint.
-  DOUBLES_EQUAL(0.25, static_cast<double>(sc.smooth.common.pad_reach_m), 1e-9);
-  DOUBLES_EQUAL(0.25, static_cast<double>(sc.seed004.common.pad_reach_m), 1e-9);
+  REAL_EQUAL(0.25, static_cast<double>(sc.smooth.common.pad_reach_m), 1e-9);
+  REAL_EQUAL(0.25, static_cast<double>(sc.seed004.common.pad_reach_m), 1e-9);
 }
 
 TEST(Scenario, EmptyFileGivesDefaults) {
@@ -132,10 +134,10 @@ TEST(Scenario, EmptyFileGivesDefaults) {
   STRCMP_EQUAL("smooth", sc.controller.c_str());
   STRCMP_EQUAL("plate-v", sc.profile.name);
   CHECK(sc.chassis.geometry.kind == docksim::DriveKind::kDifferential);
-  DOUBLES_EQUAL(0.5, sc.start.distance_min_m, 1e-12);
-  DOUBLES_EQUAL(2.5, sc.start.distance_max_m, 1e-12);
+  REAL_EQUAL(0.5, sc.start.distance_min_m, 1e-12);
+  REAL_EQUAL(2.5, sc.start.distance_max_m, 1e-12);
   // Default 0.45 m rectangle, front pads: 0.225 m from the centre.
-  DOUBLES_EQUAL(0.225, static_cast<double>(sc.smooth.common.pad_reach_m), 1e-9);
+  REAL_EQUAL(0.225, static_cast<double>(sc.smooth.common.pad_reach_m), 1e-9);
   CHECK(!sc.camera.enabled);
 }
 
@@ -191,12 +193,12 @@ TEST(Scenario, ShippedFilesLoad) {
   STRCMP_EQUAL("default", d.name.c_str());
   CHECK(d.chassis.geometry.kind == docksim::DriveKind::kDifferential);
   STRCMP_EQUAL("ld06", d.lidar.name.c_str());
-  DOUBLES_EQUAL(0.010, d.lidar.sigma_const_m, 1e-12);
-  DOUBLES_EQUAL(0.03, d.lidar.dropout_prob, 1e-12);
-  DOUBLES_EQUAL(0.5, d.start.distance_min_m, 1e-12);
-  DOUBLES_EQUAL(2.5, d.start.distance_max_m, 1e-12);
-  DOUBLES_EQUAL(45 * kDeg, d.start.bearing_max_rad, 1e-12);
-  DOUBLES_EQUAL(-30 * kDeg, d.start.heading_min_rad, 1e-12);
+  REAL_EQUAL(0.010, d.lidar.sigma_const_m, 1e-12);
+  REAL_EQUAL(0.03, d.lidar.dropout_prob, 1e-12);
+  REAL_EQUAL(0.5, d.start.distance_min_m, 1e-12);
+  REAL_EQUAL(2.5, d.start.distance_max_m, 1e-12);
+  REAL_EQUAL(45 * kDeg, d.start.bearing_max_rad, 1e-12);
+  REAL_EQUAL(-30 * kDeg, d.start.heading_min_rad, 1e-12);
   const docksim::Scenario s = docksim::load_scenario_file(scenario_dir() + "seed003.toml");
   CHECK(s.chassis.geometry.kind == docksim::DriveKind::kMecanum);
   CHECK(s.camera.enabled);
@@ -213,6 +215,6 @@ TEST(Scenario, SmoothLineupParametersAreSettable) {
   const docksim::Scenario sc = docksim::parse_scenario_toml(
       "[controller]\nname = \"smooth\"\n[controller.smooth]\nlineup_distance_m = 0.35\nlineup_max_curvature_inv_m = 2.5\n",
       "lineup.toml");
-  DOUBLES_EQUAL(0.35, sc.smooth.lineup_distance_m, 1e-12);
-  DOUBLES_EQUAL(2.5, sc.smooth.lineup_max_curvature_inv_m, 1e-12);
+  REAL_EQUAL(0.35, sc.smooth.lineup_distance_m, 1e-12);
+  REAL_EQUAL(2.5, sc.smooth.lineup_max_curvature_inv_m, 1e-12);
 }

@@ -8,6 +8,8 @@
 #include "docksim/scenario.hpp"
 #include "docksim/sim_run.hpp"
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 namespace {
@@ -70,16 +72,16 @@ TEST(SimRun, StartPoseGeometry) {
   const docksim::Scenario sc = default_scenario();
   // Bearing 90 deg, heading 0: robot at (0, 2) in the dock frame facing the dock origin (yaw -90 deg).
   const docksim::StartPose s = docksim::start_from(sc, 2.0, 90 * kDeg, 0);
-  DOUBLES_EQUAL(0.0, static_cast<double>(s.robot_in_dock.x_m), 1e-9);
-  DOUBLES_EQUAL(2.0, static_cast<double>(s.robot_in_dock.y_m), 1e-9);
-  DOUBLES_EQUAL(-90 * kDeg, static_cast<double>(s.robot_in_dock.yaw_rad), 1e-9);
+  REAL_EQUAL(0.0, static_cast<double>(s.robot_in_dock.x_m), 1e-9);
+  REAL_EQUAL(2.0, static_cast<double>(s.robot_in_dock.y_m), 1e-9);
+  REAL_EQUAL(-90 * kDeg, static_cast<double>(s.robot_in_dock.yaw_rad), 1e-9);
   // Drawn starts stay inside the envelope.
   for (std::uint64_t i = 0; i < 200; ++i) {
     const docksim::StartPose d = docksim::draw_start(sc, docksim::trial_seed(1, i));
     CHECK(d.distance_m >= 0.5 && d.distance_m <= 2.5);
     CHECK(std::fabs(d.bearing_rad) <= 45 * kDeg + 1e-12);
     CHECK(std::fabs(d.heading_rad) <= 30 * kDeg + 1e-12);
-    DOUBLES_EQUAL(d.distance_m, std::hypot(static_cast<double>(d.robot_in_dock.x_m), static_cast<double>(d.robot_in_dock.y_m)), 1e-9);
+    REAL_EQUAL(d.distance_m, std::hypot(static_cast<double>(d.robot_in_dock.x_m), static_cast<double>(d.robot_in_dock.y_m)), 1e-9);
   }
 }
 
@@ -206,7 +208,7 @@ TEST(SimRun, CameraProjection) {
   // Target 1 m ahead and 0.1 m to the left: u = 320 - 500 * 0.1 / 1 = 270.
   const dockcore::CameraTarget t = docksim::project_target(p, dockcore::Pose2{}, dockcore::Vec2(1.0, 0.1));
   CHECK(t.valid);
-  DOUBLES_EQUAL(270.0, static_cast<double>(t.u_px), 1e-9);
+  REAL_EQUAL(270.0, static_cast<double>(t.u_px), 1e-9);
   // Behind the camera / outside the image: not seen.
   CHECK(!docksim::project_target(p, dockcore::Pose2{}, dockcore::Vec2(-1.0, 0.0)).valid);
   CHECK(!docksim::project_target(p, dockcore::Pose2{}, dockcore::Vec2(1.0, 1.0)).valid);
@@ -218,5 +220,5 @@ TEST(SimRun, CameraProjection) {
   cam.update(50000, dockcore::Pose2{}, dockcore::Vec2(1.0, 0.1), true);
   CHECK(cam.latest().valid);
   CHECK_EQUAL(0u, cam.latest().stamp_us);
-  DOUBLES_EQUAL(270.0, static_cast<double>(cam.latest().u_px), 1e-9);
+  REAL_EQUAL(270.0, static_cast<double>(cam.latest().u_px), 1e-9);
 }

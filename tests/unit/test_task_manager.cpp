@@ -11,6 +11,8 @@
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
@@ -175,7 +177,7 @@ struct Sim {
     if (front.x() < 0 && std::fabs(front.y()) < 0.3) {
       const double back = -front.x();
       world.x_m += back;  // the dock faces +x
-      odom = odom.compose(Pose2{-back / std::fabs(std::cos(world.yaw_rad)), 0, 0});
+      odom = odom.compose(dockcore_test::pose(-back / std::fabs(std::cos(world.yaw_rad)), 0, 0));
     }
     const Vec2 f2 = dock.inverse_transform(world.transform(Vec2(kHalfLength, 0)));
     contact = f2.x() <= 0.002 && std::fabs(f2.y()) < 0.05;
@@ -190,9 +192,9 @@ struct Sim {
   }
   static Pose2 arc(const Twist2& t, double dt) {
     const double th = t.wz_radps * dt;
-    if (std::fabs(th) < 1e-12) return Pose2{t.vx_mps * dt, t.vy_mps * dt, 0};
+    if (std::fabs(th) < 1e-12) return dockcore_test::pose(t.vx_mps * dt, t.vy_mps * dt, 0);
     const double r = t.vx_mps / t.wz_radps;
-    return Pose2{r * std::sin(th) - t.vy_mps * dt * 0, r * (1 - std::cos(th)) + t.vy_mps * dt, th};
+    return dockcore_test::pose(r * std::sin(th) - t.vy_mps * dt * 0, r * (1 - std::cos(th)) + t.vy_mps * dt, th);
   }
   /// Runs until `state` is reached or `max_s` passes; returns whether it was reached.
   bool run_until(TaskState state, double max_s) {
@@ -242,8 +244,8 @@ TEST(TaskManager, IdleCommandsZeroAndRejections) {
   CHECK(o.command_result == CommandResult::kRejectedDockId);
   CHECK(o.status.state == TaskState::kNotTasking);
   s->run_for(0.5);
-  DOUBLES_EQUAL(1.2, s->world.x_m, 1e-12);  // nothing moved
-  DOUBLES_EQUAL(0.1, s->world.y_m, 1e-12);
+  REAL_EQUAL(1.2, s->world.x_m, 1e-12);  // nothing moved
+  REAL_EQUAL(0.1, s->world.y_m, 1e-12);
   LONGS_EQUAL(0, s->zero_violations);
 }
 
@@ -262,10 +264,10 @@ TEST(TaskManager, HappyPathStateSequenceAndChargeRequest) {
   LONGS_EQUAL(3, s->out.status.dock_id);
   LONGS_EQUAL(0, s->out.status.retries);
   // Front edge at the dock plane, near the axis.
-  DOUBLES_EQUAL(kHalfLength, s->world.x_m, 0.003);
+  REAL_EQUAL(kHalfLength, s->world.x_m, 0.003);
   // The fake controller aims its centre line at the contacts: the front edge's middle lands on them.
   const Vec2 front = s->world.transform(Vec2(kHalfLength, 0));
-  DOUBLES_EQUAL(0.0, front.x(), 0.003);
+  REAL_EQUAL(0.0, front.x(), 0.003);
   CHECK(std::fabs(front.y()) < 0.05);
   s->run_for(5.0);  // stays docked, zero velocity throughout
   CHECK(s->out.status.state == TaskState::kFinishTasking);
@@ -291,7 +293,7 @@ TEST(TaskManager, DetectionSearchSwingsWithinAmplitudeThenFault177) {
   CHECK(lo < -a + deg_to_rad(1.01) && lo > -a - 0.3 * 0.02 - 1e-9);
   const double yaw = s->world.yaw_rad;
   s->run_for(2.0);
-  DOUBLES_EQUAL(yaw, s->world.yaw_rad, 0);
+  REAL_EQUAL(yaw, s->world.yaw_rad, 0);
   LONGS_EQUAL(0, s->zero_violations);
 }
 
@@ -425,7 +427,7 @@ TEST(TaskManager, FarAwayDistanceTolerance178) {
   // Moved away along the line of sight, odometry seeing it (no push): beyond 2.0 m from the dock.
   const double dx = 2.05 - s->world.x_m;
   s->world.x_m += dx;
-  s->odom = s->odom.compose(Pose2{-dx, 0, 0});
+  s->odom = s->odom.compose(dockcore_test::pose(-dx, 0, 0));
   // Two detections: one far detection alone could be clutter (DeviationParams::confirm_detections).
   while (s->ticks % 5 != 0) s->step();
   s->step();
@@ -445,7 +447,7 @@ TEST(TaskManager, StartingFartherThanTheToleranceIsAllowedButNotDrivingAway) {
   CHECK(s->out.status.state == TaskState::kAlign);
   const double dx = 2.75 - s->world.x_m;  // 0.35 m farther than at the start: beyond the 0.3 m growth margin
   s->world.x_m += dx;
-  s->odom = s->odom.compose(Pose2{-dx, 0, 0});
+  s->odom = s->odom.compose(dockcore_test::pose(-dx, 0, 0));
   // Two detections: one far detection alone could be clutter (DeviationParams::confirm_detections).
   while (s->ticks % 5 != 0) s->step();
   s->step();
@@ -508,7 +510,7 @@ TEST(TaskManager, ObstacleStopsAndResumes) {
   CHECK(s->out.obstacles.forward);
   const double x = s->world.x_m;
   s->run_for(0.5);
-  DOUBLES_EQUAL(x, s->world.x_m, 0);
+  REAL_EQUAL(x, s->world.x_m, 0);
   s->obstacles.clear();
   CHECK(s->run_until(TaskState::kFinishTasking, 30));
   LONGS_EQUAL(0, s->zero_violations);
@@ -541,7 +543,7 @@ TEST(TaskManager, ChargingRetryThenSuccess) {
   CHECK(!s->out.status.charge_enable);
   CHECK(s->run_until(TaskState::kReachTaskingPoint, 20));
   // Backed off on odometry until the centre is at the staging distance.
-  DOUBLES_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.1 * 0.02 + 0.002);
+  REAL_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.1 * 0.02 + 0.002);
   LONGS_EQUAL(1, s->out.status.retries);
   CHECK(s->run_until(TaskState::kFinishTasking, 30));
   LONGS_EQUAL(2, s->wait_entries);
@@ -556,12 +558,12 @@ TEST(TaskManager, ChargingExhaustionBacksOffThenFault182) {
   LONGS_EQUAL(182, static_cast<int>(s->out.status.fault));
   LONGS_EQUAL(s->params.max_retries + 1, s->wait_entries);
   LONGS_EQUAL(s->params.max_retries, s->out.status.retries);
-  DOUBLES_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.004);  // a clean end: backed off
+  REAL_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.004);  // a clean end: backed off
   CHECK(!s->contact);
   CHECK(!s->out.status.charge_enable);
   const Pose2 p = s->world;
   s->run_for(3.0);
-  DOUBLES_EQUAL(p.x_m, s->world.x_m, 0);
+  REAL_EQUAL(p.x_m, s->world.x_m, 0);
   LONGS_EQUAL(0, s->zero_violations);
 }
 
@@ -594,7 +596,7 @@ TEST(TaskManager, UndockBacksOffToStagingAndReportsDone) {
   CHECK(!o.status.charge_enable);
   CHECK(s->run_until(TaskState::kNotTasking, 20));
   CHECK(s->out.status.last_result == TaskResult::kUndocked);
-  DOUBLES_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.004);
+  REAL_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.004);
   s->run_for(1.0);
   LONGS_EQUAL(0, s->zero_violations);
 }
@@ -605,7 +607,7 @@ TEST(TaskManager, UndockWaitsForAnObstacleBehind) {
   s->command(HostCommandType::kUndock);
   const double x = s->world.x_m;
   s->run_for(2.0);
-  DOUBLES_EQUAL(x, s->world.x_m, 0);
+  REAL_EQUAL(x, s->world.x_m, 0);
   CHECK(s->out.blocked);
   CHECK(s->out.status.state == TaskState::kUndocking);
   s->obstacles.clear();
@@ -618,7 +620,7 @@ TEST(TaskManager, UndockFailsWhenCurrentDoesNotStop186) {
   s->command(HostCommandType::kUndock);
   CHECK(s->run_until(TaskState::kFault, 5));
   LONGS_EQUAL(186, static_cast<int>(s->out.status.fault));
-  DOUBLES_EQUAL(kHalfLength, s->world.x_m, 0.003);  // never drove with current flowing
+  REAL_EQUAL(kHalfLength, s->world.x_m, 0.003);  // never drove with current flowing
 }
 
 TEST(TaskManager, DockWhileDockedIsReportedAndDoesNotMove) {
@@ -635,7 +637,7 @@ TEST(TaskManager, DockWhileDockedIsReportedAndDoesNotMove) {
   CHECK(o.command_result == CommandResult::kAlreadyDocked);
   CHECK(o.status.state == TaskState::kWaitForCharge);
   CHECK(s->run_until(TaskState::kFinishTasking, 6));
-  DOUBLES_EQUAL(x, s->world.x_m, 0);
+  REAL_EQUAL(x, s->world.x_m, 0);
 }
 
 TEST(TaskManager, BusyAndCancelFromEveryActiveState) {
@@ -719,10 +721,10 @@ TEST(TaskManager, TestModeReportsTheDockAndNeverMoves) {
   s->run_for(1.0);
   CHECK(s->out.status.dock_valid);
   const Pose2 truth = s->world.inverse().compose(s->dock);
-  DOUBLES_EQUAL(truth.x_m, s->out.status.dock_pose.x_m, 1e-9);
+  REAL_EQUAL(truth.x_m, s->out.status.dock_pose.x_m, 1e-9);
   o = s->command(HostCommandType::kDock);
   CHECK(o.command_result == CommandResult::kRejectedBusy);
-  DOUBLES_EQUAL(1.2, s->world.x_m, 0);
+  REAL_EQUAL(1.2, s->world.x_m, 0);
   o = s->command(HostCommandType::kCancel);
   CHECK(o.status.state == TaskState::kNotTasking);
   LONGS_EQUAL(0, s->zero_violations);
@@ -782,7 +784,7 @@ struct FacadeSim {
     if (front.x() < 0 && std::fabs(front.y()) < 0.3) {
       const double back = -front.x();
       w.world.x_m += back;
-      w.odom = w.odom.compose(Pose2{-back / std::fabs(std::cos(w.world.yaw_rad)), 0, 0});
+      w.odom = w.odom.compose(dockcore_test::pose(-back / std::fabs(std::cos(w.world.yaw_rad)), 0, 0));
     }
     const Vec2 f2 = w.dock.inverse_transform(w.world.transform(Vec2(kHalfLength, 0)));
     w.contact = f2.x() <= 0.002 && std::fabs(f2.y()) < 0.05;
@@ -812,7 +814,7 @@ TEST(Dockcore, DocksWithTheRealEstimatorAndFilter) {
   CHECK(f.core->filter().initialised());
   CHECK(f.core->estimator().counters().found > 10);
   const Vec2 front = f.w.world.transform(Vec2(kHalfLength, 0));
-  DOUBLES_EQUAL(0.0, front.x(), 0.003);
+  REAL_EQUAL(0.0, front.x(), 0.003);
   CHECK(std::fabs(front.y()) < 0.05);
   LONGS_EQUAL(0, f.w.zero_violations);
   printf("\nsizeof(Dockcore) = %zu, TaskManager = %zu, DockPoseEstimator = %zu, LaserScan = %zu\n", sizeof(Dockcore),
