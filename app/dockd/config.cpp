@@ -462,6 +462,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   auto watchdog = [&]() {
     return Handlers{{"lidar_stale_ms", p.integ(&c.lidar_stale_ms, 40, 10000)},
                     {"chassis_stale_ms", p.integ(&c.chassis_stale_ms, 40, 10000)},
+                    {"fault_after_ms", p.integ(&c.watchdog_fault_after_ms, 0, 60000)},
                     {"systemd_divider", p.integ(&c.systemd_watchdog_divider, 2, 10)}};
   };
 

@@ -102,6 +102,7 @@ struct DockdConfig {
   // [watchdog]
   std::uint32_t lidar_stale_ms = 200;
   std::uint32_t chassis_stale_ms = 200;
+  std::uint32_t watchdog_fault_after_ms = 1000;  ///< Stale this long (after the stop): the task manager faults.
   std::uint32_t systemd_watchdog_divider = 2;  ///< WATCHDOG=1 every WatchdogSec / this.
 
   // [state]

@@ -360,6 +360,8 @@ void Daemon::watchdogs(std::uint64_t now_us) {
                   static_cast<unsigned>(FaultCode::kChassisStale));
     log_event(now_us, "watchdog", f, chassis ? LogLevel::kWarn : LogLevel::kInfo);
   }
+  if (lidar && !lidar_stale_) lidar_stale_since_us_ = now_us;
+  if (chassis && !chassis_stale_) chassis_stale_since_us_ = now_us;
   lidar_stale_ = lidar;
   chassis_stale_ = chassis;
   if (lidar || chassis) fresh_since_us_ = now_us;
@@ -514,8 +516,11 @@ void Daemon::on_tick(std::uint64_t now_us) {
   in.camera = camera_;
   in.contact = fb_.charging_contact;
   in.charge_current_a = fb_.battery_current_a;
-  in.chassis_ok = !chassis_stale_;
-  in.lidar_ok = !lidar_stale_;
+  // The wheels stop at once (below); the task manager is told only when the data stays away for fault_after_ms,
+  // so a short gap (a late scan on a loaded board) holds the robot and then continues the same approach.
+  const std::uint64_t fault_after = static_cast<std::uint64_t>(cfg_.watchdog_fault_after_ms) * 1000u;
+  in.chassis_ok = !(chassis_stale_ && now_us - chassis_stale_since_us_ >= fault_after);
+  in.lidar_ok = !(lidar_stale_ && now_us - lidar_stale_since_us_ >= fault_after);
 
   // Watchdog resume: a command interrupted by a watchdog fault is re-issued once the data has been fresh for
   // kResumeHoldUs, at most kMaxResumes times per task (docs/dockd.md, "Watchdogs").
@@ -659,7 +664,10 @@ void Daemon::on_tick(std::uint64_t now_us) {
   }
   const bool changed = !prev_status_valid_ || s.state != prev_status_.state || s.fault != prev_status_.fault ||
                        s.phase != prev_status_.phase || s.retries != prev_status_.retries ||
-                       s.last_command != prev_status_.last_command;
+                       s.last_command != prev_status_.last_command || lidar_stale_ != prev_lidar_stale_ ||
+                       chassis_stale_ != prev_chassis_stale_;
+  prev_lidar_stale_ = lidar_stale_;
+  prev_chassis_stale_ = chassis_stale_;
   last_out_ = out;
   prev_status_ = s;
   prev_status_valid_ = true;
@@ -686,6 +694,7 @@ void Daemon::publish_status(std::uint64_t now_us) {
                                               : lidar_stale_          ? FaultCode::kLidarStale
                                                                       : FaultCode::kNone);
     m.retries = s.retries;
+    m.last_result = static_cast<std::uint8_t>(s.last_command);
     m.dock_valid = s.dock_valid;
     m.dock_in_robot = s.dock_pose;
     m.stamp_us = now_us;

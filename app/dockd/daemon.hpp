@@ -9,8 +9,9 @@
 /// (saturation keeping curvature, acceleration limit, twist → wheels), send_wheels, charge request, status (CAN +
 /// UDP stream at status_rate_hz and on every change), event log, teach progress, tick-period statistics.
 /// Watchdogs: lidar (no scan received for lidar_stale_ms) or chassis (no wheel feedback for chassis_stale_ms) stale
-/// → zero wheel command on that same tick, the task manager faults (185 / 184) and, when the data returns and stays
-/// fresh for resume_hold_ms, the interrupted command is re-issued (docs/dockd.md, "Watchdogs").
+/// → zero wheel command on that same tick and the watchdog fault code in the status; data back within
+/// fault_after_ms → the task continues; stale longer → the task manager faults (185 / 184) and, once the data has
+/// been fresh for 0.5 s, the interrupted command is re-issued (docs/dockd.md, "Watchdogs").
 /// Allocation: the object is large (Dockcore) — create it once at start-up (heap); no allocation per tick.
 
 #include <cstddef>
@@ -192,6 +193,7 @@ class Daemon {
 
   // Watchdogs and resume.
   bool lidar_stale_ = true, chassis_stale_ = true;
+  std::uint64_t lidar_stale_since_us_ = 0, chassis_stale_since_us_ = 0;
   bool started_ = false;
   std::uint64_t start_us_ = 0;
   dockcore::HostCommandType interrupted_ = dockcore::HostCommandType::kNone;
@@ -210,6 +212,7 @@ class Daemon {
   std::uint64_t next_status_us_ = 0;
   dockcore::TaskStatus prev_status_{};
   bool prev_status_valid_ = false;
+  bool prev_lidar_stale_ = true, prev_chassis_stale_ = true;
 
   TickStats stats_{};
   std::uint64_t prev_tick_us_ = 0;

@@ -276,6 +276,12 @@ TEST(DockdDaemon, ChassisStaleStopsWithinOneTickFaultsAndResumes) {
   CHECK_TRUE(r.daemon->chassis_stale());
   CHECK(ticks >= 10 && ticks <= 12);
   CHECK_TRUE(r.wheels_zero());
+  CHECK_EQUAL(184, r.host.last.fault_code);  // the watchdog's code is in the status at once
+  // Stale for fault_after_ms (1 s) more: the task manager faults; the wheels stay at zero throughout.
+  for (int i = 0; i < 50; ++i) {
+    r.tick();
+    CHECK_TRUE(r.wheels_zero());
+  }
   CHECK_EQUAL(static_cast<int>(TaskState::kFault), static_cast<int>(r.daemon->state()));
   CHECK_EQUAL(184, static_cast<int>(r.daemon->fault()));
   CHECK_EQUAL(184, r.host.last.fault_code);
@@ -298,6 +304,8 @@ TEST(DockdDaemon, LidarStaleStopsWithinOneTickAndFaults) {
   r.lidar_blocked = true;
   CHECK_TRUE(r.run_until([&] { return r.daemon->lidar_stale(); }, 1.0));
   CHECK_TRUE(r.wheels_zero());
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFault; }, 1.5));
+  CHECK_TRUE(r.wheels_zero());
   CHECK_EQUAL(185, static_cast<int>(r.daemon->fault()));
   // A stop while faulted forgets the interrupted command: no resume when the lidar returns.
   r.host.command(2, 0);
@@ -307,6 +315,24 @@ TEST(DockdDaemon, LidarStaleStopsWithinOneTickAndFaults) {
   CHECK_EQUAL(0u, r.daemon->counters().resumes);
   CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
   CHECK_TRUE(r.wheels_zero());
+}
+
+TEST(DockdDaemon, ShortLidarGapHoldsTheRobotAndTheDockingContinues) {
+  Rig r("gap");
+  r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kAlign && !r.wheels_zero(); }, 20.0));
+  r.lidar_blocked = true;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->lidar_stale(); }, 1.0));
+  for (int i = 0; i < 10; ++i) {  // 200 ms more without scans: held at zero, not faulted
+    CHECK_TRUE(r.wheels_zero());
+    CHECK_EQUAL(static_cast<int>(TaskState::kAlign), static_cast<int>(r.daemon->state()));
+    r.tick();
+  }
+  r.lidar_blocked = false;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
+  CHECK_EQUAL(0u, r.daemon->counters().resumes);
+  CHECK_EQUAL(1u, r.daemon->counters().lidar_stale_trips);
 }
 
 TEST(DockdDaemon, UdpFloodStaysConsistentAndUnknownDockIsRejected) {
