@@ -25,6 +25,7 @@ struct LidarOutOptions {
   double reader_baud = 230400;                  ///< The rate the host's UART is set to (dockd's [lidar] baud).
   double wrong_baud_at_s = -1, wrong_baud_for_s = 0;
   std::uint64_t seed = 7;
+  bool rplidar_autostart = false;  ///< RPLIDAR streams without waiting for SCAN (a host speaking another protocol).
 };
 
 inline void add_lidar_out_options(CLI::App& app, LidarOutOptions& o) {
@@ -39,6 +40,8 @@ inline void add_lidar_out_options(CLI::App& app, LidarOutOptions& o) {
   app.add_option("--lidar-stall-for", o.stall_for_s, "... for this long (s)");
   app.add_option("--lidar-unplug-at", o.unplug_at_s, "Lidar pty closed this long after motion start (s)");
   app.add_option("--lidar-unplug-for", o.unplug_for_s, "... and re-created after this long (s)");
+  app.add_flag("--lidar-rplidar-autostart", o.rplidar_autostart,
+               "RPLIDAR: stream scans at once, without the host's SCAN request (feeds rplidar bytes to an ld06 reader)");
   app.add_option("--lidar-corrupt-at", o.corrupt_at_s, "--lidar-corrupt applies only from this motion time (s)");
   app.add_option("--lidar-corrupt-for", o.corrupt_for_s, "... for this long (s)");
   app.add_option("--lidar-wrong-baud", o.wrong_baud,
@@ -74,6 +77,7 @@ inline std::unique_ptr<dockcore::emu::LidarEmitter> open_lidar_out(const LidarOu
   e.corrupt_packet_fraction = o.corrupt_packet_fraction;
   e.drop_fraction = o.drop_fraction;
   e.seed = o.seed;
+  e.rplidar_wait_for_scan_request = !o.rplidar_autostart;
   return dockcore::emu::LidarEmitter::open(e, err);
 }
 

@@ -269,7 +269,18 @@ int run(const Options& opt) {
       chassis.set_frozen(false);
       write_truth(truth, t, mt, chassis.state(), relay, silent, "chassis_answers");
     }
+    // Ends of timed events, in the truth log so a test knows when the fault cleared.
+    for (const auto& d : discs)
+      if (mt >= d.until) write_truth(truth, t, mt, chassis.state(), relay, silent, "obstacle_gone");
     discs.erase(std::remove_if(discs.begin(), discs.end(), [&](const Disc& d) { return mt >= d.until; }), discs.end());
+    if (occluded_until >= 0 && mt >= occluded_until) {
+      write_truth(truth, t, mt, chassis.state(), relay, silent, "occlude_dock_end");
+      occluded_until = -1;
+    }
+    if (dropout_until >= 0 && mt >= dropout_until) {
+      write_truth(truth, t, mt, chassis.state(), relay, silent, "lidar_dropout_end");
+      dropout_until = -1;
+    }
 
     // 2. Receive: wheel commands and the charge request. A silent base reads nothing (its firmware hung).
     bus->service(now_us);
@@ -324,8 +335,11 @@ int run(const Options& opt) {
       }
     }
     // Communication protection: no command for command_timeout_s -> motors stop.
+    const bool was_timed_out = cmd_timed_out;
     cmd_timed_out = !have_cmd || static_cast<double>(now_us - last_cmd_us) * 1e-6 > opt.command_timeout_s;
     if (cmd_timed_out && !silent) chassis.command_wheels(docksim::WheelRadps{});
+    // The moment the base's own protection stops the motors (the SIGKILL row of the fault matrix measures it).
+    if (cmd_timed_out && !was_timed_out) write_truth(truth, t, mt, chassis.state(), relay, silent, "command_timeout");
     // The relay opens when its request stops coming (500 ms), as documented for the base.
     if (!agilex && opt.charge_needs_request && relay && now_us - last_charge_req_us > 500000u) relay = false;
     if (!opt.no_charge) chassis.set_charging_inhibited(!relay);
@@ -448,7 +462,8 @@ int run(const Options& opt) {
         if (lidar->emit_scan(scan.view())) ++scans_sent;
       }
     }
-    lidar_faults(*lidar, opt.lidar, mt, lidar_unplugged);
+    lidar_faults(*lidar, opt.lidar, mt, lidar_unplugged,
+                 [&](const char* ev) { write_truth(truth, t, mt, cs, relay, silent, ev); });
     if (step % 4 == 0) lidar->service_requests();  // RPLIDAR requests answered within ~20 ms
 
     if (t >= next_truth_t) {

@@ -302,6 +302,7 @@ void LidarEmitter::write_bytes(std::vector<std::uint8_t>& bytes) {
       x = static_cast<std::uint8_t>(x ^ (1u << static_cast<unsigned>(uniform() * 8)));
       ++stats_.bytes_corrupted;
     }
+  if (line_filter_) line_filter_(bytes);
   std::size_t off = 0;
   while (off < bytes.size()) {
     const ssize_t w = ::write(master_fd_, bytes.data() + off, bytes.size() - off);

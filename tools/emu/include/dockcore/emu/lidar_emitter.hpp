@@ -12,6 +12,7 @@
 //   ... every 100 ms: emitter->emit_scan(scan.view());
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -84,6 +85,10 @@ class LidarEmitter {
 
   void set_corrupt_fraction(double f) { opt_.corrupt_fraction = f; }
   void set_drop_fraction(double f) { opt_.drop_fraction = f; }
+  /// Line model between the encoder and the serial port (pty mode): called with each chunk of bytes, after the
+  /// bit-flip corruption and before the write, it may rewrite or resize the chunk (e.g. the garbage a receiver at
+  /// the wrong baud rate reads). Empty function = bytes pass unchanged. chassis-sim uses it for the wrong-baud fault.
+  void set_line_filter(std::function<void(std::vector<std::uint8_t>&)> filter) { line_filter_ = std::move(filter); }
 
   /// Path of the current pty slave ("/dev/pts/N"); "" in UDP mode or while unplugged.
   const std::string& slave_path() const { return slave_path_; }
@@ -112,6 +117,7 @@ class LidarEmitter {
   std::uint64_t rng_state_ = 0;
   std::uint64_t ms_ = 0;
   LidarEmitterStats stats_{};
+  std::function<void(std::vector<std::uint8_t>&)> line_filter_;
 };
 
 }  // namespace dockcore::emu
