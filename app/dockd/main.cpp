@@ -38,6 +38,56 @@ std::uint64_t mono_us() {
   return static_cast<std::uint64_t>(ts.tv_sec) * 1000000u + static_cast<std::uint64_t>(ts.tv_nsec) / 1000u;
 }
 
+// How the previous session in the record directory ended: its events.jsonl ends with a "shutdown" event when dockd
+// stopped cleanly. Anything else (SIGKILL, power loss, a crash) is an interrupted session: dockd reports it at start
+// (event previous_session, stderr) and, like after any start, stays idle until a new command. Reads the last 64 KiB.
+struct PreviousSession {
+  bool found = false;        // a non-empty event log exists
+  bool interrupted = false;  // its last event is not "shutdown"
+  bool torn = false;         // its last line has no newline (cut mid-write)
+  std::string last_event, last_state;
+};
+
+std::string json_field(const std::string& line, const char* key) {
+  const std::string k = std::string("\"") + key + "\":\"";
+  const auto p = line.find(k);
+  if (p == std::string::npos) return "";
+  const auto b = p + k.size();
+  const auto e = line.find('"', b);
+  return e == std::string::npos ? "" : line.substr(b, e - b);
+}
+
+PreviousSession read_previous_session(const std::string& dir) {
+  PreviousSession ps;
+  std::FILE* f = std::fopen((dir + "/events.jsonl").c_str(), "rb");
+  if (f == nullptr) return ps;
+  std::string tail;
+  if (std::fseek(f, 0, SEEK_END) == 0) {
+    const long size = std::ftell(f);
+    const long from = size > 65536 ? size - 65536 : 0;
+    std::fseek(f, from, SEEK_SET);
+    tail.resize(static_cast<std::size_t>(size - from));
+    tail.resize(std::fread(&tail[0], 1, tail.size(), f));
+  }
+  std::fclose(f);
+  if (tail.empty()) return ps;
+  ps.found = true;
+  ps.torn = tail.back() != '\n';
+  std::size_t pos = 0;
+  while (pos < tail.size()) {
+    std::size_t nl = tail.find('\n', pos);
+    if (nl == std::string::npos) break;  // a torn last line is not an event
+    const std::string line = tail.substr(pos, nl - pos);
+    pos = nl + 1;
+    const std::string ev = json_field(line, "event");
+    if (ev.empty()) continue;
+    ps.last_event = ev;
+    if (ev == "state") ps.last_state = json_field(line, "to");
+  }
+  ps.interrupted = ps.last_event != "shutdown";
+  return ps;
+}
+
 class MonotonicClock final : public dockcore::hal::Clock {
  public:
   std::uint64_t now_us() const override { return mono_us(); }
@@ -141,7 +191,9 @@ int main(int argc, char** argv) {
 
   // Session record.
   dockd::RotatingLog can_log, event_log;
+  PreviousSession previous;
   if (!cfg.record_dir.empty()) {
+    previous = read_previous_session(cfg.record_dir);
     std::string err;
     if (!can_log.open(cfg.record_dir, "can.log", cfg.record_max_bytes, cfg.record_max_files, err) ||
         !event_log.open(cfg.record_dir, "events.jsonl", cfg.record_max_bytes, cfg.record_max_files, err)) {
@@ -216,6 +268,15 @@ int main(int argc, char** argv) {
   if (!daemon->start(err)) {
     std::fprintf(stderr, "dockd: %s\n", err.c_str());
     return 2;
+  }
+  if (previous.found && previous.interrupted) {
+    // Reported, never resumed: the robot waits for a new host command.
+    char fields[256];
+    std::snprintf(fields, sizeof fields,
+                  "\"clean\":false,\"last_event\":\"%.40s\",\"last_state\":\"%.40s\",\"torn_line\":%s,"
+                  "\"action\":\"idle until a new command\"",
+                  previous.last_event.c_str(), previous.last_state.c_str(), previous.torn ? "true" : "false");
+    daemon->log_event(mono_us(), "previous_session", fields, dockd::LogLevel::kWarn);
   }
 
   // Event loop.
