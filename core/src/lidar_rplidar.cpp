@@ -25,7 +25,7 @@ std::size_t rplidar_encode_request(std::uint8_t cmd, std::uint8_t out[2]) {
 
 void rplidar_encode_node(const RplidarNode& n, std::uint8_t out[kRplidarNodeBytes]) {
   const std::uint8_t q = static_cast<std::uint8_t>(n.quality > 63 ? 63 : n.quality);
-  out[0] = static_cast<std::uint8_t>((q << 2) | (n.start ? 0x01u : 0x02u));
+  out[0] = static_cast<std::uint8_t>((static_cast<unsigned>(q) << 2u) | (n.start ? 0x01u : 0x02u));
   const auto a = static_cast<std::uint16_t>(((n.angle_q6 & 0x7FFFu) << 1) | 0x01u);
   out[1] = static_cast<std::uint8_t>(a & 0xFFu);
   out[2] = static_cast<std::uint8_t>(a >> 8);
