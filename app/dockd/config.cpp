@@ -7,6 +7,8 @@
 #include <sstream>
 #include <utility>
 
+#include <sys/stat.h>
+
 #include <toml++/toml.h>
 
 namespace dockd {
@@ -31,6 +33,37 @@ const char* type_name(const toml::node& n) {
     case toml::node_type::boolean: return "a boolean";
     default: return "a date/time";
   }
+}
+
+/// Reads a regular file of at most `max_bytes` into `out`. False + reason otherwise: a FIFO, a device (/dev/zero)
+/// or an oversized file must not block dockd or grow its memory without bound.
+bool read_bounded(const std::string& path, std::size_t max_bytes, std::string& out, std::string& why) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    why = "cannot open";
+    return false;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    why = "not a regular file";
+    return false;
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    why = "cannot open";
+    return false;
+  }
+  out.assign(max_bytes + 1, '\0');
+  in.read(&out[0], static_cast<std::streamsize>(out.size()));
+  if (in.bad()) {
+    why = "cannot read";
+    return false;
+  }
+  out.resize(static_cast<std::size_t>(in.gcount()));
+  if (out.size() > max_bytes) {
+    why = "larger than " + std::to_string(max_bytes) + " bytes";
+    return false;
+  }
+  return true;
 }
 
 std::string dir_of(const std::string& path) {
@@ -158,8 +191,10 @@ class Parser {
 /// A profile file: name (optional), contact_offset_m (optional), points = [[x, y], ...] (docs/docks.md).
 dockcore::DockProfile load_profile(const Parser& p, const toml::node& at, const std::string& path) {
   toml::table t;
+  std::string text, why;
+  if (!read_bounded(path, kMaxProfileFileBytes, text, why)) p.fail(at.source(), "profile file " + path + ": " + why);
   try {
-    t = toml::parse_file(path);
+    t = toml::parse(text, path);
   } catch (const toml::parse_error& e) {
     std::ostringstream s;
     s << "profile file " << path << ":" << e.source().begin.line << ":" << e.source().begin.column << ": "
@@ -237,6 +272,9 @@ dockcore::DockProfile profile_for_target(const dockcore::DockProfile& profile, c
 
 DockdConfig parse_config_toml(const std::string& text, const std::string& source_name) {
   Parser p(source_name);
+  if (text.size() > kMaxConfigBytes) {
+    throw ConfigError(source_name + ":1:1: config larger than " + std::to_string(kMaxConfigBytes) + " bytes", 1, 1);
+  }
   toml::table root;
   try {
     root = toml::parse(text, source_name);
@@ -430,6 +468,10 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
                     {"allowlist", [&](const toml::node& n) {
                        const toml::array* a = n.as_array();
                        if (a == nullptr) p.fail(n.source(), p.key() + " must be an array of strings");
+                       if (a->size() > kMaxAllowlistEntries) {
+                         p.fail(n.source(), p.key() + " has " + std::to_string(a->size()) + " entries (at most " +
+                                                std::to_string(kMaxAllowlistEntries) + ")");
+                       }
                        h.allowlist.clear();
                        for (const toml::node& e : *a) {
                          const std::string s = p.string(e);
@@ -583,12 +625,58 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
 }
 
 DockdConfig load_config_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path + ": cannot open config file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw ConfigError(path + ": cannot read config file");
-  return parse_config_toml(ss.str(), path);
+  std::string text, why;
+  if (!read_bounded(path, kMaxConfigBytes, text, why)) throw ConfigError(path + ": config file: " + why);
+  return parse_config_toml(text, path);
+}
+
+namespace {
+
+// Field-wise equality helpers for restart_only_changes (Real fields compare exactly: both come from the same parser).
+bool same(const dockcore::DriveGeometry& a, const dockcore::DriveGeometry& b) {
+  return a.kind == b.kind && a.wheel_radius_m == b.wheel_radius_m && a.wheel_base_m == b.wheel_base_m &&
+         a.lx_m == b.lx_m && a.ly_m == b.ly_m;
+}
+
+}  // namespace
+
+std::vector<std::string> restart_only_changes(const DockdConfig& a, const DockdConfig& b) {
+  std::vector<std::string> out;
+  auto check = [&out](bool equal, const char* key) {
+    if (!equal) out.emplace_back(key);
+  };
+  // Opened or built once at start: the lidar driver, the CAN socket and link, the UDP sockets, the session record,
+  // the state file and the systemd watchdog period.
+  check(a.lidar.protocol == b.lidar.protocol, "lidar.protocol");
+  check(a.lidar.transport == b.lidar.transport, "lidar.transport");
+  check(a.lidar.device == b.lidar.device, "lidar.device");
+  check(a.lidar.baud == b.lidar.baud, "lidar.baud");
+  check(a.lidar.udp_bind_address == b.lidar.udp_bind_address, "lidar.udp_bind");
+  check(a.lidar.udp_port == b.lidar.udp_port, "lidar.udp_port");
+  check(a.lidar.reconnect_min_ms == b.lidar.reconnect_min_ms, "lidar.reconnect_min_ms");
+  check(a.lidar.reconnect_max_ms == b.lidar.reconnect_max_ms, "lidar.reconnect_max_ms");
+  check(a.can_interface == b.can_interface, "can.interface");
+  check(a.can.protocol == b.can.protocol, "can.protocol");
+  check(a.can.chassis_base_id == b.can.chassis_base_id, "can.chassis_base_id");
+  check(a.can.host_base_id == b.can.host_base_id, "can.host_base_id");
+  // The CAN link converts wheel rad/s <-> mm/s with the geometry it was built with.
+  check(same(a.drive, b.drive), "robot.drive / wheel_radius_m / track_m / half_wheelbase_m / half_track_m");
+  check(a.host_enabled == b.host_enabled, "host.enabled");
+  check(a.host.bind_address == b.host.bind_address, "host.bind");
+  check(a.host.port == b.host.port, "host.port");
+  check(a.host.max_subscribers == b.host.max_subscribers, "host.max_subscribers");
+  check(a.host.subscription_ms == b.host.subscription_ms, "host.subscription_ms");
+  check(a.camera_enabled == b.camera_enabled, "camera.enabled");
+  check(a.camera.bind_address == b.camera.bind_address, "camera.bind");
+  check(a.camera.port == b.camera.port, "camera.port");
+  check(a.camera.target_id == b.camera.target_id, "camera.target_id");
+  check(a.camera.max_age_ms == b.camera.max_age_ms, "camera.max_age_ms");
+  check(a.record_dir == b.record_dir, "record.dir");
+  check(a.record_max_bytes == b.record_max_bytes, "record.max_bytes");
+  check(a.record_max_files == b.record_max_files, "record.max_files");
+  check(a.systemd_watchdog_divider == b.systemd_watchdog_divider, "watchdog.systemd_divider");
+  check(a.state_file == b.state_file, "state.file");
+  return out;
 }
 
 }  // namespace dockd

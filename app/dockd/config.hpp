@@ -4,6 +4,7 @@
 /// exceptions whose message starts with "<file>:<line>:<column>: " (1-based, the key or value at fault).
 /// Start-up only: heap and exceptions are fine here.
 
+#include <cstddef>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -117,11 +118,23 @@ struct DockdConfig {
   const DockEntry* find_dock(std::uint16_t id) const;
 };
 
+/// Input caps (docs/reliability.md, "Security"): beyond them the file is refused with a ConfigError, so no config or
+/// profile file can make dockd (or --check-config, or a SIGHUP reload) use unbounded memory or block.
+constexpr std::size_t kMaxConfigBytes = 1u << 20;        ///< Config file / text, bytes.
+constexpr std::size_t kMaxProfileFileBytes = 64u << 10;  ///< A dock profile file, bytes.
+constexpr std::size_t kMaxAllowlistEntries = 64;         ///< host.allowlist entries.
+/// [[docks]] entries are bounded by their unique ids 0..31: at most 32.
+
 /// Parses config TOML held in `text`. `source_name` names it in messages and anchors relative profile paths.
 /// Throws ConfigError. O(text size).
 DockdConfig parse_config_toml(const std::string& text, const std::string& source_name);
-/// Reads and parses a config file. Throws ConfigError (also when it cannot be read).
+/// Reads and parses a config file. Throws ConfigError (also when it cannot be read, is not a regular file or is
+/// larger than kMaxConfigBytes).
 DockdConfig load_config_file(const std::string& path);
+
+/// The restart-only keys (docs/dockd.md, "Config reload") whose values differ between `running` and `next`, as
+/// "section.key" names in file order; empty when `next` can be applied at runtime. O(config size).
+std::vector<std::string> restart_only_changes(const DockdConfig& running, const DockdConfig& next);
 
 /// The nominal docked-pose target for the configured pads: the dock at (pad_reach, 0) facing the robot (yaw π);
 /// rear pads: (−pad_reach, 0), yaw 0. O(1).

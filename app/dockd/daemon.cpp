@@ -61,11 +61,20 @@ Daemon::Daemon(const DockdConfig& config, const DaemonIo& io)
       scan_(std::make_unique<dockcore::LaserScan>()),
       teach_storage_(std::make_unique<Teach>()),
       teach_(*teach_storage_) {
+  build_core();
+}
+
+void Daemon::build_core() {
+  seed000_ = dockcore::Seed000Controller(cfg_.seed000);
+  seed004_ = dockcore::Seed004Controller(cfg_.seed004);
+  seed003_ = dockcore::Seed003Controller(cfg_.seed003);
+  smooth_ = dockcore::SmoothController(cfg_.smooth);
   if (cfg_.controller == "seed000") controller_ = &seed000_;
   else if (cfg_.controller == "seed004") controller_ = &seed004_;
   else if (cfg_.controller == "seed003") controller_ = &seed003_;
   else controller_ = &smooth_;
   core_ = std::make_unique<dockcore::Dockcore>(*controller_);
+  core_cfg_ = dockcore::DockcoreConfig{};
   core_cfg_.estimator = cfg_.estimator;
   core_cfg_.task = cfg_.task;
   core_cfg_.footprint = cfg_.footprint;
@@ -76,6 +85,113 @@ Daemon::Daemon(const DockdConfig& config, const DaemonIo& io)
 }
 
 Daemon::~Daemon() = default;
+
+// --- config reload (SIGHUP) ----------------------------------------------------------------------------------------
+
+namespace {
+
+// The message as a JSON string body: quotes, backslashes and control bytes escaped; cut at `max` bytes.
+std::string json_escape(const std::string& in, std::size_t max) {
+  std::string out;
+  for (char ch : in) {
+    if (out.size() >= max) {
+      out += "...";
+      break;
+    }
+    const unsigned char u = static_cast<unsigned char>(ch);
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (u < 0x20) {
+      char b[8];
+      std::snprintf(b, sizeof b, "\\u%04x", u);
+      out += b;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void Daemon::log_reload(std::uint64_t now_us, const char* result, const std::string& message, LogLevel level) {
+  const std::string line = "{\"t_us\":" + std::to_string(now_us) + ",\"event\":\"config_reload\",\"result\":\"" + result +
+                           "\",\"message\":\"" + json_escape(message, 1024) + "\"}\n";
+  emit_event(level, line.data(), line.size());
+}
+
+ReloadResult Daemon::reload_from_file(const std::string& path, std::uint64_t now_us, std::string& message,
+                                      const std::function<void(DockdConfig&)>& adjust) {
+  DockdConfig next;
+  try {
+    next = load_config_file(path);
+  } catch (const ConfigError& e) {
+    message = std::string(e.what()) + " (config reload rejected; the running configuration stays)";
+    ++counters_.config_reloads_rejected;
+    log_reload(now_us, "rejected", message, LogLevel::kError);
+    return ReloadResult::kRejected;
+  }
+  if (adjust) adjust(next);
+  return request_reload(next, now_us, message);
+}
+
+ReloadResult Daemon::request_reload(const DockdConfig& next, std::uint64_t now_us, std::string& message) {
+  const std::vector<std::string> changed = restart_only_changes(cfg_, next);
+  if (!changed.empty()) {
+    message = next.source + ": config reload rejected: restart-only keys changed (";
+    for (std::size_t i = 0; i < changed.size(); ++i) message += (i > 0 ? ", " : "") + changed[i];
+    message += "); restart dockd to change them. The running configuration stays.";
+    ++counters_.config_reloads_rejected;
+    log_reload(now_us, "rejected", message, LogLevel::kError);
+    return ReloadResult::kRejected;
+  }
+  pending_cfg_ = std::make_unique<DockdConfig>(next);
+  if (reload_can_apply()) return apply_reload(now_us, message) ? ReloadResult::kApplied : ReloadResult::kRejected;
+  message = next.source + ": config reload valid; pending until the task is idle (state " +
+            dockcore::to_string(state()) + ")";
+  log_reload(now_us, "pending", message, LogLevel::kInfo);
+  return ReloadResult::kPending;
+}
+
+bool Daemon::reload_can_apply() const {
+  // Rebuilding the core resets the task manager: only while nothing runs, no fault is latched (the host must see
+  // it) and no watchdog resume waits — so no motion, charge or fault report changes under a reload.
+  return state() == TaskState::kNotTasking && !teach_.active && interrupted_ == HostCommandType::kNone;
+}
+
+bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
+  std::unique_ptr<DockdConfig> next = std::move(pending_cfg_);
+  std::string err;
+  // The only step that can still refuse: done first, so a refusal leaves everything as it was.
+  if (io_.udp_host != nullptr && !io_.udp_host->set_allowlist(next->host.allowlist, err)) {
+    ++counters_.config_reloads_rejected;
+    message = next->source + ": config reload rejected: " + err + " (the running configuration stays)";
+    log_reload(now_us, "rejected", message, LogLevel::kError);
+    return false;
+  }
+  DockdConfig old = cfg_;
+  cfg_ = *next;
+  build_core();
+  if (!configure_core(cfg_.default_dock_id, false)) {
+    // A profile the estimator refuses (validated configs do not have one): back to the old config entirely.
+    cfg_ = old;
+    build_core();
+    configure_core(cfg_.default_dock_id, false);
+    if (io_.udp_host != nullptr) io_.udp_host->set_allowlist(cfg_.host.allowlist, err);
+    ++counters_.config_reloads_rejected;
+    message = next->source + ": config reload rejected: dock profile refused by the estimator (the running "
+                             "configuration stays)";
+    log_reload(now_us, "rejected", message, LogLevel::kError);
+    return false;
+  }
+  io_.stderr_level = cfg_.log_level;
+  prev_cmd_ = dockcore::Twist2{};
+  ++counters_.config_reloads;
+  message = cfg_.source + ": config reloaded";
+  log_reload(now_us, "applied", message, LogLevel::kWarn);
+  return true;
+}
 
 dockcore::TaskState Daemon::state() const { return core_->task_manager().state(); }
 dockcore::FaultCode Daemon::fault() const { return core_->task_manager().fault(); }
@@ -508,6 +624,10 @@ void Daemon::on_tick(std::uint64_t now_us) {
   poll_hosts(now_us);
   watchdogs(now_us);
   teach_progress(now_us);
+  if (pending_cfg_ != nullptr && reload_can_apply()) {
+    std::string msg;
+    apply_reload(now_us, msg);  // logged there
+  }
 
   dockcore::TickInput in;
   in.now_us = now_us;
@@ -725,7 +845,8 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       "\"cmd_vx_mps\":%.3f,\"cmd_wz_radps\":%.3f,\"teaching\":%s,\"taught\":%s,\"ticks\":%llu,"
       "\"tick_worst_us\":%llu,\"tick_overruns\":%llu,\"tick_work_worst_us\":%llu,\"scans\":%u,\"detections\":%u,"
       "\"lidar_crc_errors\":%u,\"lidar_resyncs\":%u,\"lidar_reconnects\":%u,\"can_bad_frames\":%u,"
-      "\"can_send_failures\":%u,\"commands\":%u,\"commands_rejected\":%u,\"resumes\":%u}",
+      "\"can_send_failures\":%u,\"commands\":%u,\"commands_rejected\":%u,\"resumes\":%u,\"can_host_rejected\":%u,"
+      "\"udp_not_allowed\":%u,\"config_reloads\":%u,\"config_reloads_rejected\":%u,\"config_reload_pending\":%s}",
       static_cast<unsigned long long>(now_us), dockcore::to_string(s.state), static_cast<unsigned>(s.state), s.phase,
       s.state == TaskState::kAlign ? controller_->phase_name(s.phase) : "", static_cast<unsigned>(s.fault),
       dockcore::to_string(s.fault), static_cast<unsigned>(watchdog_fault), s.retries, s.dock_id,
@@ -740,7 +861,10 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       static_cast<unsigned long long>(stats_.ticks), static_cast<unsigned long long>(stats_.worst_period_us),
       static_cast<unsigned long long>(stats_.overruns), static_cast<unsigned long long>(stats_.worst_work_us),
       counters_.scans, counters_.detections, lc.crc_errors, lc.resyncs, lc.reconnects, cc.bad_frames,
-      cc.send_failures, counters_.commands, counters_.commands_rejected, counters_.resumes);
+      cc.send_failures, counters_.commands, counters_.commands_rejected, counters_.resumes,
+      io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u,
+      io_.udp_host != nullptr ? io_.udp_host->counters().not_allowed : 0u, counters_.config_reloads,
+      counters_.config_reloads_rejected, pending_cfg_ != nullptr ? "true" : "false");
   if (n < 0 || static_cast<std::size_t>(n) >= size) return 0;
   return static_cast<std::size_t>(n);
 }

@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -42,6 +43,8 @@ struct DaemonIo {
   dockcore::hal::CameraTargetSource* camera = nullptr;
   const dockcore::hal::Clock* clock = nullptr;
   RotatingLog* event_log = nullptr;                      ///< JSON-lines event log (may be closed).
+  /// Optional: the CAN link behind can_host, for its host_commands_rejected() (replays, out-of-order) in the status.
+  const dockcore::drivers::CanLink* can_link = nullptr;
   /// Also print events at or above this level to stderr (journal). kError..kDebug.
   LogLevel stderr_level = LogLevel::kInfo;
 };
@@ -67,6 +70,15 @@ struct DaemonCounters {
   std::uint32_t resumes = 0;
   std::uint32_t wheel_send_failures = 0;
   std::uint32_t status_sent = 0;
+  std::uint32_t config_reloads = 0;          ///< Reloads applied.
+  std::uint32_t config_reloads_rejected = 0; ///< Reloads refused (invalid file, restart-only key changed).
+};
+
+/// What a config reload request came to (docs/dockd.md, "Config reload").
+enum class ReloadResult : std::uint8_t {
+  kApplied = 0,   ///< In effect now (the task was idle).
+  kPending = 1,   ///< Valid; applied on the first tick the task is idle (NOT_TASKING, no teach, no resume pending).
+  kRejected = 2,  ///< Invalid or changes a restart-only key: nothing changed; the message says why.
 };
 
 class Daemon {
@@ -94,6 +106,19 @@ class Daemon {
   void log_shutdown(std::uint64_t now_us, const char* reason);
   /// A free-form event (SIGHUP, reconnects) into the event log: `fields` is a JSON fragment without braces.
   void log_event(std::uint64_t now_us, const char* event, const char* fields, LogLevel level = LogLevel::kInfo);
+
+  /// SIGHUP: reads `path` like --check-config (parse + validation), applies `adjust` (the command-line overrides)
+  /// and hands the result to request_reload(). A file that does not parse or validate is rejected with its
+  /// "file:line:column: message" in `message`, the event log (event config_reload) and stderr; the running
+  /// configuration is untouched. Allocates (parsing); never called from the tick.
+  ReloadResult reload_from_file(const std::string& path, std::uint64_t now_us, std::string& message,
+                                const std::function<void(DockdConfig&)>& adjust = {});
+  /// Takes a parsed, validated config. Rejected when a restart-only key differs from the running config
+  /// (restart_only_changes) — all or nothing. Otherwise applied at once when the task is idle, else pending until
+  /// the first idle tick (a newer request replaces a pending one). Never changes a running motion. Allocates.
+  ReloadResult request_reload(const DockdConfig& next, std::uint64_t now_us, std::string& message);
+  bool reload_pending() const { return pending_cfg_ != nullptr; }
+  const DockdConfig& config() const { return cfg_; }
 
   // Introspection (tests, status).
   dockcore::TaskState state() const;
@@ -155,6 +180,10 @@ class Daemon {
   void publish_status(std::uint64_t now_us);
   void send_wheels(const dockcore::hal::WheelCommand& w);
   void emit_event(LogLevel level, const char* line, std::size_t len);
+  void build_core();
+  bool reload_can_apply() const;
+  bool apply_reload(std::uint64_t now_us, std::string& message);
+  void log_reload(std::uint64_t now_us, const char* result, const std::string& message, LogLevel level);
 
   DockdConfig cfg_;
   DaemonIo io_;
@@ -218,6 +247,7 @@ class Daemon {
   std::uint64_t prev_tick_us_ = 0;
   DaemonCounters counters_{};
   bool shutdown_logged_ = false;
+  std::unique_ptr<DockdConfig> pending_cfg_;  ///< A validated reload waiting for an idle task.
 };
 
 /// Short stable name of a task result ("none", "docked", ...). Never null.

@@ -263,6 +263,7 @@ int main(int argc, char** argv) {
   io.camera = camera.get();
   io.clock = &clock;
   io.event_log = &event_log;
+  io.can_link = can.get();
   io.stderr_level = cfg.log_level;
   auto daemon = std::make_unique<dockd::Daemon>(cfg, io);
   if (!daemon->start(err)) {
@@ -352,8 +353,13 @@ int main(int argc, char** argv) {
             if (si.ssi_signo == SIGTERM) stop_reason = "SIGTERM";
             else if (si.ssi_signo == SIGINT) stop_reason = "SIGINT";
             else if (si.ssi_signo == SIGHUP) {
-              daemon->log_event(now, "sighup", "\"action\":\"ignored: config reload is not supported; restart dockd\"",
-                                dockd::LogLevel::kWarn);
+              // Config reload (docs/dockd.md, "Config reload"): validated like --check-config, all or nothing,
+              // applied only while the task is idle. The command-line overrides stay in force.
+              std::string msg;
+              daemon->reload_from_file(config_path, now, msg, [&](dockd::DockdConfig& next) {
+                if (!log_level.empty()) dockd::parse_log_level(log_level, next.log_level);
+                if (!record_dir.empty()) next.record_dir = record_dir;
+              });
             }
           }
           break;

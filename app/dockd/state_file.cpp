@@ -111,9 +111,15 @@ ReadResult read_file(const std::string& path, StateData& out, std::string& why) 
     why = std::string("cannot open: ") + std::strerror(errno);
     return ReadResult::kBad;
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_state(ss.str(), out, why) ? ReadResult::kOk : ReadResult::kBad;
+  // Bounded: a legitimate file holds at most a few hundred bytes per dock; a runaway one is corrupt, not read whole.
+  std::string text(kMaxStateFileBytes + 1, '\0');
+  in.read(&text[0], static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxStateFileBytes) {
+    why = "larger than " + std::to_string(kMaxStateFileBytes) + " bytes";
+    return ReadResult::kBad;
+  }
+  return parse_state(text, out, why) ? ReadResult::kOk : ReadResult::kBad;
 }
 
 std::string dir_of(const std::string& path) {

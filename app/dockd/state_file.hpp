@@ -4,6 +4,7 @@
 /// "<file>.bak". A file whose checksum or syntax is wrong is reported, moved aside to "<file>.corrupt", and the last
 /// good copy (.bak) is used instead. Start-up / teach only: heap and stdio are fine here.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -35,6 +36,9 @@ enum class StateLoadStatus : std::uint8_t {
   kRecoveredBackup = 2,    ///< The file was missing or corrupt; the .bak copy was used.
   kCorruptNoBackup = 3,    ///< The file is corrupt and no good backup exists: empty state (reported).
 };
+
+/// A state file larger than this is treated as corrupt without being read whole (32 docks need ~3 KiB).
+constexpr std::size_t kMaxStateFileBytes = 1u << 20;
 
 /// Serialised form (with its checksum line). O(targets).
 std::string serialize_state(const StateData& s);

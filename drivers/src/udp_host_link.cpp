@@ -172,6 +172,24 @@ struct Cidr {
   std::uint32_t mask_be;
 };
 
+bool parse_allowlist(const std::vector<std::string>& list, std::vector<Cidr>& out, std::string& error) {
+  if (list.size() > kMaxHostAllowlist) {
+    error = "host link: allowlist has " + std::to_string(list.size()) + " entries (at most " +
+            std::to_string(kMaxHostAllowlist) + ")";
+    return false;
+  }
+  out.clear();
+  for (const std::string& a : list) {
+    Cidr c{};
+    if (!parse_ipv4_cidr(a, c.addr_be, c.mask_be)) {
+      error = "host link: allowlist entry '" + a + "' is not an IPv4 address or a.b.c.d/prefix";
+      return false;
+    }
+    out.push_back(c);
+  }
+  return true;
+}
+
 struct Subscriber {
   HostPeer peer{};
   std::uint64_t until_us = 0;
@@ -180,8 +198,9 @@ struct Subscriber {
 
 class UdpHostLinkImpl final : public UdpHostLink {
  public:
-  UdpHostLinkImpl(int fd, std::vector<Cidr> allow, const UdpHostLinkOptions& o, std::uint16_t port)
-      : fd_(fd), allow_(std::move(allow)), subs_(o.max_subscribers), sub_ms_(o.subscription_ms), port_(port) {}
+  UdpHostLinkImpl(int fd, std::vector<Cidr> allow, const UdpHostLinkOptions& o, std::uint16_t port, bool loopback)
+      : fd_(fd), allow_(std::move(allow)), subs_(o.max_subscribers), sub_ms_(o.subscription_ms), port_(port),
+        loopback_bind_(loopback) {}
   ~UdpHostLinkImpl() override {
     if (fd_ >= 0) ::close(fd_);
   }
@@ -268,6 +287,16 @@ class UdpHostLinkImpl final : public UdpHostLink {
   const UdpHostCounters& counters() const override { return c_; }
   void count_rejected() override { ++c_.rejected_later; }
   std::uint16_t bound_port() const override { return port_; }
+  bool set_allowlist(const std::vector<std::string>& list, std::string& error) override {
+    std::vector<Cidr> next;
+    if (!parse_allowlist(list, next, error)) return false;
+    if (!loopback_bind_ && next.empty()) {
+      error = "host link: bound to a non-loopback address: the allowlist cannot become empty";
+      return false;
+    }
+    allow_ = std::move(next);
+    return true;
+  }
 
   // hal::HostLink.
   bool poll_command(hal::HostCommandMessage& out) override {
@@ -382,6 +411,7 @@ class UdpHostLinkImpl final : public UdpHostLink {
   std::vector<Subscriber> subs_;
   std::uint32_t sub_ms_;
   std::uint16_t port_;
+  bool loopback_bind_;
   UdpHostCounters c_{};
   hal::StatusMessage last_{};
   std::uint64_t last_now_us_ = 0;
@@ -396,15 +426,9 @@ std::unique_ptr<UdpHostLink> open_udp_host_link(const UdpHostLinkOptions& o, std
     return nullptr;
   }
   std::vector<Cidr> allow;
-  for (const std::string& a : o.allowlist) {
-    Cidr c{};
-    if (!parse_ipv4_cidr(a, c.addr_be, c.mask_be)) {
-      error = "host link: allowlist entry '" + a + "' is not an IPv4 address or a.b.c.d/prefix";
-      return nullptr;
-    }
-    allow.push_back(c);
-  }
-  if ((ntohl(bind_addr.s_addr) >> 24) != 127u && allow.empty()) {
+  if (!parse_allowlist(o.allowlist, allow, error)) return nullptr;
+  const bool loopback = (ntohl(bind_addr.s_addr) >> 24) == 127u;
+  if (!loopback && allow.empty()) {
     error = "host link: binding " + o.bind_address + " (not loopback) needs an explicit allowlist";
     return nullptr;
   }
@@ -428,7 +452,7 @@ std::unique_ptr<UdpHostLink> open_udp_host_link(const UdpHostLinkOptions& o, std
   }
   socklen_t sl = sizeof sa;
   ::getsockname(fd, reinterpret_cast<sockaddr*>(&sa), &sl);
-  return std::make_unique<UdpHostLinkImpl>(fd, std::move(allow), o, ntohs(sa.sin_port));
+  return std::make_unique<UdpHostLinkImpl>(fd, std::move(allow), o, ntohs(sa.sin_port), loopback);
 }
 
 }  // namespace dockcore::drivers

@@ -1,6 +1,10 @@
 // dockd's config: every error names file:line:column; defaults and derived values; the docked-target correction.
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
 #include <string>
+#include <vector>
 
 #include "config.hpp"
 
@@ -70,4 +74,64 @@ TEST(DockdConfig, TargetCorrectionMovesTheEstimateOntoTheNominalPose) {
     DOUBLES_EQUAL(static_cast<double>(a.x()), static_cast<double>(b.x()), 1e-9);
     DOUBLES_EQUAL(static_cast<double>(a.y()), static_cast<double>(b.y()), 1e-9);
   }
+}
+
+// Issue #6 §5: every config input is bounded (docs/reliability.md, "Security").
+TEST(DockdConfig, InputCapsAreEnforcedWithPositions) {
+  std::string allow = "[host]\nallowlist = [";
+  for (std::size_t i = 0; i <= dockd::kMaxAllowlistEntries; ++i) allow += (i ? ", " : "") + std::string("\"10.0.0.1\"");
+  allow += "]\n";
+  STRCMP_CONTAINS("t.toml:2:13: host.allowlist has 65 entries (at most 64)", error_of(allow).c_str());
+  std::string big = "# " + std::string(dockd::kMaxConfigBytes, 'x') + "\n";
+  STRCMP_CONTAINS("t.toml:1:1: config larger than 1048576 bytes", error_of(big).c_str());
+  // A device or FIFO as a profile file must not block or grow memory: refused before reading.
+  STRCMP_CONTAINS("profile file /dev/zero: not a regular file",
+                  error_of("[[docks]]\nid = 1\nprofile = \"/dev/zero\"\n").c_str());
+  const std::string path = "/tmp/dockd_cfg_big_profile_" + std::to_string(::getpid()) + ".toml";
+  {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    CHECK_TRUE(f != nullptr);
+    const std::string pad(dockd::kMaxProfileFileBytes, '#');
+    std::fwrite(pad.data(), 1, pad.size(), f);
+    std::fputs("\npoints = [[0, 0], [0.1, 0]]\n", f);
+    std::fclose(f);
+  }
+  STRCMP_CONTAINS("t.toml:3:11: profile file", error_of("[[docks]]\nid = 1\nprofile = \"" + path + "\"\n").c_str());
+  STRCMP_CONTAINS("larger than 65536 bytes", error_of("[[docks]]\nid = 1\nprofile = \"" + path + "\"\n").c_str());
+  std::remove(path.c_str());
+  // Config file itself: a non-regular file is refused by load_config_file.
+  bool threw = false;
+  try {
+    dockd::load_config_file("/dev/zero");
+  } catch (const dockd::ConfigError& e) {
+    threw = true;
+    STRCMP_CONTAINS("/dev/zero: config file: not a regular file", e.what());
+  }
+  CHECK_TRUE(threw);
+  // 32 docks (ids 0..31) is the most a valid database can hold: the 33rd id is out of range or a duplicate.
+  std::string docks;
+  for (int i = 0; i < 32; ++i) docks += "[[docks]]\nid = " + std::to_string(i) + "\n";
+  CHECK_EQUAL(32u, dockd::parse_config_toml(docks, "t.toml").docks.size());
+  STRCMP_CONTAINS("appears twice", error_of(docks + "[[docks]]\nid = 0\n").c_str());
+}
+
+// Issue #6 §3: which keys a SIGHUP reload may change (docs/dockd.md, "Config reload").
+TEST(DockdConfig, RestartOnlyChangesNameTheKeys) {
+  const dockd::DockdConfig a = dockd::parse_config_toml("", "t.toml");
+  // Runtime keys: no restart-only change.
+  const dockd::DockdConfig b = dockd::parse_config_toml(
+      "[watchdog]\nchassis_stale_ms = 300\n[controller.smooth]\nv_max_mps = 0.2\n[task]\nmax_retries = 5\n"
+      "[host]\nallowlist = [\"10.1.0.0/16\"]\n[[docks]]\nid = 4\n[dock]\ndefault_id = 4\n[log]\nlevel = \"debug\"\n"
+      "[lidar]\nmount_x_m = 0.1\n[can]\nstatus_rate_hz = 20\n",
+      "t.toml");
+  CHECK_TRUE(dockd::restart_only_changes(a, b).empty());
+  const dockd::DockdConfig c = dockd::parse_config_toml(
+      "[can]\ninterface = \"vcan0\"\n[host]\nport = 7400\n[robot]\nwheel_radius_m = 0.08\n[lidar]\ndevice = \"/dev/ttyS1\"\n",
+      "t.toml");
+  const std::vector<std::string> ch = dockd::restart_only_changes(a, c);
+  CHECK_EQUAL(4u, ch.size());
+  STRCMP_EQUAL("lidar.device", ch[0].c_str());
+  STRCMP_EQUAL("can.interface", ch[1].c_str());
+  STRCMP_CONTAINS("wheel_radius_m", ch[2].c_str());
+  STRCMP_EQUAL("host.port", ch[3].c_str());
 }

@@ -418,3 +418,73 @@ TEST(DockdDaemon, TeachStoresTargetUsedByLaterDockings) {
   DOUBLES_EQUAL(static_cast<double>(t->target.x_m), static_cast<double>(loaded.find(3)->target.x_m), 1e-6);
   ::close(s);
 }
+
+// Issue #6 §3: SIGHUP config reload (docs/dockd.md, "Config reload").
+TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
+  Rig r("reload");
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
+  std::string msg;
+
+  // Valid, runtime keys only, robot idle: in effect at once.
+  dockd::DockdConfig next = r.cfg;
+  next.source = "good.toml";
+  next.log_level = dockd::LogLevel::kError;  // the reload applies [log] level to stderr: keep the test quiet
+  next.chassis_stale_ms = 300;
+  next.smooth.v_max_mps = static_cast<dockcore::Real>(0.15);
+  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kApplied), static_cast<int>(r.daemon->request_reload(next, r.clock.t, msg)));
+  STRCMP_CONTAINS("good.toml: config reloaded", msg.c_str());
+  CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
+  CHECK_EQUAL(1u, r.daemon->counters().config_reloads);
+
+  // A file that does not parse: rejected with file:line:col, nothing changes.
+  const std::string bad = "/tmp/dockd_test_" + std::to_string(::getpid()) + "_bad.toml";
+  {
+    std::FILE* f = std::fopen(bad.c_str(), "w");
+    std::fputs("[watchdog]\nchassis_stale_ms = 500\nlidar_stale_ms = \"fast\"\n", f);
+    std::fclose(f);
+  }
+  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kRejected), static_cast<int>(r.daemon->reload_from_file(bad, r.clock.t, msg)));
+  STRCMP_CONTAINS((bad + ":3:18: watchdog.lidar_stale_ms must be an integer").c_str(), msg.c_str());
+  STRCMP_CONTAINS("running configuration stays", msg.c_str());
+  CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
+  std::remove(bad.c_str());
+
+  // A restart-only key: the whole reload is refused, the runtime keys in it included.
+  dockd::DockdConfig other = r.daemon->config();
+  other.source = "restart.toml";
+  other.can_interface = "vcan7";
+  other.chassis_stale_ms = 400;
+  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kRejected), static_cast<int>(r.daemon->request_reload(other, r.clock.t, msg)));
+  STRCMP_CONTAINS("restart-only keys changed (can.interface)", msg.c_str());
+  CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
+  STRCMP_EQUAL("can0", r.daemon->config().can_interface.c_str());
+  CHECK_EQUAL(2u, r.daemon->counters().config_reloads_rejected);
+
+  // Mid-docking: valid but pending; the motion goes on unchanged until the task is idle again.
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kAlign && !r.wheels_zero(); }, 20.0));
+  dockd::DockdConfig slow = r.daemon->config();
+  slow.source = "slow.toml";
+  slow.smooth.v_max_mps = static_cast<dockcore::Real>(0.05);
+  slow.chassis_stale_ms = 250;
+  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kPending), static_cast<int>(r.daemon->request_reload(slow, r.clock.t, msg)));
+  STRCMP_CONTAINS("pending until the task is idle (state ALIGN)", msg.c_str());
+  CHECK_TRUE(r.daemon->reload_pending());
+  for (int i = 0; i < 10; ++i) {
+    r.tick();
+    CHECK_EQUAL(static_cast<int>(TaskState::kAlign), static_cast<int>(r.daemon->state()));
+    CHECK_FALSE(r.wheels_zero());
+  }
+  CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
+  char json[dockcore::drivers::kMaxHostReply];
+  CHECK(r.daemon->status_json(json, sizeof json - 64, r.clock.t) > 0);  // still fits the status reply
+  STRCMP_CONTAINS("\"config_reloads\":1,\"config_reloads_rejected\":2,\"config_reload_pending\":true", json);
+  r.host.command(2, 0);  // stop: idle -> the pending reload applies on that tick
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->reload_pending(); }, 1.0));
+  CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
+  CHECK_EQUAL(250u, r.daemon->config().chassis_stale_ms);
+  CHECK_EQUAL(2u, r.daemon->counters().config_reloads);
+  // The rebuilt core docks with the new parameters.
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 90.0));
+}

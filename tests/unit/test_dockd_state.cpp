@@ -88,3 +88,26 @@ TEST(DockdState, SaveNeverLeavesAPartialFile) {
 TEST(DockdState, Crc32MatchesTheStandardCheckValue) {
   CHECK_EQUAL(0xCBF43926u, dockd::crc32_ieee("123456789", 9));
 }
+
+// Issue #6 §5: an oversized state file is treated as corrupt without being read whole; the backup is used.
+TEST(DockdState, OversizedFileIsCorruptAndTheBackupIsUsed) {
+  dockd::StateData s;
+  dockd::TaughtTarget t;
+  t.dock_id = 2;
+  t.scans = 5;
+  s.put(t);
+  std::string err;
+  CHECK_TRUE(dockd::save_state(path, s, err));
+  CHECK_TRUE(dockd::save_state(path, s, err));  // the first copy becomes the .bak
+  {
+    std::FILE* f = std::fopen(path.c_str(), "ab");
+    const std::string junk(dockd::kMaxStateFileBytes, 'x');
+    std::fwrite(junk.data(), 1, junk.size(), f);
+    std::fclose(f);
+  }
+  dockd::StateData out;
+  std::string msg;
+  CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kRecoveredBackup), static_cast<int>(dockd::load_state(path, out, msg)));
+  STRCMP_CONTAINS("larger than 1048576 bytes", msg.c_str());
+  CHECK_TRUE(out.find(2) != nullptr);
+}

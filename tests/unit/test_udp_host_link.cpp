@@ -8,6 +8,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "dockcore/drivers/flat_json.hpp"
 #include "dockcore/drivers/udp_camera.hpp"
@@ -217,4 +218,29 @@ TEST(UdpCamera, SocketKeepsNewestValidTargetAndCountsGarbage) {
   CHECK_EQUAL(1u, cam->counters().malformed);
   CHECK_EQUAL(2u, cam->counters().accepted);
   CHECK_FALSE(cam->poll_target(t));
+}
+
+// Issue #6 §3/§5: the allowlist can change at runtime (config reload), checked as a whole and bounded.
+TEST(UdpHostLink, AllowlistReplacedAtRuntimeAllOrNothingAndBounded) {
+  auto l = open_link();
+  Peer stranger("127.0.0.2");
+  HostRequest r;
+  std::string err;
+  CHECK_FALSE(l->set_allowlist({"127.0.0.2", "10.0.0.300"}, err));  // one bad entry: the old list stays
+  STRCMP_CONTAINS("10.0.0.300", err.c_str());
+  stranger.send(l->bound_port(), "{\"cmd\":\"stop\",\"seq\":1}");
+  CHECK_FALSE(l->poll_request(r, 1000));
+  CHECK_EQUAL(1u, l->counters().not_allowed);
+  std::vector<std::string> many(kMaxHostAllowlist + 1, "10.0.0.1");
+  CHECK_FALSE(l->set_allowlist(many, err));
+  STRCMP_CONTAINS("at most 64", err.c_str());
+  CHECK_TRUE(l->set_allowlist({"127.0.0.2/32"}, err));
+  stranger.send(l->bound_port(), "{\"cmd\":\"stop\",\"seq\":2}");
+  CHECK_TRUE(l->poll_request(r, 1000));
+  CHECK_EQUAL(2u, r.seq);
+  CHECK_TRUE(l->set_allowlist({}, err));  // loopback bind: back to 127.0.0.1 only
+  stranger.send(l->bound_port(), "{\"cmd\":\"stop\",\"seq\":3}");
+  CHECK_FALSE(l->poll_request(r, 1000));
+  CHECK_EQUAL(2u, l->counters().not_allowed);
+  CHECK_EQUAL(0u, l->counters().replies);  // dropped peers never get a reply (no amplification)
 }

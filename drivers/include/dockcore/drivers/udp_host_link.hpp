@@ -19,6 +19,8 @@ namespace dockcore::drivers {
 
 /// Largest accepted request datagram, bytes.
 constexpr std::size_t kMaxHostDatagram = 512;
+/// Most allowlist entries (each checked per datagram from a non-127.0.0.1 peer: the cost per datagram is bounded).
+constexpr std::size_t kMaxHostAllowlist = 64;
 /// Largest reply / status datagram dockd sends, bytes.
 constexpr std::size_t kMaxHostReply = 1400;
 
@@ -129,6 +131,10 @@ class UdpHostLink : public hal::HostLink {
   virtual void count_rejected() = 0;
   /// The bound port (useful with port 0).
   virtual std::uint16_t bound_port() const = 0;
+  /// Replaces the allowlist (dockd's config reload). The whole list is checked first: false + message in `error`
+  /// and the old list kept when an entry is malformed, when there are more than kMaxHostAllowlist entries, or when
+  /// the link is bound to a non-loopback address and the new list is empty. Allocates; not for the tick.
+  virtual bool set_allowlist(const std::vector<std::string>& allowlist, std::string& error) = 0;
 };
 
 /// Opens the socket. nullptr + message in `error` for a bad address, a bad allowlist entry, a non-loopback bind
