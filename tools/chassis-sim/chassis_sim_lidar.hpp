@@ -115,26 +115,51 @@ inline std::vector<std::uint8_t> uart_misread(const std::vector<std::uint8_t>& i
   return out;
 }
 
+/// One scripted fault window on the motion clock. It opens on the first call at or after `at_s` and then lasts
+/// `for_s` from the moment it opened: a loop that was descheduled across the scheduled window (a loaded VM) still
+/// applies the whole fault, late, instead of skipping it.
+struct FaultWindow {
+  double opened = -1;
+  bool done = false;
+  /// True while the fault applies at motion time `mt` (negative before motion starts).
+  bool active(double at_s, double for_s, double mt) {
+    if (at_s < 0 || done || mt < 0) return false;
+    if (opened < 0 && mt >= at_s) opened = mt;
+    if (opened < 0) return false;
+    if (mt >= opened + for_s) {
+      done = true;
+      return false;
+    }
+    return true;
+  }
+};
+
+/// Fault windows of one lidar (chassis-sim has one).
+struct LidarFaultState {
+  FaultWindow stall, unplug, corrupt, baud;
+  bool unplugged = false, corrupting = false, wrong_baud = false;
+};
+
 /// Applies the scripted stall/unplug/corruption/wrong-baud windows for motion time `mt` (negative before motion
 /// starts); `log` gets the name of each transition (truth log events: lidar_stall, lidar_unstall, lidar_unplug,
 /// lidar_replug, lidar_corrupt, lidar_clean, lidar_wrong_baud, lidar_right_baud).
-inline void lidar_faults(dockcore::emu::LidarEmitter& em, const LidarOutOptions& o, double mt, bool& unplugged,
+inline void lidar_faults(dockcore::emu::LidarEmitter& em, const LidarOutOptions& o, double mt, LidarFaultState& st,
                          const std::function<void(const char*)>& log) {
   if (o.stall_at_s >= 0) {
-    const bool want = mt >= o.stall_at_s && mt < o.stall_at_s + o.stall_for_s;
+    const bool want = st.stall.active(o.stall_at_s, o.stall_for_s, mt);
     if (want != em.stalled()) log(want ? "lidar_stall" : "lidar_unstall");
     em.set_stalled(want);
   }
   if (o.unplug_at_s >= 0) {
-    const bool want_out = mt >= o.unplug_at_s && mt < o.unplug_at_s + o.unplug_for_s;
-    if (want_out && !unplugged) {
+    const bool want_out = st.unplug.active(o.unplug_at_s, o.unplug_for_s, mt);
+    if (want_out && !st.unplugged) {
       em.unplug();
-      unplugged = true;
+      st.unplugged = true;
       log("lidar_unplug");
-    } else if (!want_out && unplugged) {
+    } else if (!want_out && st.unplugged) {
       std::string err;
       if (em.replug(err)) {
-        unplugged = false;
+        st.unplugged = false;
         log("lidar_replug");
       } else {
         std::fprintf(stderr, "chassis-sim: lidar replug failed: %s\n", err.c_str());
@@ -142,16 +167,15 @@ inline void lidar_faults(dockcore::emu::LidarEmitter& em, const LidarOutOptions&
     }
   }
   if (o.corrupt_at_s >= 0) {
-    const bool want = mt >= o.corrupt_at_s && mt < o.corrupt_at_s + o.corrupt_for_s;
-    const double f = want ? o.corrupt_fraction : 0.0;
-    if (f != em.options().corrupt_fraction) log(want ? "lidar_corrupt" : "lidar_clean");
-    em.set_corrupt_fraction(f);
+    const bool want = st.corrupt.active(o.corrupt_at_s, o.corrupt_for_s, mt);
+    if (want != st.corrupting) log(want ? "lidar_corrupt" : "lidar_clean");
+    st.corrupting = want;
+    em.set_corrupt_fraction(want ? o.corrupt_fraction : 0.0);
   }
   if (o.wrong_baud > 0) {
-    static bool active = false;  // one emitter per process
-    const bool want = o.wrong_baud_at_s < 0 || (mt >= o.wrong_baud_at_s && mt < o.wrong_baud_at_s + o.wrong_baud_for_s);
-    if (want != active) {
-      active = want;
+    const bool want = o.wrong_baud_at_s < 0 || st.baud.active(o.wrong_baud_at_s, o.wrong_baud_for_s, mt);
+    if (want != st.wrong_baud) {
+      st.wrong_baud = want;
       log(want ? "lidar_wrong_baud" : "lidar_right_baud");
       if (want) {
         const double line = o.wrong_baud, reader = o.reader_baud;
@@ -162,3 +186,4 @@ inline void lidar_faults(dockcore::emu::LidarEmitter& em, const LidarOutOptions&
     }
   }
 }
+

@@ -83,12 +83,17 @@ struct Options {
 };
 
 /// One line of the truth log.
+/// `wall_us` (CLOCK_REALTIME µs) stamps the line with an earlier moment than now (0: now).
 void write_truth(std::FILE* f, double t_s, double motion_t_s, const docksim::ChassisState& cs, bool relay,
-                 bool silent, const char* event) {
+                 bool silent, const char* event, std::int64_t wall_us = 0) {
   if (f == nullptr) return;
   // "wall" is CLOCK_REALTIME, the clock candump stamps frames with, so a test can line events up with the CAN log.
   timespec wall{};
   clock_gettime(CLOCK_REALTIME, &wall);
+  if (wall_us > 0) {
+    wall.tv_sec = static_cast<time_t>(wall_us / 1000000);
+    wall.tv_nsec = static_cast<long>(wall_us % 1000000) * 1000;
+  }
   std::fprintf(f, "{\"wall\":%lld.%06ld,", static_cast<long long>(wall.tv_sec), wall.tv_nsec / 1000);
   std::fprintf(f,
                "\"t\":%.3f,\"motion_t\":%.3f,\"x\":%.4f,\"y\":%.4f,\"yaw\":%.5f,\"contact\":%s,\"charging\":%s,"
@@ -205,7 +210,7 @@ int run(const Options& opt) {
   double motion_t0 = -1;  // scenario clock origin
   std::size_t next_event = 0;
   double occluded_until = -1, dropout_until = -1, silent_until = -1;
-  bool silent = false;
+  bool silent = false, silent_done = false;
   struct Disc {
     dockcore::Vec2 c;
     double r, until;
@@ -221,7 +226,8 @@ int run(const Options& opt) {
   double next_scan_t = 0, next_truth_t = 0;
   std::uint32_t bad_frames = 0, frames_rx = 0, scans_sent = 0;
   v1::CounterTracker cmd_tracker;
-  bool lidar_unplugged = false;
+  LidarFaultState lidar_fault_state;
+  std::int64_t last_scan_wall_us = 0;
   double charging_since_t = -1;
   bool contact_broken = false;
   // A LaserScan is ~64 kB: keep it off the stack.
@@ -258,8 +264,9 @@ int run(const Options& opt) {
       }
       write_truth(truth, t, mt, chassis.state(), relay, silent, docksim::to_string(ev.kind));
     }
-    if (motion_t0 >= 0 && opt.silent_at_s >= 0 && mt >= opt.silent_at_s && silent_until < opt.silent_at_s) {
-      silent_until = opt.silent_at_s + opt.silent_for_s;
+    if (motion_t0 >= 0 && opt.silent_at_s >= 0 && mt >= opt.silent_at_s && !silent_done) {
+      silent_done = true;
+      silent_until = mt + opt.silent_for_s;  // the full window even when this loop was late
       silent = true;
       chassis.set_frozen(true, docksim::FreezeMotion::kStop);
       write_truth(truth, t, mt, chassis.state(), relay, silent, "chassis_silent");
@@ -459,11 +466,21 @@ int run(const Options& opt) {
         for (const auto& d : discs) w.add_circle(d.c, d.r);
         const Pose2 lidar_world = cs.true_pose.compose(sc.lidar_mount);
         docksim::simulate_scan(w, lidar_world, sc.lidar, lidar_rng, &scan, now_us);
-        if (lidar->emit_scan(scan.view())) ++scans_sent;
+        if (lidar->emit_scan(scan.view())) {
+          ++scans_sent;
+          timespec sent_at{};
+          clock_gettime(CLOCK_REALTIME, &sent_at);
+          last_scan_wall_us = static_cast<std::int64_t>(sent_at.tv_sec) * 1000000 + sent_at.tv_nsec / 1000;
+        }
       }
     }
-    lidar_faults(*lidar, opt.lidar, mt, lidar_unplugged,
-                 [&](const char* ev) { write_truth(truth, t, mt, cs, relay, silent, ev); });
+    lidar_faults(*lidar, opt.lidar, mt, lidar_fault_state, [&](const char* ev) {
+      write_truth(truth, t, mt, cs, relay, silent, ev);
+      // The reference of the stale-lidar reaction: the last scan that left before the fault began.
+      if (std::strcmp(ev, "lidar_stall") == 0 || std::strcmp(ev, "lidar_unplug") == 0 ||
+          std::strcmp(ev, "lidar_corrupt") == 0 || std::strcmp(ev, "lidar_wrong_baud") == 0)
+        write_truth(truth, t, mt, cs, relay, silent, "lidar_last_good_scan", last_scan_wall_us);
+    });
     if (step % 4 == 0) lidar->service_requests();  // RPLIDAR requests answered within ~20 ms
 
     if (t >= next_truth_t) {

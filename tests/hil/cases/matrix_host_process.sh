@@ -1,0 +1,132 @@
+# Fault-injection matrix, host and process rows (issue #6 §1, §3; docs/reliability.md), judged on the host by
+# tests/hil/matrix.py from the candump stamps.
+source "$SRC/tests/hil/matrix_lib.sh"
+HF="$BUILD/tests/hil/hil_frames"
+UDP="$BUILD/tests/hil/hil_udp"
+
+# Host-side checks (tests/hil/matrix.py).
+post_flood() {
+  local gap n f states
+  read -r gap n <<< "$($MATRIX_PY wheel-gaps "$RD" "$(inject_time flood_start)" "$(inject_time flood_end)")"
+  echo "FIGURE ${ROW}_reaction_ms n/a"
+  echo "FIGURE ${ROW}_max_wheel_period_ms $gap"
+  echo "FIGURE ${ROW}_wheel_frames_during_flood $n"
+  f=$($MATRIX_PY faults "$RD"); echo "INFO $ROW faults: '$f'"
+  check "${ROW}_no_fault" test -z "$f"
+  states=$($MATRIX_PY states "$RD"); echo "INFO $ROW states: $states"
+  check "${ROW}_state_sequence" grep -qE '^0 1 (2 )?3 5 4$' <<< "$states"
+}
+post_bad_commands() {
+  echo "FIGURE host_bad_commands_reaction_ms n/a"
+  check host_bad_commands_never_moved test "$($MATRIX_PY nonzero-count "$RD")" = 0
+}
+post_sigkill() {
+  local base
+  base=$($MATRIX_PY delta "$RD" last_wheel_cmd command_timeout)
+  echo "FIGURE process_sigkill_reaction_ms $base"
+  check process_sigkill_base_stops_by_timeout awk -v m="$base" 'BEGIN{exit !(m != "none" && m + 0 <= 525)}'
+  # The record up to the kill: every line is whole JSON and the last state event is the moving state it was in.
+  check process_sigkill_record_intact /usr/bin/python3 -c '
+import json, sys
+lines = open(sys.argv[1]).read().split("\n")
+assert lines[-1] == "", "torn last line"
+ev = [json.loads(l) for l in lines[:-1]]
+st = [e["to"] for e in ev if e.get("event") == "state"]
+assert st and st[-1] in ("REACH_TASKING_POINT", "ALIGN"), st[-3:]
+' "$RD/events_at_kill.jsonl"
+  check process_sigkill_canlog_intact /usr/bin/python3 -c '
+import sys
+t = open(sys.argv[1]).read()
+assert t.endswith("\n"), "torn can.log"
+last = t.rstrip("\n").rsplit("\n", 1)[-1]
+assert float(last[1:last.index(")")]) > float(sys.argv[2]) - 0.1, last
+' "$RD/canlog_at_kill.log" "$(inject_time sigkill)"
+  check process_restart_no_motion test "$($MATRIX_PY nonzero-count "$RD" "$(inject_time restart)" "$(inject_time redock)")" = 0
+  check process_restart_moves_on_new_command test "$($MATRIX_PY nonzero-count "$RD" "$(inject_time redock)")" -gt 0
+}
+[ -n "${MATRIX_POST:-}" ] && return 0
+
+# Host command flood on UDP: 1000 requests/s for 10 s (status and dock alternately; hil_udp) during a docking.
+# Expected: every request answered, the extra docks rejected (6), the docking completes, the 50 Hz loop holds.
+row_start host_flood_udp
+row_dock
+wait_for 30 motion_after 0.5
+inject flood_start
+"$UDP" flood 7300 1000 10 > "$RD/flood.txt" 2>&1
+inject flood_end
+echo "INFO host_flood_udp: $(cat "$RD/flood.txt")"
+echo "FIGURE host_flood_udp_rate_per_s $(awk '{print $6}' "$RD/flood.txt")"
+check host_flood_udp_all_answered awk '{exit !($2 > 0 && $4 >= $2)}' "$RD/flood.txt"
+check host_flood_udp_docked wait_state FINISH_TASKING 90
+row_stop
+post post_flood
+
+# Host command flood on CAN: 10000 HostCommand frames at 1 ms (canplayer) during a docking: valid checksums and
+# counters, all replaying the dock's sequence 1 — each passes the frame checks and is rejected by the sequence rule.
+row_start host_flood_can
+frames=(); for c in $(seq 0 15); do frames+=("$("$HF" dock 0 1 "$c")"); done
+for ((i = 0; i < 10000; i++)); do
+  printf '(%d.%06d) vcan0 %s\n' $((1000 + i / 1000)) $(((i % 1000) * 1000)) "${frames[$(((2 + i) % 16))]}"
+done > "$RD/flood.log"
+row_dock
+wait_for 30 motion_after 0.5
+inject flood_start
+canplayer -I "$RD/flood.log" vcan0=vcan0 2> "$RD/canplayer.log"
+inject flood_end
+t0=$(inject_time flood_start); t1=$(inject_time flood_end)
+echo "FIGURE host_flood_can_rate_per_s $(awk -v a="$t0" -v b="$t1" 'BEGIN{printf "%.0f", 10000/(b-a)}')"
+check host_flood_can_docked wait_state FINISH_TASKING 90
+row_stop
+post post_flood
+echo "FIGURE host_flood_can_commands_rejected $(matrix_field "$RD/status.json" commands_rejected)"
+check host_flood_can_replays_rejected test "$(matrix_field "$RD/status.json" commands_rejected)" -ge 9000
+
+# Bad host requests (idle robot): malformed JSON -> 1, unknown command -> 2, unknown dock id -> 5 (UDP); on CAN an
+# unknown command code and an unknown dock id -> rejected (commands_rejected), the state stays NOT_TASKING.
+row_start host_bad_commands
+"$UDP" send 7300 '{"cmd":"dock",' > "$RD/replies.txt"
+"$UDP" send 7300 '{"cmd":"fly"}' >> "$RD/replies.txt"
+"$UDP" send 7300 '{"cmd":"dock","dock_id":9}' >> "$RD/replies.txt"
+sed 's/^/INFO host_bad_commands reply: /' "$RD/replies.txt"
+check host_bad_commands_malformed_1 grep -q '"code":1,' <(sed -n 1p "$RD/replies.txt")
+check host_bad_commands_unknown_command_2 grep -q '"code":2,' <(sed -n 2p "$RD/replies.txt")
+check host_bad_commands_unknown_dock_5 grep -q '"code":5,' <(sed -n 3p "$RD/replies.txt")
+cansend vcan0 "$("$HF" 9 0 1)"
+cansend vcan0 "$("$HF" dock 9 2)"
+sleep 1
+check host_bad_commands_state_unchanged state_is NOT_TASKING
+row_stop
+post post_bad_commands
+rej=$(matrix_field "$RD/status.json" commands_rejected)
+echo "FIGURE host_bad_commands_rejected $rej"
+check host_bad_commands_all_counted test "${rej:-0}" -ge 5
+
+# SIGKILL mid-approach (2 s into the motion): nothing stops the robot but the base's own command timeout (500 ms
+# after the last wheel command; chassis-sim truth event command_timeout): limit 500 ms + one 5 ms physics step +
+# one 20 ms loop wake-up = 525 ms. The session record must hold every event up to the kill. Restarted, dockd comes up
+# idle, reports the interrupted session (event previous_session) and sends only zero wheel commands until a new
+# dock command.
+row_start process_sigkill
+row_dock
+wait_for 30 motion_after 2
+inject sigkill
+stop_bg "$PID_dockd" KILL
+PID_dockd=
+cp "$RD/record/events.jsonl" "$RD/events_at_kill.jsonl"
+cp "$RD/record/can.log" "$RD/canlog_at_kill.log"
+wait_for 10 truth_has command_timeout
+last_cmd=$(grep ' 100#' "$RD/candump.log" | tail -1 | sed 's/^(\([0-9.]*\)).*/\1/')
+echo "last_wheel_cmd $last_cmd" >> "$RD/inject.log"
+check process_sigkill_no_frame_after_kill awk -v a="$last_cmd" -v k="$(inject_time sigkill)" \
+  'BEGIN{exit !(a + 0 <= k + 0.005)}'
+inject restart
+row_dockd
+check process_restart_idle wait_for 30 state_is NOT_TASKING
+sleep 2
+check process_restart_reports_interrupted grep -q '"event":"previous_session".*"clean":false' "$RD/record/events.jsonl"
+grep '"previous_session"' "$RD/record/events.jsonl" | sed 's/^/INFO /'
+inject redock
+cansend vcan0 "$("$HF" dock 0 1)"
+sleep 3
+row_stop
+post post_sigkill

@@ -1,0 +1,367 @@
+#!/usr/bin/env python3
+"""Fault-injection matrix analysis (issue #6 §1), standard library only. Every time is CLOCK_REALTIME seconds: the
+candump log's stamps, chassis-sim's truth "wall" field and the case's inject log (`date +%s.%N`) share that clock.
+
+  matrix.py row ROW_DIR --row NAME --fault EVENT [--limit-ms L] [--code C] [--clear EVENT] [--recover KIND]
+                [--hold-end EVENT] [--no-moving-check] [--status-limit-ms L]
+      Judges one row from ROW_DIR/{candump.log,decode.json,truth.jsonl,inject.log,record/events.jsonl,status.json}
+      and prints PASS/FAIL <row>_<check> and FIGURE <row>_<name> <value> lines. Exit status = number of FAILs.
+      EVENT names a truth-log event ("event" field) or an inject.log line ("NAME WALL"); the first one counts;
+      "status:C" is the first DockStatus frame with fault C, "last:FRAME:REF" / "first:FRAME:REF" the last FRAME frame
+      before / the first at or after another reference, "frame:FRAME" the first FRAME frame of the log.
+        fault time  t_f = EVENT's time.
+        reaction    first WheelCmdA with zero speeds (or enable 0) at or after t_f; reaction_ms = that - t_f,
+                    must be <= L (when L is given).
+        moving      the last WheelCmdA before t_f was non-zero (else the reaction says nothing) unless --no-moving-check.
+        fault code  a DockStatus frame with fault C at or after t_f (status_ms = its delay; <= --status-limit-ms).
+        hold        no non-zero WheelCmdA from the reaction until --clear EVENT (the fault clears) or --hold-end
+                    EVENT or the end of the log.
+        recovery    KIND: resume (a dockd "resume" event, then non-zero wheels after the clear), moving (non-zero wheels
+                    after the clear, no new command needed), charging (DockStatus FINISH_TASKING after the clear),
+                    none (still no non-zero wheel to the end of the log: faults that wait for a new command).
+  matrix.py frame ID HEX14            -> cansend "ID#DATA" with the dockcore v1 CRC-8 appended (7 data bytes given)
+  matrix.py last-counter CANDUMP ID   -> counter (byte 6 low nibble) of the last frame with that id in a candump log
+  matrix.py json-field FILE KEY       -> the value of KEY in a one-line JSON object file ("" when absent)
+  matrix.py wheel-gaps ROW_DIR T0 T1  -> "max_gap_ms count" of dockd's WheelCmdA between wall times T0 and T1
+  matrix.py first-wheels ROW_DIR REF  -> zero | moving | none: the first WheelCmdA at or after REF
+  matrix.py nonzero-count ROW_DIR [T0 [T1]] -> number of non-zero WheelCmdA frames (between wall times T0, T1)
+  matrix.py summary CASE_DIR...       -> one line per row: verdict, failed checks, figures (job.log + post.log)
+  matrix.py delta ROW_DIR EV1 EV2     -> ms from the first EV1 to the first EV2 at or after it (truth/inject events)
+  matrix.py last-signal ROW_DIR FRAME SIGNAL -> that signal in the last frame of that name (dock-decode names)
+  matrix.py faults ROW_DIR            -> distinct non-zero DockStatus fault codes in order
+  matrix.py states ROW_DIR            -> deduplicated DockStatus state sequence
+"""
+import json
+import os
+import sys
+
+ROW_NAMES = ["lidar_unplug", "lidar_stall", "lidar_corrupt50", "lidar_corrupt5", "lidar_wrong_baud", "lidar_protocol",
+             "can_silent", "can_down_up", "can_flood", "can_bad_frames", "motion_push_distance", "motion_push_angle",
+             "motion_obstacle", "motion_occlude_1s", "motion_occlude_6s", "motion_no_charge", "motion_contact_break",
+             "host_flood_udp", "host_flood_can", "host_bad_commands", "process_sigkill", "process_restart"]
+STATE = {"NOT_TASKING": 0, "GET_TASKING_CMD": 1, "REACH_TASKING_POINT": 2, "ALIGN": 3, "FINISH_TASKING": 4,
+         "WAIT_FOR_CHARGE": 5, "RETRY": 6, "UNDOCKING": 7, "FAULT": 8, "TEST_MODE": 9}
+
+
+def crc8_h2f(data):
+    crc = 0xFF
+    for b in data:
+        crc ^= b
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x2F) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
+    return crc ^ 0xFF
+
+
+def candump_times(path):
+    """Line number (1-based, as dock-decode counts) -> wall time."""
+    times = {}
+    with open(path, errors="replace") as f:
+        for i, line in enumerate(f, 1):
+            if line.startswith("("):
+                try:
+                    times[i] = float(line[1:line.index(")")])
+                except ValueError:
+                    pass
+    return times
+
+
+class Row:
+    def __init__(self, d):
+        self.dir = d
+        self.times = candump_times(os.path.join(d, "candump.log"))
+        dj = os.path.join(d, "decode.json")
+        if not os.path.exists(dj):  # decoded on first use (on the host: fast)
+            import subprocess
+            dd = os.path.join(os.environ.get("BUILD", "build/default"), "tools", "dock-decode", "dock-decode")
+            with open(dj, "w") as out:
+                subprocess.run([dd, "--json", os.path.join(d, "candump.log")], stdout=out, stderr=subprocess.DEVNULL,
+                               check=False)
+        with open(dj) as f:
+            doc = json.load(f)
+        self.timeline = []
+        for e in doc.get("timeline", []):
+            t = self.times.get(e.get("line"))
+            if t is not None:
+                e["wall"] = t
+                self.timeline.append(e)
+        self.decode = doc
+        self.events = {}  # name -> [wall...]
+        tp = os.path.join(d, "truth.jsonl")
+        if os.path.exists(tp):
+            with open(tp) as f:
+                for line in f:
+                    try:
+                        j = json.loads(line)
+                    except ValueError:
+                        continue
+                    if "event" in j and "wall" in j:
+                        self.events.setdefault(j["event"], []).append(float(j["wall"]))
+        ip = os.path.join(d, "inject.log")
+        if os.path.exists(ip):
+            with open(ip) as f:
+                for line in f:
+                    p = line.split()
+                    if len(p) >= 2:
+                        self.events.setdefault(p[0], []).append(float(p[1]))
+        self.dockd_events = []
+        ep = os.path.join(d, "record", "events.jsonl")
+        if os.path.exists(ep):
+            with open(ep) as f:
+                for line in f:
+                    try:
+                        self.dockd_events.append(json.loads(line))
+                    except ValueError:
+                        pass
+
+    def wheels(self):
+        return [e for e in self.timeline if e["name"] == "WheelCmdA"]
+
+    def status(self):
+        return [e for e in self.timeline if e["name"] == "DockStatus"]
+
+    def event(self, name):
+        """Wall time of a reference: a truth/inject event NAME; "status:C" the first DockStatus with fault C;
+        "last:FRAME:REF" the last FRAME frame before REF; "first:FRAME:REF" the first FRAME frame at or after REF;
+        "frame:FRAME" the first FRAME frame of the log."""
+        if name.startswith("status:"):
+            code = int(name.split(":", 1)[1])
+            st = next((e for e in self.status() if int(e["signals"]["fault"]) == code), None)
+            return st["wall"] if st else None
+        if name.startswith(("last:", "first:", "frame:")):
+            kind, frame, ref = (name.split(":", 2) + [""])[:3]
+            frames = [e for e in self.timeline if e["name"] == frame]
+            if kind == "frame":
+                return frames[0]["wall"] if frames else None
+            t = self.event(ref)
+            if t is None:
+                return None
+            if kind == "last":
+                before = [e for e in frames if e["wall"] < t]
+                return before[-1]["wall"] if before else None
+            after = [e for e in frames if e["wall"] >= t]
+            return after[0]["wall"] if after else None
+        v = self.events.get(name)
+        return v[0] if v else None
+
+
+def nonzero(e):
+    s = e["signals"]
+    return bool(s.get("enable", 1)) and (s["wheel0"] != 0 or s["wheel1"] != 0)
+
+
+def judge_row(argv):
+    import argparse
+    ap = argparse.ArgumentParser()
+    ap.add_argument("dir")
+    ap.add_argument("--row", required=True)
+    ap.add_argument("--fault", required=True)
+    ap.add_argument("--limit-ms", type=float)
+    ap.add_argument("--code", type=int)
+    ap.add_argument("--status-limit-ms", type=float)
+    ap.add_argument("--clear")
+    ap.add_argument("--hold-end")
+    ap.add_argument("--recover", default="none", choices=["resume", "moving", "charging", "none"])
+    ap.add_argument("--no-moving-check", action="store_true")
+    a = ap.parse_args(argv)
+    r = Row(a.dir)
+    name = a.row
+    fails = 0
+
+    def check(what, ok, why=""):
+        nonlocal fails
+        print(("PASS" if ok else "FAIL") + f" {name}_{what}" + (f"  ({why})" if why and not ok else ""))
+        if not ok:
+            fails += 1
+
+    def figure(what, v):
+        print(f"FIGURE {name}_{what} {v}")
+
+    t_f = r.event(a.fault)
+    if t_f is None:
+        check("fault_injected", False, f"no event {a.fault} in truth/inject logs")
+        return fails
+    wheels = r.wheels()
+    before = [e for e in wheels if e["wall"] < t_f]
+    if not a.no_moving_check:
+        check("moving_at_fault", bool(before) and nonzero(before[-1]),
+              "the last wheel command before the fault was zero: nothing to stop")
+    zero = next((e for e in wheels if e["wall"] >= t_f and not nonzero(e)), None)
+    t_z = zero["wall"] if zero else None
+    if t_z is None:
+        check("reaction", False, "no zero wheel command after the fault")
+        figure("reaction_ms", "none")
+    else:
+        ms = (t_z - t_f) * 1000
+        figure("reaction_ms", f"{ms:.1f}")
+        # dockd sends a wheel frame every 20 ms tick: a longer gap inside the reaction window is the loop (or the
+        # VM) not running — starvation, reported with the verdict so it is not mistaken for a slow watchdog.
+        win = [e["wall"] for e in wheels if t_f - 0.02 <= e["wall"] <= t_z]
+        stall = max((b - a_) for a_, b in zip(win, win[1:])) * 1000 if len(win) > 1 else 0.0
+        figure("tick_gap_in_reaction_ms", f"{stall:.1f}")
+        if a.limit_ms is not None:
+            why = f"{ms:.1f} ms > {a.limit_ms:g} ms"
+            if stall > 40:
+                why += f"; dockd's wheel frames stalled {stall:.0f} ms inside the window: VM starvation"
+            check("reaction", ms <= a.limit_ms, why)
+    # The longest gap between dockd's wheel commands around the fault: a starved VM shows here (nominal 20 ms).
+    around = [e["wall"] for e in wheels if t_f - 1.0 <= e["wall"] <= t_f + 1.0]
+    gap = max((b - a_) for a_, b in zip(around, around[1:])) * 1000 if len(around) > 1 else float("nan")
+    figure("wheel_gap_near_fault_ms", f"{gap:.1f}")
+    t_c = r.event(a.clear) if a.clear else None
+    if a.clear and t_c is None:
+        check("fault_cleared", False, f"no event {a.clear}")
+    if a.code is not None:
+        st = next((e for e in r.status() if e["wall"] >= t_f and int(e["signals"]["fault"]) == a.code), None)
+        check(f"fault_code_{a.code}", st is not None,
+              "status faults after the fault time: " +
+              " ".join(sorted({str(int(e["signals"]["fault"])) for e in r.status() if e["wall"] >= t_f})))
+        if st is not None:
+            ms = (st["wall"] - t_f) * 1000
+            figure("status_ms", f"{ms:.1f}")
+            if a.status_limit_ms is not None:
+                check("status_in_time", ms <= a.status_limit_ms, f"{ms:.1f} ms > {a.status_limit_ms:g} ms")
+    t_hold_end = t_c if t_c is not None else (r.event(a.hold_end) if a.hold_end else None)
+    if t_hold_end is None:
+        t_hold_end = float("inf")
+    if t_z is not None:
+        bad = [e for e in wheels if t_z <= e["wall"] < t_hold_end and nonzero(e)]
+        check("no_motion_while_fault", not bad,
+              f"{len(bad)} non-zero wheel commands, first at +{(bad[0]['wall'] - t_f) * 1000:.0f} ms" if bad else "")
+    if a.recover != "none" and t_c is None and a.recover != "charging":
+        check("recovered", False, "no clear time")
+    elif a.recover == "resume":
+        resumed = any(e.get("event") == "resume" for e in r.dockd_events)
+        moved = next((e for e in wheels if e["wall"] >= t_c and nonzero(e)), None)
+        check("recovered", resumed and moved is not None,
+              f"resume event {'yes' if resumed else 'no'}, motion after clear {'yes' if moved else 'no'}")
+        if moved:
+            figure("recovery_s", f"{moved['wall'] - t_c:.2f}")
+    elif a.recover == "moving":
+        moved = next((e for e in wheels if e["wall"] >= t_c and nonzero(e)), None)
+        check("recovered", moved is not None, "no motion after the fault cleared")
+        if moved:
+            figure("recovery_s", f"{moved['wall'] - t_c:.2f}")
+    elif a.recover == "charging":
+        t0 = t_c if t_c is not None else t_f
+        ch = next((e for e in r.status() if e["wall"] >= t0 and int(e["signals"]["state"]) == STATE["FINISH_TASKING"]), None)
+        check("recovered_to_charging", ch is not None, "FINISH_TASKING never reported after the fault")
+    elif t_z is not None and t_c is None and not a.hold_end:
+        pass  # hold checked to the end of the log above
+    return fails
+
+
+def main(argv):
+    if len(argv) < 2:
+        print(__doc__)
+        return 2
+    cmd = argv[1]
+    if cmd == "row":
+        return judge_row(argv[2:])
+    if cmd == "frame":
+        ident = int(argv[2], 16)
+        data = bytes.fromhex(argv[3])[:7]
+        crc = crc8_h2f([ident & 0xFF, (ident >> 8) & 0x07] + list(data))
+        print(f"{ident:03X}#{data.hex().upper()}{crc:02X}")
+        return 0
+    if cmd == "last-counter":
+        ident = argv[3].upper().lstrip("0") or "0"
+        last = None
+        with open(argv[2], errors="replace") as f:
+            for line in f:
+                p = line.split()
+                if len(p) == 3 and "#" in p[2]:
+                    i, d = p[2].split("#", 1)
+                    if (i.lstrip("0") or "0") == ident and len(d) >= 14:
+                        last = int(d[12:14], 16) & 0x0F
+        print("" if last is None else last)
+        return 0 if last is not None else 1
+    if cmd == "json-field":
+        try:
+            with open(argv[2]) as f:
+                v = json.loads(f.readline()).get(argv[3], "")
+        except (OSError, ValueError):
+            v = ""
+        print(str(v).lower() if isinstance(v, bool) else v)
+        return 0
+    if cmd == "wheel-gaps":
+        r = Row(argv[2])
+        t0, t1 = float(argv[3]), float(argv[4])
+        ts = [e["wall"] for e in r.wheels() if t0 <= e["wall"] <= t1]
+        gap = max((b - a) for a, b in zip(ts, ts[1:])) * 1000 if len(ts) > 1 else float("nan")
+        print(f"{gap:.1f} {len(ts)}")
+        return 0
+    if cmd == "summary":
+        # Per row of one or more case results dirs: verdict, failed checks and every FIGURE (for docs/reliability.md).
+        rows = {}
+        for d in argv[2:]:
+            for name in ("job.log", "post.log"):
+                p = os.path.join(d, name)
+                if not os.path.exists(p):
+                    continue
+                with open(p, errors="replace") as f:
+                    for line in f:
+                        parts = line.split()
+                        if len(parts) < 2 or parts[0] not in ("PASS", "FAIL", "FIGURE"):
+                            continue
+                        row = next((r for r in ROW_NAMES if parts[1].startswith(r + "_")), parts[1].split("_")[0])
+                        e = rows.setdefault(row, {"fail": [], "pass": 0, "fig": {}})
+                        if parts[0] == "FAIL":
+                            e["fail"].append(parts[1][len(row) + 1:])
+                        elif parts[0] == "PASS":
+                            e["pass"] += 1
+                        else:
+                            e["fig"][parts[1][len(row) + 1:]] = parts[2] if len(parts) > 2 else ""
+        for row, e in rows.items():
+            figs = " ".join(f"{k}={v}" for k, v in e["fig"].items())
+            print(f"{row}: {'FAIL ' + ','.join(e['fail']) if e['fail'] else 'PASS'} ({e['pass']} pass) {figs}")
+        return 0
+    if cmd == "delta":
+        r = Row(argv[2])
+        t1 = r.event(argv[3])
+        later = [t for t in r.events.get(argv[4], []) if t1 is not None and t >= t1]
+        if not later and t1 is not None and argv[4].startswith(("first:", "last:", "status:", "frame:")):
+            t2 = r.event(argv[4])
+            later = [t2] if t2 is not None else []
+        print(f"{(later[0] - t1) * 1000:.1f}" if later else "none")
+        return 0 if later else 1
+    if cmd == "first-wheels":
+        r = Row(argv[2])
+        t = r.event(argv[3])
+        e = next((e for e in r.wheels() if t is not None and e["wall"] >= t), None)
+        print("none" if e is None else ("zero" if not nonzero(e) else "moving"))
+        return 0
+    if cmd == "faults":
+        r = Row(argv[2])
+        seq = []
+        for e in r.status():
+            c = int(e["signals"]["fault"])
+            if c and (not seq or seq[-1] != c):
+                seq.append(c)
+        print(" ".join(map(str, seq)))
+        return 0
+    if cmd == "last-signal":
+        r = Row(argv[2])
+        fr = [e for e in r.timeline if e["name"] == argv[3]]
+        print(f'{fr[-1]["signals"][argv[4]]:g}' if fr else "none")
+        return 0 if fr else 1
+    if cmd == "nonzero-count":
+        r = Row(argv[2])
+        t0 = float(argv[3]) if len(argv) > 3 else 0.0
+        t1 = float(argv[4]) if len(argv) > 4 else float("inf")
+        print(sum(1 for e in r.wheels() if t0 <= e["wall"] < t1 and nonzero(e)))
+        return 0
+    if cmd == "states":
+        r = Row(argv[2])
+        seq = []
+        for e in r.status():
+            s = int(e["signals"]["state"])
+            if not seq or seq[-1] != s:
+                seq.append(s)
+        print(" ".join(map(str, seq)))
+        return 0
+    print(__doc__)
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
