@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <sstream>
 #include <utility>
 
@@ -96,6 +97,7 @@ class Parser {
         fail(key.source(), "unknown key '" + path + k + "' (expected " + expected + ")");
       }
       key_ = path + k;
+      where_[key_] = value.source();
       (*h)(value);
     }
   }
@@ -182,10 +184,16 @@ class Parser {
     return [this, path, make](const toml::node& n) { each(table(n), path, make()); };
   }
   const std::string& key() const { return key_; }
+  /// Where `key` ("section.key") was given; `fallback` when it was not (cross-key errors point at the key).
+  toml::source_region where(const std::string& key, const toml::source_region& fallback) const {
+    const auto it = where_.find(key);
+    return it != where_.end() ? it->second : fallback;
+  }
 
  private:
   std::string src_;
   mutable std::string key_;
+  mutable std::map<std::string, toml::source_region> where_;
 };
 
 /// A profile file: name (optional), contact_offset_m (optional), points = [[x, y], ...] (docs/docks.md).
@@ -571,9 +579,9 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
            "lidar.protocol = \"lakibeam\" needs lidar.transport = \"udp\"");
   }
   if (c.lidar.reconnect_max_ms < c.lidar.reconnect_min_ms) {
-    p.fail(root.source(), "lidar.reconnect_max_ms must be >= lidar.reconnect_min_ms");
+    p.fail(p.where("lidar.reconnect_max_ms", root.source()), "lidar.reconnect_max_ms must be >= lidar.reconnect_min_ms");
   }
-  if (c.estimator.min_range_m >= c.estimator.max_range_m) p.fail(root.source(), "lidar.min_range_m must be < lidar.max_range_m");
+  if (c.estimator.min_range_m >= c.estimator.max_range_m) p.fail(p.where("lidar.min_range_m", p.where("lidar.max_range_m", root.source())), "lidar.min_range_m must be < lidar.max_range_m");
   c.can.protocol = *dockcore::drivers::parse_chassis_protocol(can_protocol);
   c.drive.kind = drive_kind == "mecanum" ? dockcore::DriveKind::kMecanum : dockcore::DriveKind::kDifferential;
   c.can.drive = c.drive;
@@ -591,9 +599,9 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   c.task.max_vx_mps = c.limits.max_vx_mps > 0 ? c.limits.max_vx_mps : c.task.max_vx_mps;
   c.task.max_vy_mps = c.limits.max_vy_mps > 0 ? c.limits.max_vy_mps : c.task.max_vy_mps;
   c.task.max_wz_radps = c.limits.max_wz_radps > 0 ? c.limits.max_wz_radps : c.task.max_wz_radps;
-  if (!c.host_enabled && c.host.allowlist.size() > 0) p.fail(root.source(), "host.allowlist given but host.enabled = false");
+  if (!c.host_enabled && c.host.allowlist.size() > 0) p.fail(p.where("host.allowlist", root.source()), "host.allowlist given but host.enabled = false");
   if (c.camera_enabled && c.host_enabled && c.camera.port == c.host.port && c.camera.bind_address == c.host.bind_address) {
-    p.fail(root.source(), "camera.port must differ from host.port");
+    p.fail(p.where("camera.port", root.source()), "camera.port must differ from host.port");
   }
 
   if (c.docks.empty()) {
@@ -619,7 +627,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   }
   c.task.accepted_dock_ids = mask;
   if (c.find_dock(c.default_dock_id) == nullptr) {
-    p.fail(root.source(), "dock.default_id = " + std::to_string(c.default_dock_id) + " is not a configured dock id");
+    p.fail(p.where("dock.default_id", root.source()), "dock.default_id = " + std::to_string(c.default_dock_id) + " is not a configured dock id");
   }
   return c;
 }
