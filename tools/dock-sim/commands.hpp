@@ -14,5 +14,7 @@ void register_scene(CLI::App& app);
 void register_run(CLI::App& app);
 /// `dock-sim montecarlo`: many seeded starts per controller, comparison table (run.cpp).
 void register_montecarlo(CLI::App& app);
+/// `dock-sim soak`: N consecutive dock -> charge -> undock cycles of one continuous robot (soak.cpp).
+void register_soak(CLI::App& app);
 
 }  // namespace docksim_cli

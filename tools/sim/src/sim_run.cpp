@@ -110,16 +110,6 @@ double clearance(const std::vector<P>& poly, bool is_disc, P disc_c, double disc
   return best;
 }
 
-dockcore::DriveGeometry core_geometry(const DriveGeometry& g) {
-  dockcore::DriveGeometry c;
-  c.kind = g.kind == DriveKind::kMecanum ? dockcore::DriveKind::kMecanum : dockcore::DriveKind::kDifferential;
-  c.wheel_radius_m = static_cast<Real>(g.wheel_radius_m);
-  c.wheel_base_m = static_cast<Real>(g.wheel_base_m);
-  c.lx_m = static_cast<Real>(g.lx_m);
-  c.ly_m = static_cast<Real>(g.ly_m);
-  return c;
-}
-
 struct Controllers {
   explicit Controllers(const Scenario& sc) : s000(sc.seed000), s004(sc.seed004), s003(sc.seed003), smooth(sc.smooth) {}
   dockcore::Seed000Controller s000;
@@ -152,6 +142,31 @@ const char* to_string(TimelineKind k) {
   }
   return "?";
 }
+
+dockcore::DriveGeometry core_drive_geometry(const DriveGeometry& g) {
+  dockcore::DriveGeometry c;
+  c.kind = g.kind == DriveKind::kMecanum ? dockcore::DriveKind::kMecanum : dockcore::DriveKind::kDifferential;
+  c.wheel_radius_m = static_cast<Real>(g.wheel_radius_m);
+  c.wheel_base_m = static_cast<Real>(g.wheel_base_m);
+  c.lx_m = static_cast<Real>(g.lx_m);
+  c.ly_m = static_cast<Real>(g.ly_m);
+  return c;
+}
+
+CameraSimParams camera_sim_params(const Scenario& sc) {
+  CameraSimParams camp;
+  camp.model = sc.camera.model;
+  camp.rate_hz = sc.camera.rate_hz;
+  camp.latency_s = sc.camera.latency_s;
+  camp.sigma_px = sc.camera.sigma_px;
+  camp.dropout_prob = sc.camera.dropout_prob;
+  camp.min_depth_m = sc.camera.min_depth_m;
+  camp.max_depth_m = sc.camera.max_depth_m;
+  camp.v_px = sc.camera.v_px;
+  return camp;
+}
+
+std::uint64_t seed_stream(std::uint64_t seed, std::uint64_t salt) { return mix64(seed ^ salt); }
 
 std::uint64_t trial_seed(std::uint64_t base, std::uint64_t index) { return mix64(mix64(base) ^ (index * 0xD1B54A32D192ED03ull)); }
 
@@ -237,19 +252,10 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   chassis.reset_odometry(Pose2{});
   Rng lidar_rng(mix64(seed ^ 0x4C494441ull));
 
-  CameraSimParams camp;
-  camp.model = sc.camera.model;
-  camp.rate_hz = sc.camera.rate_hz;
-  camp.latency_s = sc.camera.latency_s;
-  camp.sigma_px = sc.camera.sigma_px;
-  camp.dropout_prob = sc.camera.dropout_prob;
-  camp.min_depth_m = sc.camera.min_depth_m;
-  camp.max_depth_m = sc.camera.max_depth_m;
-  camp.v_px = sc.camera.v_px;
-  CameraSim camera(camp, mix64(seed ^ 0x43414dull));
+  CameraSim camera(camera_sim_params(sc), mix64(seed ^ 0x43414dull));
   const Vec2 target_world = sc.dock_pose.transform(sc.camera.target_in_dock);
 
-  const dockcore::DriveGeometry geom = core_geometry(sc.chassis.geometry);
+  const dockcore::DriveGeometry geom = core_drive_geometry(sc.chassis.geometry);
   const double dt = sc.chassis.dt_s;
   const double tick_dt = dt * kStepsPerTick;
 

@@ -13,6 +13,9 @@
 #include <vector>
 
 #include "dockcore/geometry.hpp"
+#include "dockcore/kinematics.hpp"
+#include "docksim/camera_sim.hpp"
+#include "docksim/chassis.hpp"
 #include "dockcore/task_manager.hpp"
 #include "docksim/scenario.hpp"
 
@@ -33,6 +36,14 @@ StartPose start_from(const Scenario& sc, double distance_m, double bearing_rad, 
 StartPose draw_start(const Scenario& sc, std::uint64_t seed);
 /// Seed of Monte Carlo trial `index` for base seed `base` (splitmix64 mixing): the same for every controller.
 std::uint64_t trial_seed(std::uint64_t base, std::uint64_t index);
+
+/// dockcore's drive geometry (kinematics.hpp) for the simulated chassis' geometry. O(1).
+dockcore::DriveGeometry core_drive_geometry(const DriveGeometry& g);
+/// The camera simulator's parameters for a scenario's camera (rate, latency, noise, dropouts, depth range). O(1).
+CameraSimParams camera_sim_params(const Scenario& sc);
+/// The seed of one random stream of a run: splitmix64 of `seed ^ salt`, as run_docking derives its chassis, lidar and
+/// camera streams (salts 0x43484153 "CHAS", 0x4C494441 "LIDA", 0x43414d "CAM"). O(1).
+std::uint64_t seed_stream(std::uint64_t seed, std::uint64_t salt);
 
 enum class TimelineKind : std::uint8_t { kState, kPhase, kFault, kEvent, kContact, kHost };
 const char* to_string(TimelineKind k);
