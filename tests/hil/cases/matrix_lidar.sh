@@ -21,29 +21,32 @@ lidar_row() {
   row_dock
   wait_for 60 truth_has "$clear"
   # Resume: 0.5 s of fresh scans after the driver reconnected (backoff up to 2 s), then motion.
-  wait_for 15 dockd_logged resume
+  [ -z "${JUDGE:-}" ] && wait_for 15 dockd_logged resume
   sleep 1
   row_stop
-  judge --fault lidar_last_good_scan --limit-ms "${LIMIT_MS:-220}" --code 185 --clear "$clear" --recover resume
+  # shellcheck disable=SC2086
+  judge --fault lidar_last_good_scan --limit-ms "${LIMIT_MS:-220}" --code 185 --clear "$clear" ${JUDGE:---recover resume}
 }
 
 lidar_row lidar_unplug lidar_unplug lidar_replug --lidar-unplug-at 2 --lidar-unplug-for 1.5
 lidar_row lidar_stall lidar_stall lidar_unstall --lidar-stall-at 2 --lidar-stall-for 1.5
 lidar_row lidar_corrupt50 lidar_corrupt lidar_clean --lidar-corrupt 0.5 --lidar-corrupt-at 2 --lidar-corrupt-for 1.5
-LIMIT_MS=620 lidar_row lidar_corrupt5 lidar_corrupt lidar_clean --lidar-corrupt 0.05 --lidar-corrupt-at 2 --lidar-corrupt-for 1.5
+# 5 %: scans that still complete make the lidar fresh again between trips: the robot may hold and go on; judged by
+# the status (never motion while a DockStatus shows a fault) and motion after the corruption ends.
+LIMIT_MS=620 JUDGE="--hold-by-status --recover moving" lidar_row lidar_corrupt5 lidar_corrupt lidar_clean --lidar-corrupt 0.05 --lidar-corrupt-at 2 --lidar-corrupt-for 1.5
 lidar_row lidar_wrong_baud lidar_wrong_baud lidar_right_baud --lidar-wrong-baud 115200 --lidar-wrong-baud-at 2 \
   --lidar-wrong-baud-for 1.5
 
 # Another protocol: RPLIDAR bytes into dockd's LD06 parser from the start. No scan ever parses: the dock command
 # faults 185 at once (the lidar was never fresh). Fault time = the HostCommand frame in the candump log; limit for the
-# 185 status: the command is taken on the next tick and faults on the one after (GET_TASKING_CMD sees lidar_ok
-# false), status on change: 3 ticks = 60 ms. The robot never moves; the parser counts the garbage.
+# FAULT/185 status (idle, the status already shows 185 as the watchdog condition): the command is taken on the next
+# tick and faults on the one after (GET_TASKING_CMD sees lidar_ok false), status on change: 3 ticks = 60 ms. The robot never moves; the parser counts the garbage.
 row_start lidar_protocol --lidar-protocol rplidar --lidar-rplidar-autostart
 sleep 2
 row_dock
 sleep 3
 row_stop
-judge --fault first:HostCommand:dock --no-moving-check --code 185 --status-limit-ms 60 --recover none
+judge --fault first:HostCommand:dock --no-moving-check --code 185 --state 8 --status-limit-ms 60 --recover none
 post post_lidar_protocol
 check lidar_protocol_no_scans test "$(matrix_field "$RD/status.json" scans)" = 0
 errs=$(( $(matrix_field "$RD/status.json" lidar_crc_errors) + $(matrix_field "$RD/status.json" lidar_resyncs) ))
