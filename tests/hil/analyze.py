@@ -7,6 +7,8 @@
   analyze.py first-zero-after DECODE.json T -> log time of the first zero WheelCmdA at or after T
   analyze.py final-error TRUTH.jsonl        -> "contact lateral_mm yaw_deg" at the last truth line with contact
   analyze.py faults DECODE.json             -> distinct non-zero DockStatus fault codes in order
+  analyze.py contact-errors TRUTH.jsonl     -> one "episode lateral_mm yaw_deg" line per contact episode (contacts
+                                               closed, then opened or the log ended), at its last line with contact
 """
 import json
 import math
@@ -73,6 +75,23 @@ def main(argv):
             print("no-contact")
             return 1
         print(f'1 {last["pad_lateral_m"] * 1000:.1f} {math.degrees(last["pad_yaw_rad"]):.2f}')
+    elif cmd == "contact-errors":
+        episodes, last = [], None
+        with open(argv[2]) as f:
+            for line in f:
+                try:
+                    d = json.loads(line)
+                except ValueError:
+                    continue
+                if d.get("contact"):
+                    last = d
+                elif last is not None:
+                    episodes.append(last)
+                    last = None
+        if last is not None:
+            episodes.append(last)
+        for i, e in enumerate(episodes, 1):
+            print(f'{i} {e["pad_lateral_m"] * 1000:.1f} {math.degrees(e["pad_yaw_rad"]):.2f}')
     else:
         print(__doc__)
         return 2
