@@ -379,6 +379,24 @@ def main(argv):
             delay = min(delay * 2, 2.0)
         print(f"{(t + delay + 0.020 - t_up) * 1000:.1f} {(first - t_up) * 1000:.1f}")
         return 0
+    if cmd == "record-check":
+        # The session record survives SIGKILL up to the last event: every line of events.jsonl (copied right after
+        # the kill) is whole JSON, and its last state event is the state the last DockStatus frame before the kill
+        # showed on the bus (candump) — what dockd had done, it had written.
+        r = Row(argv[2])
+        t_kill = r.event(argv[4])
+        names = {v: k for k, v in STATE.items()}
+        with open(argv[3]) as f:
+            text = f.read()
+        if not text.endswith("\n"):
+            print("torn last line")
+            return 1
+        ev = [json.loads(line) for line in text.splitlines()]
+        states = [e["to"] for e in ev if e.get("event") == "state"]
+        st = [e for e in r.status() if e["wall"] <= t_kill]
+        bus = names.get(int(st[-1]["signals"]["state"])) if st else None
+        print(f"record {len(ev)} events, last state {states[-1] if states else None}; bus before the kill: {bus}")
+        return 0 if states and bus == states[-1] else 1
     if cmd == "first-wheels":
         r = Row(argv[2])
         t = r.event(argv[3])

@@ -46,8 +46,9 @@ rbg() {
   printf -v "PID_${name//-/_}" '%s' "$pid"
 }
 
-# inject NAME: records "NAME <CLOCK_REALTIME>" in the row's inject.log (the case's own fault times).
-inject() { echo "$1 $(date +%s.%N)" >> "$RD/inject.log"; }
+# inject NAME: records "NAME <CLOCK_REALTIME>" in the row's inject.log (the case's own fault times). $EPOCHREALTIME
+# is read by bash itself: `date` is a process start, which takes up to a second in the loaded VM.
+inject() { echo "$1 $EPOCHREALTIME" >> "$RD/inject.log"; }
 
 # row_start NAME [chassis-sim options...]: $ROW_SCENARIO (default scenario) and $ROW_TOML (extra dockd config
 # text appended, e.g. a [task] table) apply. Starts candump (dockcore ids 0x100-0x1FF only), chassis-sim, dockd.

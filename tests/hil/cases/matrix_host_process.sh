@@ -25,15 +25,9 @@ post_sigkill() {
   base=$($MATRIX_PY delta "$RD" last_wheel_cmd command_timeout)
   echo "FIGURE process_sigkill_reaction_ms $base"
   check process_sigkill_base_stops_by_timeout awk -v m="$base" 'BEGIN{exit !(m != "none" && m + 0 <= 525)}'
-  # The record up to the kill: every line is whole JSON and the last state event is the moving state it was in.
-  check process_sigkill_record_intact /usr/bin/python3 -c '
-import json, sys
-lines = open(sys.argv[1]).read().split("\n")
-assert lines[-1] == "", "torn last line"
-ev = [json.loads(l) for l in lines[:-1]]
-st = [e["to"] for e in ev if e.get("event") == "state"]
-assert st and st[-1] in ("REACH_TASKING_POINT", "ALIGN"), st[-3:]
-' "$RD/events_at_kill.jsonl"
+  # The record up to the kill: every line whole JSON, the last state event = the last DockStatus state on the bus.
+  $MATRIX_PY record-check "$RD" "$RD/events_at_kill.jsonl" sigkill | sed 's/^/INFO process_sigkill /'
+  check process_sigkill_record_intact $MATRIX_PY record-check "$RD" "$RD/events_at_kill.jsonl" sigkill
   check process_sigkill_canlog_intact /usr/bin/python3 -c '
 import sys
 t = open(sys.argv[1]).read()
@@ -88,9 +82,10 @@ row_start host_bad_commands
 "$UDP" send 7300 '{"cmd":"fly"}' >> "$RD/replies.txt"
 "$UDP" send 7300 '{"cmd":"dock","dock_id":9}' >> "$RD/replies.txt"
 sed 's/^/INFO host_bad_commands reply: /' "$RD/replies.txt"
-check host_bad_commands_malformed_1 grep -q '"code":1,' <(sed -n 1p "$RD/replies.txt")
-check host_bad_commands_unknown_command_2 grep -q '"code":2,' <(sed -n 2p "$RD/replies.txt")
-check host_bad_commands_unknown_dock_5 grep -q '"code":5,' <(sed -n 3p "$RD/replies.txt")
+reply_code() { sed -n "${1}p" "$RD/replies.txt" | grep -q "\"code\":$2,"; }
+check host_bad_commands_malformed_1 reply_code 1 1
+check host_bad_commands_unknown_command_2 reply_code 2 2
+check host_bad_commands_unknown_dock_5 reply_code 3 5
 cansend vcan0 "$("$HF" 9 0 1)"
 cansend vcan0 "$("$HF" dock 9 2)"
 sleep 1
@@ -98,8 +93,13 @@ check host_bad_commands_state_unchanged state_is NOT_TASKING
 row_stop
 post post_bad_commands
 rej=$(matrix_field "$RD/status.json" commands_rejected)
-echo "FIGURE host_bad_commands_rejected $rej"
-check host_bad_commands_all_counted test "${rej:-0}" -ge 5
+echo "FIGURE host_bad_commands_udp_rejected $rej"
+check host_bad_commands_udp_counted test "${rej:-0}" -ge 3
+# CAN: the task manager's verdicts, in the event log and in DockStatus LastResult (CommandResult).
+check host_bad_commands_can_unknown_rejected grep -q '"source":"can","command":9.*"result":"rejected_unknown"' \
+  "$RD/record/events.jsonl"
+check host_bad_commands_can_dock_id_rejected grep -q '"source":"can","command":1,"dock_id":9.*"result":"rejected_dock_id"' \
+  "$RD/record/events.jsonl"
 
 # SIGKILL mid-approach (2 s into the motion): nothing stops the robot but the base's own command timeout (500 ms
 # after the last wheel command; chassis-sim truth event command_timeout): limit 500 ms + one 5 ms physics step +
