@@ -17,7 +17,8 @@ candump log's stamps, chassis-sim's truth "wall" field and the case's inject log
         hold        no non-zero WheelCmdA from the reaction until --clear EVENT (the fault clears) or --hold-end
                     EVENT or the end of the log (not with --hold-by-status).
         status hold never a non-zero WheelCmdA while the last DockStatus carried a fault (always checked).
-        recovery    KIND: resume (a dockd "resume" event, then non-zero wheels after the clear), moving (non-zero wheels
+        recovery    KIND: resume (non-zero wheels after the clear, and dockd's "resume" event if the task faulted — a
+                    watchdog outage shorter than fault_after_ms only holds the wheels), moving (non-zero wheels
                     after the clear, no new command needed), charging (DockStatus FINISH_TASKING after the clear),
                     none (still no non-zero wheel to the end of the log: faults that wait for a new command).
   matrix.py frame ID HEX14            -> cansend "ID#DATA" with the dockcore v1 CRC-8 appended (7 data bytes given)
@@ -267,10 +268,15 @@ def judge_row(argv):
     if a.recover != "none" and t_c is None and a.recover != "charging":
         check("recovered", False, "no clear time")
     elif a.recover == "resume":
+        # dockd holds the wheels at once but faults the task only when the data stays away for [watchdog]
+        # fault_after_ms (1 s): a shorter outage just continues; a task fault (FAULT in the status) must be
+        # followed by dockd's resume (0.5 s of fresh data). Either way the robot moves again after the clear.
+        faulted = any(e["wall"] >= t_f and int(e["signals"]["state"]) == STATE["FAULT"] for e in r.status())
         resumed = any(e.get("event") == "resume" for e in r.dockd_events)
         moved = next((e for e in wheels if e["wall"] >= t_c and nonzero(e)), None)
-        check("recovered", resumed and moved is not None,
-              f"resume event {'yes' if resumed else 'no'}, motion after clear {'yes' if moved else 'no'}")
+        check("recovered", (resumed or not faulted) and moved is not None,
+              f"task fault {'yes' if faulted else 'no'}, resume event {'yes' if resumed else 'no'}, "
+              f"motion after clear {'yes' if moved else 'no'}")
         if moved:
             figure("recovery_s", f"{moved['wall'] - t_c:.2f}")
     elif a.recover == "moving":
