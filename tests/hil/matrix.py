@@ -68,15 +68,18 @@ def candump_times(path):
 
 
 class Row:
-    def __init__(self, d):
+    def __init__(self, d, log=None):
+        # The judged CAN log: candump's (default) or, with MATRIX_LOG / --log, another candump-format log such as
+        # dockd's session record record/can.log (the CAN down/up row: candump exits when the link goes down).
+        log = log or os.environ.get("MATRIX_LOG", "candump.log")
         self.dir = d
-        self.times = candump_times(os.path.join(d, "candump.log"))
-        dj = os.path.join(d, "decode.json")
+        self.times = candump_times(os.path.join(d, log))
+        dj = os.path.join(d, "decode.json" if log == "candump.log" else log.replace("/", "_") + ".decode.json")
         if not os.path.exists(dj):  # decoded on first use (on the host: fast)
             import subprocess
             dd = os.path.join(os.environ.get("BUILD", "build/default"), "tools", "dock-decode", "dock-decode")
             with open(dj, "w") as out:
-                subprocess.run([dd, "--json", os.path.join(d, "candump.log")], stdout=out, stderr=subprocess.DEVNULL,
+                subprocess.run([dd, "--json", os.path.join(d, log)], stdout=out, stderr=subprocess.DEVNULL,
                                check=False)
         with open(dj) as f:
             doc = json.load(f)
@@ -176,8 +179,9 @@ def judge_row(argv):
     # The fault comes and goes by itself (5 % corruption: some scans still pass): judge the hold by the status frames
     # only (no_motion_while_status_faulted), not by the window reaction..clear.
     ap.add_argument("--hold-by-status", action="store_true")
+    ap.add_argument("--log", help="candump-format log to judge, relative to the row (default candump.log)")
     a = ap.parse_args(argv)
-    r = Row(a.dir)
+    r = Row(a.dir, a.log)
     name = a.row
     fails = 0
 
