@@ -32,9 +32,16 @@ matrix_field() { sed -n "s/.*\"$2\":\(\"[^\"]*\"\|[^,}]*\).*/\1/p" "$1" 2>/dev/n
 # Wall time of the first inject.log entry NAME.
 inject_time() { awk -v n="$1" '$1 == n {print $2; exit}' "$RD/inject.log"; }
 # Prints the worst-tick figures of the row from its status snapshot.
+# (dockctl status may time out in a starved VM: then dockd's shutdown event, which carries the same statistics.)
 tick_figures() {
-  echo "FIGURE ${ROW}_worst_tick_ms $(awk -v u="$(matrix_field "$RD/status.json" tick_worst_us)" 'BEGIN{printf "%.1f", u/1000}')"
-  echo "FIGURE ${ROW}_tick_overruns $(matrix_field "$RD/status.json" tick_overruns)"
+  local w o
+  w=$(matrix_field "$RD/status.json" tick_worst_us); o=$(matrix_field "$RD/status.json" tick_overruns)
+  if [ -z "$w" ]; then
+    grep '"event":"shutdown"' "$RD/record/events.jsonl" 2>/dev/null | tail -1 > "$RD/shutdown.json"
+    w=$(matrix_field "$RD/shutdown.json" worst_tick_us); o=$(matrix_field "$RD/shutdown.json" overruns)
+  fi
+  echo "FIGURE ${ROW}_worst_tick_ms $(awk -v u="$w" 'BEGIN{printf "%.1f", u/1000}')"
+  echo "FIGURE ${ROW}_tick_overruns $o"
 }
 
 # rbg NAME COMMAND...: like bg, but the output goes to the row's directory.
