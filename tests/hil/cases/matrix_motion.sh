@@ -39,7 +39,7 @@ push_row() {
 push_row motion_push_distance push_distance.toml 178
 push_row motion_push_angle push_angle.toml 179
 
-# Obstacle: a 12 cm disc appears 0.3 m ahead of the robot's centre (inside the forward check area, see
+# Obstacle: a 12 cm disc appears 0.4 m ahead of the robot's centre (inside the forward check area, see
 # tests/hil/scenarios/obstacle.toml) for 2 s. It is in the next scan (<= 100 ms) and stops the robot on the next
 # tick: limit 120 ms; no fault (obstacle_timeout 10 s); the robot moves again when it is gone.
 ROW_SCENARIO="$SC/obstacle.toml" row_start motion_obstacle
