@@ -10,8 +10,9 @@ candump log's stamps, chassis-sim's truth "wall" field and the case's inject log
       "status:C" is the first DockStatus frame with fault C, "last:FRAME:REF" / "first:FRAME:REF" the last FRAME frame
       before / the first at or after another reference, "frame:FRAME" the first FRAME frame of the log.
         fault time  t_f = EVENT's time.
-        reaction    first WheelCmdA with zero speeds (or enable 0) at or after t_f; reaction_ms = that - t_f,
-                    must be <= L (when L is given).
+        reaction    the WheelCmdA with zero speeds (or enable 0) that starts the lasting stop: the run of zero frames
+                    that reaches the clear / hold end (the first zero at all is reported as first_zero_ms; with
+                    --hold-by-status the first zero counts); reaction_ms = that - t_f, must be <= L (when given).
         moving      the last WheelCmdA before t_f was non-zero (else the reaction says nothing) unless --no-moving-check.
         fault code  a DockStatus frame with fault C at or after t_f (status_ms = its delay; <= --status-limit-ms).
         hold        no non-zero WheelCmdA from the reaction until --clear EVENT (the fault clears) or --hold-end
@@ -203,10 +204,29 @@ def judge_row(argv):
     if not a.no_moving_check:
         check("moving_at_fault", bool(before) and nonzero(before[-1]),
               "the last wheel command before the fault was zero: nothing to stop")
-    zero = next((e for e in wheels if e["wall"] >= t_f and not nonzero(e)), None)
+    first_zero = next((e for e in wheels if e["wall"] >= t_f and not nonzero(e)), None)
+    t_c0 = r.event(a.clear) if a.clear else None
+    t_end0 = t_c0 if t_c0 is not None else (r.event(a.hold_end) if a.hold_end else float("inf"))
+    if a.hold_by_status:
+        zero = first_zero
+    else:
+        # The reaction is the stop that lasts: the start of the run of zero frames that reaches the end of the hold
+        # (a loaded VM adds short watchdog holds before it; they are not the reaction to this fault).
+        zero = None
+        for e in wheels:
+            if e["wall"] < t_f:
+                continue
+            if e["wall"] >= t_end0:
+                break
+            if nonzero(e):
+                zero = None
+            elif zero is None:
+                zero = e
+    if first_zero is not None:
+        figure("first_zero_ms", f"{(first_zero['wall'] - t_f) * 1000:.1f}")
     t_z = zero["wall"] if zero else None
     if t_z is None:
-        check("reaction", False, "no zero wheel command after the fault")
+        check("reaction", False, "no lasting stop after the fault (non-zero wheel commands until the fault cleared)")
         figure("reaction_ms", "none")
     else:
         ms = (t_z - t_f) * 1000

@@ -76,7 +76,7 @@ kill -0 "$PID_candump" 2>/dev/null || {
 wait_for 15 dockd_logged resume
 sleep 1
 row_stop
-judge --log record/can.log --fault can_up --code 184 --clear can_up --recover resume --no-moving-check
+judge --log record/can.log --fault can_up --code 184 --clear can_up --recover resume --no-moving-check --hold-by-status
 post post_can_down_up
 
 # Another node floods the bus with higher-priority frames (id 0x010 < every dockcore id) for 4 s mid-approach, at
