@@ -4,13 +4,16 @@
 // 3 a device could not be opened at start (CAN interface, lidar options, UDP ports).
 #include <sys/epoll.h>
 #include <sys/signalfd.h>
+#include <sys/socket.h>
 #include <sys/timerfd.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <csignal>
+#include <cstddef>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -20,6 +23,9 @@
 
 #ifdef DOCKD_HAVE_SYSTEMD
 #include <systemd/sd-daemon.h>
+#else
+#include <sys/un.h>
+#include <unistd.h>
 #endif
 
 #include "config.hpp"
@@ -111,11 +117,42 @@ class NoChassisBus final : public dockcore::hal::CanBus {
   dockcore::hal::CanBusCounters c_{};
 };
 
+#ifndef DOCKD_HAVE_SYSTEMD
+// Without libsystemd (e.g. a cross build whose sysroot lacks it) dockd still speaks the notify protocol itself, so
+// the Type=notify unit works on every target: one datagram to $NOTIFY_SOCKET (a path, or '@' for the abstract
+// namespace), as sd_notify(3) documents.
+void sd_notify_fallback(const char* what) {
+  const char* path = std::getenv("NOTIFY_SOCKET");
+  if (path == nullptr || (path[0] != '/' && path[0] != '@') || std::strlen(path) >= sizeof(sockaddr_un::sun_path)) return;
+  const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return;
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  const std::size_t n = std::strlen(path);
+  std::memcpy(addr.sun_path, path, n);
+  if (addr.sun_path[0] == '@') addr.sun_path[0] = '\0';
+  const socklen_t len = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + n);
+  if (::sendto(fd, what, std::strlen(what), MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&addr), len) < 0) {
+    std::fprintf(stderr, "dockd: sd_notify to %s: %s\n", path, std::strerror(errno));
+  }
+  ::close(fd);
+}
+
+// sd_watchdog_enabled(3) without libsystemd: WATCHDOG_USEC, and WATCHDOG_PID when set must be this process.
+std::uint64_t watchdog_usec_from_env() {
+  const char* usec = std::getenv("WATCHDOG_USEC");
+  if (usec == nullptr) return 0;
+  const char* pid = std::getenv("WATCHDOG_PID");
+  if (pid != nullptr && std::strtol(pid, nullptr, 10) != static_cast<long>(::getpid())) return 0;
+  return std::strtoull(usec, nullptr, 10);
+}
+#endif
+
 void notify(const char* what) {
 #ifdef DOCKD_HAVE_SYSTEMD
   sd_notify(0, what);
 #else
-  (void)what;
+  sd_notify_fallback(what);
 #endif
 }
 
@@ -307,6 +344,8 @@ int main(int argc, char** argv) {
   std::uint64_t watchdog_usec = 0;
 #ifdef DOCKD_HAVE_SYSTEMD
   if (sd_watchdog_enabled(0, &watchdog_usec) <= 0) watchdog_usec = 0;
+#else
+  watchdog_usec = watchdog_usec_from_env();
 #endif
   const std::uint64_t watchdog_every = watchdog_usec / cfg.systemd_watchdog_divider;
   std::uint64_t next_watchdog = mono_us();
