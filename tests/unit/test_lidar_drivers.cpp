@@ -5,10 +5,14 @@
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <pty.h>
+#include <asm/ioctls.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <termios.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -25,6 +29,14 @@ using namespace dockcore;
 using namespace dockcore::drivers;
 
 namespace {
+
+// The kernel's termios2 (asm/termbits.h clashes with <termios.h>), only to probe whether TCGETS2 exists here.
+struct termios2 {
+  tcflag_t c_iflag, c_oflag, c_cflag, c_lflag;
+  cc_t c_line;
+  cc_t c_cc[19];
+  speed_t c_ispeed, c_ospeed;
+};
 
 struct Pty {
   int master = -1, slave = -1;
@@ -141,6 +153,16 @@ TEST(LidarDrivers, SerialRplidarSendsStopAndScanAfterOpen) {
   o.protocol = LidarProtocol::kRplidar;
   o.device = kLink;
   o.baud = 256000;  // no B constant: termios2 / BOTHER path
+  {
+    // qemu-user (the armhf stage of tools/test) does not translate the TCGETS2/TCSETS2 ioctls; a real ARM kernel
+    // does. Where the platform lacks them the driver rightly refuses 256000, so the request path is tested at a
+    // standard rate there, and the BOTHER path on the platforms that have it (x86-64 natively, aarch64).
+    termios2 t2{};
+    if (::ioctl(pty.slave, TCGETS2, &t2) != 0) {
+      std::printf("\n  (TCGETS2 unsupported here (%s): testing the RPLIDAR requests at 115200)\n", std::strerror(errno));
+      o.baud = 115200;
+    }
+  }
   std::string err;
   auto d = make_lidar_driver(o, err);
   CHECK(d != nullptr);
