@@ -9,6 +9,8 @@
 
 #include "state_file.hpp"
 
+#include "real_tolerance.hpp"
+
 #include "CppUTest/TestHarness.h"
 
 namespace {
@@ -48,7 +50,7 @@ TEST(DockdState, RoundTripsAndKeepsTheLastGoodCopy) {
   CHECK_TRUE(dockd::save_state(path, one(1, 0.225), err));
   CHECK_TRUE(dockd::save_state(path, one(1, 0.230), err));
   CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kOk), static_cast<int>(dockd::load_state(path, out, msg)));
-  DOUBLES_EQUAL(0.230, static_cast<double>(out.find(1)->target.x_m), 1e-9);
+  REAL_EQUAL(0.230, static_cast<double>(out.find(1)->target.x_m), 1e-9);
   // Flip one digit: the checksum catches it, the file is moved aside and the backup (the previous save) is used.
   std::string text = read_all(path);
   const std::size_t pos = text.find("0.23");
@@ -56,7 +58,7 @@ TEST(DockdState, RoundTripsAndKeepsTheLastGoodCopy) {
   write_all(path, text);
   CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kRecoveredBackup), static_cast<int>(dockd::load_state(path, out, msg)));
   STRCMP_CONTAINS("checksum mismatch", msg.c_str());
-  DOUBLES_EQUAL(0.225, static_cast<double>(out.find(1)->target.x_m), 1e-9);
+  REAL_EQUAL(0.225, static_cast<double>(out.find(1)->target.x_m), 1e-9);
   CHECK_FALSE(read_all(path + ".corrupt").empty());
 }
 
