@@ -1,5 +1,6 @@
 #include "daemon.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -213,7 +214,7 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
   active_dock_ = dock_id;
   active_raw_ = raw_profile;
   // configure() forgets the scan: hand the latest one back so the next tick does not see a lidar without data.
-  if (have_scan_) {
+  if (have_scan_ && !last_scan_late_) {
     const std::uint64_t stamp = scan_->stamp_us != 0 ? scan_->stamp_us : last_scan_rx_us_;
     core_->on_scan(scan_->view(), stamp, odom_at(stamp));
   }
@@ -325,9 +326,21 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
   // Only the newest scan matters (poll_scan keeps the newest); bounded to a few per call.
   for (int i = 0; i < 4 && io_.lidar->poll_scan(*scan_); ++i) {
     ++counters_.scans;
+    const std::uint64_t stamp = scan_->stamp_us != 0 && scan_->stamp_us <= now_us ? scan_->stamp_us : now_us;
+    if (prev_scan_stamp_us_ != 0 && stamp > prev_scan_stamp_us_ && stamp - prev_scan_stamp_us_ <= 500000u)
+      scan_period_us_ = stamp - prev_scan_stamp_us_;
+    prev_scan_stamp_us_ = stamp;
+    const std::uint64_t turn_end_us = std::min(now_us, stamp + scan_period_us_);
+    if (now_us - turn_end_us > static_cast<std::uint64_t>(cfg_.lidar_stale_ms) * 1000u) {
+      // Measured longer ago than the watchdog allows (a backlog drained late): steering by it would be as wrong
+      // as by no scan, so it is counted and left to the watchdog, which holds and, if it lasts, faults and resumes.
+      ++counters_.late_scans;
+      last_scan_late_ = true;
+      continue;
+    }
     have_scan_ = true;
-    last_scan_rx_us_ = now_us;
-    const std::uint64_t stamp = scan_->stamp_us != 0 ? scan_->stamp_us : now_us;
+    last_scan_late_ = false;
+    if (turn_end_us > last_scan_rx_us_) last_scan_rx_us_ = turn_end_us;
     const dockcore::DockEstimate& e = core_->on_scan(scan_->view(), stamp, odom_at(stamp));
     if (e.found) {
       ++counters_.detections;
@@ -844,7 +857,8 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       "\"lidar_stale\":%s,\"chassis_stale\":%s,\"odom_x_m\":%.4f,\"odom_y_m\":%.4f,\"odom_yaw_deg\":%.2f,"
       "\"cmd_vx_mps\":%.3f,\"cmd_wz_radps\":%.3f,\"teaching\":%s,\"taught\":%s,\"ticks\":%llu,"
       "\"tick_worst_us\":%llu,\"tick_overruns\":%llu,\"tick_work_worst_us\":%llu,\"scans\":%u,\"detections\":%u,"
-      "\"lidar_crc_errors\":%u,\"lidar_resyncs\":%u,\"lidar_reconnects\":%u,\"can_bad_frames\":%u,"
+      "\"lidar_crc_errors\":%u,\"lidar_resyncs\":%u,\"lidar_reconnects\":%u,\"lidar_late_scans\":%u,"
+      "\"can_bad_frames\":%u,"
       "\"can_send_failures\":%u,\"commands\":%u,\"commands_rejected\":%u,\"resumes\":%u,\"can_host_rejected\":%u,"
       "\"udp_not_allowed\":%u,\"config_reloads\":%u,\"config_reloads_rejected\":%u,\"config_reload_pending\":%s}",
       static_cast<unsigned long long>(now_us), dockcore::to_string(s.state), static_cast<unsigned>(s.state), s.phase,
@@ -860,7 +874,8 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       teach_.active ? "true" : "false", state_.find(s.dock_id) != nullptr ? "true" : "false",
       static_cast<unsigned long long>(stats_.ticks), static_cast<unsigned long long>(stats_.worst_period_us),
       static_cast<unsigned long long>(stats_.overruns), static_cast<unsigned long long>(stats_.worst_work_us),
-      counters_.scans, counters_.detections, lc.crc_errors, lc.resyncs, lc.reconnects, cc.bad_frames,
+      counters_.scans, counters_.detections, lc.crc_errors, lc.resyncs, lc.reconnects,
+      counters_.late_scans, cc.bad_frames,
       cc.send_failures, counters_.commands, counters_.commands_rejected, counters_.resumes,
       io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u,
       io_.udp_host != nullptr ? io_.udp_host->counters().not_allowed : 0u, counters_.config_reloads,

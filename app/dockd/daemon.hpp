@@ -64,6 +64,7 @@ struct DaemonCounters {
   std::uint32_t commands_rejected = 0; ///< By the task manager or dockd (unknown dock id, queue full).
   std::uint32_t queue_overflows = 0;
   std::uint32_t scans = 0;
+  std::uint32_t late_scans = 0;  ///< Scans whose turn had ended more than lidar_stale_ms before dockd parsed them.
   std::uint32_t detections = 0;
   std::uint32_t lidar_stale_trips = 0;
   std::uint32_t chassis_stale_trips = 0;
@@ -212,7 +213,12 @@ class Daemon {
 
   // Lidar and camera.
   bool have_scan_ = false;
+  /// When the newest scan's turn ended (its stamp plus one turn), clamped to its receive time: what the stale-lidar
+  /// watchdog measures from. Parse time would let a backlog of old bytes pass for a live sensor.
   std::uint64_t last_scan_rx_us_ = 0;
+  std::uint64_t prev_scan_stamp_us_ = 0;
+  bool last_scan_late_ = false;       ///< scan_ holds a late scan (not given to the core).
+  std::uint64_t scan_period_us_ = 0;  ///< Spacing of the last two scan stamps, if plausible (≤ 0.5 s); 0 = unknown.
   dockcore::CameraTarget camera_{};
 
   // Commands.

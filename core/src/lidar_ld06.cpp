@@ -90,7 +90,8 @@ bool Ld06Parser::configure(const Ld06Config& cfg) {
   if (!out_.configure(cfg.bins_per_turn, cfg.angle_min_rad)) return false;
   cfg_ = cfg;
   len_ = 0;
-  synced_ = have_prev_ = turn_open_ = turn_from_wrap_ = false;
+  synced_ = have_prev_ = turn_open_ = turn_from_wrap_ = clock_valid_ = clock_frozen_ = false;
+  still_steps_ = 0;
   return true;
 }
 
@@ -99,7 +100,64 @@ void Ld06Parser::reset() {
   len_ = 0;
   synced_ = false;
   if (turn_open_) counters_.samples_discarded += out_.building().samples();
-  have_prev_ = turn_open_ = turn_from_wrap_ = false;
+  have_prev_ = turn_open_ = turn_from_wrap_ = clock_valid_ = clock_frozen_ = false;  // the sensor may have restarted
+  still_steps_ = 0;
+}
+
+std::uint64_t Ld06Parser::map_sensor_clock(std::uint16_t ts_ms, std::uint64_t arrival_us) {
+  if (!cfg_.sensor_clock || clock_frozen_) return arrival_us;
+  const std::uint32_t ts = ts_ms % kLd06TimestampWrapMs;
+  // Packets are 2-3 ms apart, so the ms timestamp steps on (nearly) every one; a sensor (or clone) whose stamp does
+  // not move would pin every turn to the first one's time and look stale forever: fall back to arrival stamps.
+  if (clock_valid_ && ts == prev_ts_ms_) {
+    if (++still_steps_ >= kFrozenClockPackets) {
+      clock_frozen_ = true;
+      ++counters_.clock_resyncs;
+      return arrival_us;
+    }
+  } else {
+    still_steps_ = 0;
+  }
+  if (clock_valid_) {
+    // Unwrap: the step is taken forward modulo the wrap, so a timestamp going back reads as a ~30 s step.
+    const std::uint32_t step_ms = (ts + kLd06TimestampWrapMs - prev_ts_ms_) % kLd06TimestampWrapMs;
+    if (step_ms > cfg_.sensor_clock_max_step_ms) {
+      clock_valid_ = false;
+      ++counters_.clock_resyncs;
+    } else {
+      const std::uint64_t step_us = static_cast<std::uint64_t>(step_ms) * 1000u;
+      sensor_us_ += step_us;
+      const std::int64_t off = static_cast<std::int64_t>(arrival_us) - static_cast<std::int64_t>(sensor_us_);
+      const auto creep = static_cast<std::int64_t>(step_us * cfg_.sensor_clock_drift_ppm / 1000000u);
+      offset_us_ = off < offset_us_ + creep ? off : offset_us_ + creep;
+    }
+  }
+  prev_ts_ms_ = static_cast<std::uint16_t>(ts);
+  if (!clock_valid_) {
+    clock_valid_ = true;
+    lagging_ = false;
+    sensor_us_ = arrival_us;
+    offset_us_ = 0;
+  }
+  const std::int64_t host_signed = static_cast<std::int64_t>(sensor_us_) + offset_us_;
+  const std::uint64_t host = host_signed > 0 ? static_cast<std::uint64_t>(host_signed) : 0;
+  // A backlog drains: its lag is transient. A lag that persists for sensor_clock_relock_ms of host time means the
+  // sensor clock paused or slowed (a restarted or stalled sensor that kept its count): restart from arrival.
+  if (arrival_us > host + static_cast<std::uint64_t>(cfg_.sensor_clock_lag_ms) * 1000u) {
+    if (!lagging_) {
+      lagging_ = true;
+      lag_since_us_ = arrival_us;
+    } else if (arrival_us - lag_since_us_ > static_cast<std::uint64_t>(cfg_.sensor_clock_relock_ms) * 1000u) {
+      lagging_ = false;
+      sensor_us_ = arrival_us;
+      offset_us_ = 0;
+      ++counters_.clock_resyncs;
+      return arrival_us;
+    }
+  } else {
+    lagging_ = false;
+  }
+  return host;
 }
 
 void Ld06Parser::drop_first() {
@@ -195,6 +253,7 @@ void Ld06Parser::on_data_packet(const Ld06Packet& p, std::uint64_t stamp_us) {
   }
   ++counters_.packets;
   last_ = p;
+  stamp_us = map_sensor_clock(p.timestamp_ms, stamp_us);
   const Real period_us = static_cast<Real>(1e6) / cfg_.point_rate_hz;
   for (std::size_t i = 0; i < kLd06PointsPerPacket; ++i) {
     const Real deg = ld06_point_angle_cdeg(p.start_cdeg, p.end_cdeg, i) / static_cast<Real>(100);
@@ -269,7 +328,11 @@ std::size_t Ld06StreamEncoder::encode_scan(const ScanView& scan, std::uint16_t t
     p.speed_dps = speed_dps_;
     p.start_cdeg = pend_angle_[0];
     p.end_cdeg = pend_angle_[kLd06PointsPerPacket - 1];
-    p.timestamp_ms = static_cast<std::uint16_t>(timestamp_ms % 30000u);
+    // The packet leaves when its last point (j) was measured: j + 1 point periods after the scan's first point.
+    const std::uint64_t after_ms = speed_dps_ > 0 ? (static_cast<std::uint64_t>(j) + 1u) * 360000u /
+                                                        (static_cast<std::uint64_t>(speed_dps_) * m)
+                                                  : 0;
+    p.timestamp_ms = static_cast<std::uint16_t>((timestamp_ms + after_ms) % kLd06TimestampWrapMs);
     for (std::size_t i = 0; i < kLd06PointsPerPacket; ++i) {
       p.distance_mm[i] = pend_dist_[i];
       p.intensity[i] = pend_int_[i];

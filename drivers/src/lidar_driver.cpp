@@ -209,7 +209,11 @@ class SerialLidarDriver final : public LidarDriver {
       const ssize_t n = ::read(fd_, buf, sizeof buf);
       if (n > 0) {
         if (opt_.raw_tap) opt_.raw_tap(buf, static_cast<std::size_t>(n));
-        decoder_.feed_bytes(buf, static_cast<std::size_t>(n), monotonic_us(), byte_period_us_);
+        // The bytes still queued behind this chunk arrived after its last byte: stamp that byte as far back as
+        // they take on the wire, so a reader running late still stamps scans with (about) the sensor's time.
+        const std::uint64_t t = monotonic_us();
+        const std::uint64_t behind = static_cast<std::uint64_t>(queued_bytes()) * byte_period_us_;
+        decoder_.feed_bytes(buf, static_cast<std::size_t>(n), t > behind ? t - behind : 0, byte_period_us_);
         continue;
       }
       if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) break;
@@ -248,6 +252,14 @@ class SerialLidarDriver final : public LidarDriver {
   }
 
  private:
+  /// Bytes waiting in the tty's line-discipline buffer (at most 4 KiB: n_tty's; more may wait in the kernel's flip
+  /// buffers, which no ioctl reports); 0 when the driver cannot tell (stamps then fall back to the read time).
+  std::size_t queued_bytes() const {
+    int q = 0;
+    if (::ioctl(fd_, FIONREAD, &q) != 0 || q < 0) return 0;
+    return static_cast<std::size_t>(q);
+  }
+
   bool configure_tty(int fd) {
     termios t{};
     if (::tcgetattr(fd, &t) != 0) {

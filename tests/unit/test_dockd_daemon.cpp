@@ -134,6 +134,7 @@ struct Rig {
   docksim::Rng rng{7};
   std::unique_ptr<dockd::Daemon> daemon;
   bool lidar_blocked = false;
+  std::uint64_t scan_lag_us = 0;  ///< Scans are delivered this long after they were measured (a backlog).
   std::uint64_t next_scan_us = 0;
   std::string state_file;
   std::unique_ptr<dockcore::drivers::UdpHostLink> udp;
@@ -200,7 +201,7 @@ struct Rig {
       next_scan_us = clock.t + 100000;
       if (!lidar_blocked) {
         const dockcore::Pose2 lp = chassis->state().true_pose.compose(sc.lidar_mount);
-        docksim::simulate_scan(world, lp, sc.lidar, rng, lidar.scan.get(), clock.t);
+        docksim::simulate_scan(world, lp, sc.lidar, rng, lidar.scan.get(), clock.t - scan_lag_us);
         lidar.pending = true;
       }
     }
@@ -315,6 +316,30 @@ TEST(DockdDaemon, LidarStaleStopsWithinOneTickAndFaults) {
   CHECK_EQUAL(0u, r.daemon->counters().resumes);
   CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
   CHECK_TRUE(r.wheels_zero());
+}
+
+TEST(DockdDaemon, ScansDeliveredLateDoNotKeepTheLidarFresh) {
+  // A reader behind a backlog keeps parsing turns, but their stamps (sensor clock) are old: the stale watchdog must
+  // go by when the turn was measured, not when dockd parsed it.
+  Rig r("late");
+  r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kAlign && !r.wheels_zero(); }, 20.0));
+  const std::uint32_t scans_before = r.daemon->counters().scans;
+  r.scan_lag_us = 600000;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->lidar_stale(); }, 0.3));
+  CHECK_TRUE(r.wheels_zero());
+  r.run_until([] { return false; }, 0.5);
+  CHECK_TRUE(r.daemon->lidar_stale());
+  CHECK_TRUE(r.wheels_zero());
+  CHECK(r.daemon->counters().scans >= scans_before + 4);  // they kept coming...
+  CHECK(r.daemon->counters().late_scans >= 4);             // ...and were counted as late
+  // 0.8 s without a usable scan: the core's own scan-age backstop (lidar_stale_ms + 0.3 s) has faulted 185 while
+  // dockd's watchdog held; live scans again resume the docking.
+  CHECK_EQUAL(185, static_cast<int>(r.daemon->fault()));
+  r.scan_lag_us = 0;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
+  CHECK_EQUAL(1u, r.daemon->counters().resumes);
 }
 
 TEST(DockdDaemon, ShortLidarGapHoldsTheRobotAndTheDockingContinues) {

@@ -154,7 +154,11 @@ TEST(Ld06, StreamAssemblesTurnsAtTheWrap) {
 }
 
 TEST(Ld06, ScanStampIsFirstPointTime) {
-  auto p = make_parser();
+  // Arrival stamps (the test packets' timestamps are all 0); the sensor clock has its own tests below.
+  auto p = std::make_unique<Ld06Parser>();
+  Ld06Config cfg;
+  cfg.sensor_clock = false;
+  CHECK(p->configure(cfg));
   const auto s = stream(80);
   std::vector<std::size_t> starts;
   stream(80, &starts);
@@ -165,6 +169,112 @@ TEST(Ld06, ScanStampIsFirstPointTime) {
   const double period = 1e6 / 4500.0;
   const auto expect = static_cast<std::uint64_t>(1000 + starts[37] - static_cast<std::uint64_t>(6 * period));
   CHECK(scan.stamp_us + 1 >= expect && scan.stamp_us <= expect + 1);
+}
+
+namespace {
+
+// One packet per element: packet k covers sensor points 12k..12k+11 at 0.8 deg (450 points = 10 Hz at 4500 Hz),
+// carries sensor timestamp ts_ms[k] and arrives (its bytes) at arrival_us[k].
+void feed_timed(Ld06Parser& p, const std::vector<std::uint32_t>& ts_ms, const std::vector<std::uint64_t>& arrival_us) {
+  for (std::size_t k = 0; k < ts_ms.size(); ++k) {
+    Ld06Packet pk;
+    pk.speed_dps = 3600;
+    pk.start_cdeg = static_cast<std::uint16_t>((k * 12 * 80) % 36000);
+    pk.end_cdeg = static_cast<std::uint16_t>(((k * 12 + 11) * 80) % 36000);
+    pk.timestamp_ms = static_cast<std::uint16_t>(ts_ms[k] % kLd06TimestampWrapMs);
+    for (std::size_t i = 0; i < kLd06PointsPerPacket; ++i) pk.distance_mm[i] = 1000;
+    std::uint8_t b[kLd06PacketBytes];
+    ld06_encode_packet(pk, b);
+    p.feed(b, sizeof b, arrival_us[k]);
+  }
+}
+
+constexpr std::uint64_t kPacketUs = 2667;  // 12 points at 4500 Hz
+
+}  // namespace
+
+TEST(Ld06, SensorClockKeepsABackloggedTurnsOwnTime) {
+  // 150 packets = 4 turns. The first 50 arrive live (1 ms transport delay); the reader then stalls and the other
+  // 100 (turns 2-3, 267 ms of data) arrive at once, 1.5 s after the stall began.
+  auto p = make_parser();
+  std::vector<std::uint32_t> ts;
+  std::vector<std::uint64_t> at;
+  const std::uint64_t t0 = 10'000'000;
+  for (std::size_t k = 0; k < 150; ++k) {
+    ts.push_back(static_cast<std::uint32_t>(5000 + k * kPacketUs / 1000));
+    at.push_back(k < 50 ? t0 + k * kPacketUs + 1000 : t0 + 50 * kPacketUs + 1'500'000);
+  }
+  feed_timed(*p, ts, at);
+  CHECK(p->sensor_clock_active());
+  LaserScan scan;
+  CHECK(p->take_scan(scan));
+  // The newest complete turn starts at point 900 = packet 75: measured ~t0 + 75 packets, not at the late arrival.
+  // (ms timestamps: up to 1 ms off; the first point is 12 point periods before its packet's time.)
+  const std::uint64_t expect = t0 + 75 * kPacketUs + 1000 - 12 * 222;
+  CHECK_TEXT(scan.stamp_us + 2000 >= expect && scan.stamp_us <= expect + 2000,
+             ("stamp " + std::to_string(scan.stamp_us) + " expected ~" + std::to_string(expect)).c_str());
+  CHECK_EQUAL(0u, p->counters().clock_resyncs);
+
+  // With the sensor clock off the same bytes would pass for fresh: the turn is stamped at the late arrival.
+  auto q = std::make_unique<Ld06Parser>();
+  Ld06Config cfg;
+  cfg.sensor_clock = false;
+  CHECK(q->configure(cfg));
+  feed_timed(*q, ts, at);
+  CHECK(q->take_scan(scan));
+  CHECK(scan.stamp_us > t0 + 1'400'000);
+}
+
+TEST(Ld06, SensorClockUnwrapsAt30000) {
+  auto p = make_parser();
+  std::vector<std::uint32_t> ts;
+  std::vector<std::uint64_t> at;
+  for (std::size_t k = 0; k < 120; ++k) {
+    ts.push_back(static_cast<std::uint32_t>(29900 + k * kPacketUs / 1000));  // wraps after ~37 packets
+    at.push_back(1'000'000 + k * kPacketUs);
+  }
+  feed_timed(*p, ts, at);
+  LaserScan scan;
+  CHECK(p->take_scan(scan));
+  const std::uint64_t expect = 1'000'000 + 75 * kPacketUs - 12 * 222;
+  CHECK(scan.stamp_us + 2000 >= expect && scan.stamp_us <= expect + 2000);
+  CHECK_EQUAL(0u, p->counters().clock_resyncs);
+  CHECK(p->sensor_clock_active());
+}
+
+TEST(Ld06, FrozenSensorClockFallsBackToArrival) {
+  auto p = make_parser();
+  std::vector<std::uint32_t> ts(120, 777);
+  std::vector<std::uint64_t> at;
+  for (std::size_t k = 0; k < 120; ++k) at.push_back(2'000'000 + k * kPacketUs);
+  feed_timed(*p, ts, at);
+  CHECK_FALSE(p->sensor_clock_active());
+  CHECK_EQUAL(1u, p->counters().clock_resyncs);
+  LaserScan scan;
+  CHECK(p->take_scan(scan));
+  const std::uint64_t expect = 2'000'000 + 75 * kPacketUs - 12 * 222;
+  CHECK(scan.stamp_us + 500 >= expect && scan.stamp_us <= expect + 500);
+}
+
+TEST(Ld06, PausedSensorClockRelocksAfterALastingLag) {
+  // Live packets, then the sensor's count pauses for 1.5 s while its data keeps arriving late by that much: a backlog
+  // would drain, this lag stays. After sensor_clock_relock_ms (1 s) of it the mapping restarts from arrival.
+  auto p = make_parser();
+  std::vector<std::uint32_t> ts;
+  std::vector<std::uint64_t> at;
+  for (std::size_t k = 0; k < 1000; ++k) {
+    ts.push_back(static_cast<std::uint32_t>(k * kPacketUs / 1000));
+    at.push_back(3'000'000 + k * kPacketUs + (k >= 100 ? 1'500'000 : 0));
+  }
+  feed_timed(*p, ts, at);
+  CHECK_EQUAL(1u, p->counters().clock_resyncs);
+  CHECK(p->sensor_clock_active());
+  LaserScan scan;
+  CHECK(p->take_scan(scan));
+  // The newest complete turn (points 11250.. = packet 937, point 6) is stamped from its arrival again.
+  const std::uint64_t expect = 3'000'000 + 1'500'000 + 937 * kPacketUs - 6 * 222;
+  CHECK_TEXT(scan.stamp_us + 3000 >= expect && scan.stamp_us <= expect + 3000,
+             ("stamp " + std::to_string(scan.stamp_us) + " expected ~" + std::to_string(expect)).c_str());
 }
 
 TEST(Ld06, PacketStraddlingZeroIsSplitExactly) {

@@ -27,7 +27,7 @@ nlohmann::json counters_json(const dockcore::LidarParserCounters& c, std::uint32
                         {"health_packets", c.health_packets}, {"info_packets", c.info_packets},
                         {"descriptors", c.descriptors}, {"bad_packets", c.bad_packets}, {"samples", c.samples},
                         {"samples_discarded", c.samples_discarded}, {"bin_collisions", c.bin_collisions},
-                        {"scans_overwritten", c.scans_overwritten}};
+                        {"scans_overwritten", c.scans_overwritten}, {"clock_resyncs", c.clock_resyncs}};
 }
 
 struct Printer {
@@ -194,11 +194,11 @@ int main(int argc, char** argv) {
   std::fprintf(stderr,
                "counters: scans=%u crc_errors=%u resyncs=%u dropped_bytes=%u reconnects=%u packets=%u bad_span=%u "
                "health=%u info=%u descriptors=%u bad_packets=%u samples_discarded=%u bin_collisions=%u "
-               "scans_overwritten=%u\n",
+               "scans_overwritten=%u clock_resyncs=%u\n",
                counters.scans, counters.crc_errors, counters.resyncs, counters.dropped_bytes, reconnects,
                counters.packets, counters.bad_span, counters.health_packets, counters.info_packets,
                counters.descriptors, counters.bad_packets, counters.samples_discarded, counters.bin_collisions,
-               counters.scans_overwritten);
+               counters.scans_overwritten, counters.clock_resyncs);
   if (!json_counters.empty()) {
     const std::string j = counters_json(counters, reconnects).dump();
     if (json_counters == "-") {

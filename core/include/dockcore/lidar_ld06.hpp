@@ -20,6 +20,7 @@ constexpr std::size_t kLd06PacketBytes = 47;
 constexpr std::size_t kLd06HealthBytes = 4;
 constexpr std::size_t kLd06InfoBytes = 23;
 constexpr std::size_t kLd06PointsPerPacket = 12;
+constexpr std::uint32_t kLd06TimestampWrapMs = 30000;  ///< The packet timestamp counts ms modulo this.
 
 /// CRC8 of the LD06 protocol: polynomial 0x4D, init 0, no reflection, no final xor ("123456789" -> 0xC3).
 /// O(n): one lookup per byte in a 256-byte table generated at compile time.
@@ -54,6 +55,20 @@ struct Ld06Config {
   /// The first turn after configure()/reset() started mid-turn unless its first point is within this many degrees
   /// after 0; such a partial turn is discarded (samples_discarded) instead of published.
   Real first_turn_max_start_deg = 10;
+  /// Stamp packets from the sensor's own clock (the packet timestamp, ms) mapped to host time, instead of their
+  /// arrival: host = sensor + the smallest (arrival - sensor) seen. A packet that waited in a buffer behind a
+  /// reader running late then keeps the time it was measured, so an old turn is not taken for a fresh one.
+  bool sensor_clock = true;
+  /// How fast the smallest offset may creep up (host clock running faster than the sensor's), ppm of sensor time.
+  std::uint32_t sensor_clock_drift_ppm = 1000;
+  /// A step in the sensor time larger than this (a stall, a restarted sensor, a timestamp going back) restarts the
+  /// mapping from that packet's arrival.
+  std::uint32_t sensor_clock_max_step_ms = 1000;
+  /// Packets later than their mapped time by more than sensor_clock_lag_ms, continuously for sensor_clock_relock_ms
+  /// of host time, restart the mapping too: a backlog drains within that time, a paused sensor clock does not.
+  std::uint32_t sensor_clock_lag_ms = 100;
+  std::uint32_t sensor_clock_relock_ms = 1000;
+  // A timestamp that stays put for 8 packets in a row marks the clock unusable (arrival stamps until reset()).
 };
 
 /// Byte-at-a-time LD06 parser. Framing: a candidate starts at 0x54 followed by a known kind; when the packet's CRC
@@ -76,7 +91,8 @@ class Ld06Parser {
   /// Feeds n bytes that all arrived at stamp_us; returns the number of scans completed. O(n).
   std::size_t feed(const std::uint8_t* data, std::size_t n, std::uint64_t stamp_us);
   /// Copies the newest complete scan into out; false (out untouched) if none is waiting. Scan stamp = host time of
-  /// the turn's first point: arrival of the first byte of its packet minus (12 - i) point periods. O(bins).
+  /// the turn's first point: its packet's time (sensor clock mapped to host time, or the arrival of its first byte
+  /// when sensor_clock is off) minus (12 - i) point periods. O(bins).
   bool take_scan(LaserScan& out) { return out_.take(out); }
   bool scan_ready() const { return out_.ready(); }
   const LidarParserCounters& counters() const { return counters_; }
@@ -84,6 +100,8 @@ class Ld06Parser {
   const Ld06Packet& last_packet() const { return last_; }  ///< Last accepted measurement packet.
   std::uint8_t last_health_error() const { return health_error_; }  ///< Error byte of the last health packet.
   const Ld06Config& config() const { return cfg_; }
+  /// True while scans are stamped from the sensor clock (configured, synced and not found frozen).
+  bool sensor_clock_active() const { return cfg_.sensor_clock && clock_valid_ && !clock_frozen_; }
 
  private:
   void process();
@@ -92,6 +110,8 @@ class Ld06Parser {
   void on_data_packet(const Ld06Packet& p, std::uint64_t stamp_us);
   void add_point(Real sensor_deg, Real range_m, Real intensity, std::uint64_t stamp_us);
   void end_turn();
+  /// Host time of a packet stamped ts_ms by the sensor that arrived at arrival_us (config sensor_clock).
+  std::uint64_t map_sensor_clock(std::uint16_t ts_ms, std::uint64_t arrival_us);
 
   Ld06Config cfg_{};
   LidarScanOutput out_{};
@@ -107,6 +127,15 @@ class Ld06Parser {
   bool turn_from_wrap_ = false;  ///< It began at a wrap (complete), not mid-turn after start.
   Real turn_first_deg_ = 0;
   std::uint8_t health_error_ = 0;
+  static constexpr std::uint32_t kFrozenClockPackets = 8;  ///< Packets in a row with one timestamp: clock unusable.
+  bool clock_valid_ = false;     ///< sensor_us_/offset_us_ describe the running sensor clock.
+  bool clock_frozen_ = false;    ///< The sensor's timestamp does not advance: arrival stamps until reset().
+  std::uint32_t still_steps_ = 0;
+  bool lagging_ = false;          ///< The last packets arrived over sensor_clock_lag_ms after their mapped time...
+  std::uint64_t lag_since_us_ = 0;  ///< ...since this arrival.
+  std::uint16_t prev_ts_ms_ = 0;
+  std::uint64_t sensor_us_ = 0;  ///< Unwrapped sensor time of the last packet, in host microseconds at sync.
+  std::int64_t offset_us_ = 0;   ///< Smallest arrival - sensor time seen (with drift allowance).
 };
 
 /// Turns scans into a continuous LD06 packet stream, the way the sensor sends it: points are taken clockwise from
@@ -119,7 +148,8 @@ class Ld06StreamEncoder {
   /// convention: the lidar's (LD06 default). speed_dps is written into every packet.
   void configure(const LidarAngleConvention& convention, std::uint16_t speed_dps);
   /// Encodes one scan; writes whole packets into out (capacity cap bytes, a multiple of 47 is used). Returns the
-  /// bytes written; points that did not fit are counted in points_lost(). timestamp_ms: sensor time of the scan.
+  /// bytes written; points that did not fit are counted in points_lost(). timestamp_ms: sensor time of the scan's
+  /// first point; each packet carries the time of its last point, as the sensor's do (at speed_dps, M points/turn).
   std::size_t encode_scan(const ScanView& scan, std::uint16_t timestamp_ms, std::uint8_t* out, std::size_t cap);
   std::uint32_t points_lost() const { return lost_; }
 

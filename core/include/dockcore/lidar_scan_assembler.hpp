@@ -34,6 +34,7 @@ struct LidarParserCounters {
   std::uint32_t bin_collisions = 0; ///< Samples that fell into an already filled grid bin (see LidarScanAssembler).
   std::uint32_t stray_start = 0;    ///< RPLIDAR: S=1 nodes ignored because the turn had not wrapped yet.
   std::uint32_t scans_overwritten = 0; ///< A ready scan was replaced by a newer one before take_scan() read it.
+  std::uint32_t clock_resyncs = 0;  ///< LD06: sensor-clock mapping restarted (step over the limit) or found frozen.
 };
 
 /// How a sensor's own angle maps to core's angle: core = zero_offset + sign * sensor, sign = -1 for clockwise

@@ -218,11 +218,12 @@ void LidarEmitter::service_requests() {
 bool LidarEmitter::emit_scan(const ScanView& scan) {
   service_requests();
   const bool rp_idle = opt_.protocol == EmuProtocol::kRplidar && !rplidar_scanning_;
+  // The sensor's clock runs on while it sends nothing (stall, unplugged): the next packets' timestamps show the gap.
+  ms_ += static_cast<std::uint64_t>(std::llround(1000.0 / opt_.rate_hz));
   if (stalled_ || !plugged() || rp_idle) {
     ++stats_.scans_suppressed;
     return false;
   }
-  ms_ += static_cast<std::uint64_t>(std::llround(1000.0 / opt_.rate_hz));
   std::vector<std::uint8_t>& b = impl_->bytes;
   switch (opt_.protocol) {
     case EmuProtocol::kLd06: {
