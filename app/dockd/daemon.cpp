@@ -841,6 +841,16 @@ void Daemon::publish_status(std::uint64_t now_us) {
   ++counters_.status_sent;
 }
 
+std::uint32_t Daemon::commands_rejected_total() const {
+  std::uint32_t n = counters_.commands_rejected;
+  if (io_.udp_host != nullptr) {
+    // Requests the UDP link refused before dockd saw them (it answered them itself): still host commands refused.
+    const auto& u = io_.udp_host->counters();
+    n += u.malformed + u.unknown_command + u.bad_field + u.too_long;
+  }
+  return n;
+}
+
 std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_us) const {
   const dockcore::TaskStatus& s = last_out_.status;
   const FaultCode watchdog_fault = chassis_stale_ ? FaultCode::kChassisStale
@@ -876,7 +886,7 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       static_cast<unsigned long long>(stats_.overruns), static_cast<unsigned long long>(stats_.worst_work_us),
       counters_.scans, counters_.detections, lc.crc_errors, lc.resyncs, lc.reconnects,
       counters_.late_scans, cc.bad_frames,
-      cc.send_failures, counters_.commands, counters_.commands_rejected, counters_.resumes,
+      cc.send_failures, counters_.commands, commands_rejected_total(), counters_.resumes,
       io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u,
       io_.udp_host != nullptr ? io_.udp_host->counters().not_allowed : 0u, counters_.config_reloads,
       counters_.config_reloads_rejected, pending_cfg_ != nullptr ? "true" : "false");

@@ -61,7 +61,9 @@ struct TickStats {
 /// Counters the daemon itself keeps (the drivers keep theirs).
 struct DaemonCounters {
   std::uint32_t commands = 0;          ///< Task commands handed to the task manager.
-  std::uint32_t commands_rejected = 0; ///< By the task manager or dockd (unknown dock id, queue full).
+  /// By the task manager or dockd (unknown dock id, queue full), from CAN or UDP; the status field adds the UDP
+  /// link's own refusals (commands_rejected_total()).
+  std::uint32_t commands_rejected = 0;
   std::uint32_t queue_overflows = 0;
   std::uint32_t scans = 0;
   std::uint32_t late_scans = 0;  ///< Scans whose turn had ended more than lidar_stale_ms before dockd parsed them.
@@ -137,6 +139,10 @@ class Daemon {
   std::uint16_t active_dock_id() const { return active_dock_; }
   /// Current status as one JSON object (no newline). Returns the length (0 when it does not fit). O(1).
   std::size_t status_json(char* buf, std::size_t size, std::uint64_t now_us) const;
+  /// Every host command refused, whatever refused it: dockd and the task manager (counters().commands_rejected)
+  /// plus the UDP link's parse refusals (malformed, unknown command, bad field, too long). The status field
+  /// `commands_rejected`. O(1).
+  std::uint32_t commands_rejected_total() const;
 
  private:
   struct PendingCommand {

@@ -342,6 +342,23 @@ TEST(DockdDaemon, ScansDeliveredLateDoNotKeepTheLidarFresh) {
   CHECK_EQUAL(1u, r.daemon->counters().resumes);
 }
 
+TEST(DockdDaemon, CanHostCommandsTheTaskManagerRejectsAreCounted) {
+  // Issue #6 matrix: an unknown command code and an unknown dock id over CAN are rejected by the task manager; the
+  // status counter commands_rejected must count them as it counts UDP refusals, and nothing else changes.
+  Rig r("canrej");
+  r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+  const std::uint32_t before = r.daemon->counters().commands_rejected;
+  r.host.command(9, 0);  // no such command
+  r.tick();
+  r.tick();
+  r.host.command(1, 9);  // dock 9 is not in the database
+  r.tick();
+  r.tick();
+  CHECK_EQUAL(before + 2, r.daemon->counters().commands_rejected);
+  CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
+  CHECK_TRUE(r.wheels_zero());
+}
+
 TEST(DockdDaemon, ShortLidarGapHoldsTheRobotAndTheDockingContinues) {
   Rig r("gap");
   r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
@@ -402,6 +419,12 @@ TEST(DockdDaemon, UdpFloodStaysConsistentAndUnknownDockIsRejected) {
   CHECK_TRUE(r.wheels_zero());
   CHECK(r.udp->counters().malformed >= 400);
   CHECK(r.daemon->counters().commands > 100);
+  // The status counts every refusal: dockd's and the task manager's plus the link's malformed requests.
+  CHECK(r.daemon->commands_rejected_total() >= r.daemon->counters().commands_rejected + 500);
+  char st[dockcore::drivers::kMaxHostReply];
+  const std::size_t len = r.daemon->status_json(st, sizeof st, 0);
+  CHECK(len > 0);
+  STRCMP_CONTAINS(("\"commands_rejected\":" + std::to_string(r.daemon->commands_rejected_total()) + ",").c_str(), st);
   ::close(s);
 }
 
