@@ -208,8 +208,14 @@ def judge_row(argv):
     wheels = r.wheels()
     before = [e for e in wheels if e["wall"] < t_f]
     if not a.no_moving_check:
+        # A watchdog hold caused by dockd's own loop stalling just before the fault (the VM starved) can leave the
+        # robot standing at the fault time: that row cannot show a reaction, reported as STARVED.
+        recent = [e["wall"] for e in before if e["wall"] >= t_f - 0.5]
+        pre_stall = max((b - a_) for a_, b in zip(recent, recent[1:])) * 1000 if len(recent) > 1 else 0.0
         check("moving_at_fault", bool(before) and nonzero(before[-1]),
-              "the last wheel command before the fault was zero: nothing to stop")
+              "the last wheel command before the fault was zero: nothing to stop" +
+              (f"; dockd's wheel frames stalled {pre_stall:.0f} ms in the 0.5 s before: VM starvation"
+               if pre_stall > 100 else ""), starved=pre_stall > 100)
     first_zero = next((e for e in wheels if e["wall"] >= t_f and not nonzero(e)), None)
     t_c0 = r.event(a.clear) if a.clear else None
     t_end0 = t_c0 if t_c0 is not None else (r.event(a.hold_end) if a.hold_end else float("inf"))
@@ -450,6 +456,28 @@ def main(argv):
             if c and (not seq or seq[-1] != c):
                 seq.append(c)
         print(" ".join(map(str, seq)))
+        return 0
+    if cmd == "faults-split":
+        # "UNEXCUSED;EXCUSED": fault codes of the status frames, split by cause. A watchdog fault (184/185) whose onset
+        # follows a stall of dockd's own 20 ms wheel frames longer than the watchdog limit (200 ms) within the 1.5 s
+        # before it (stale limit + fault_after) is the watchdog reacting, correctly, to dockd itself not running
+        # (the TCG VM starved): excused, listed with the stall. Anything else is unexcused.
+        r = Row(argv[2])
+        wheels = [e["wall"] for e in r.wheels()]
+        unexcused, excused = [], []
+        prev = 0
+        for e in r.status():
+            c = int(e["signals"]["fault"])
+            if c and c != prev:
+                t = e["wall"]
+                ts = [w for w in wheels if t - 1.5 <= w <= t]
+                stall = max((b - a) for a, b in zip(ts, ts[1:])) * 1000 if len(ts) > 1 else 0.0
+                if c in (184, 185) and stall > 200:
+                    excused.append(f"{c}(stall {stall:.0f} ms)")
+                else:
+                    unexcused.append(str(c))
+            prev = c
+        print(" ".join(unexcused) + ";" + " ".join(excused))
         return 0
     if cmd == "last-signal":
         r = Row(argv[2])

@@ -27,6 +27,20 @@ judge_now() {
   return 0
 }
 
+# check_no_fault NAME: no fault in the row's status frames (host side). Watchdog faults that followed a stall of
+# dockd's own loop (matrix.py faults-split) are reported as STARVED instead, unless HIL_STRICT_TIMING=1.
+check_no_fault() {
+  local split unexc exc
+  split=$($MATRIX_PY faults-split "$RD")
+  unexc=${split%%;*}; exc=${split#*;}
+  echo "INFO $1 faults: '$unexc' starvation-excused: '$exc'"
+  if [ -z "$unexc" ] && [ -n "$exc" ] && [ "${HIL_STRICT_TIMING:-0}" != 1 ]; then
+    echo "STARVED ${1}_no_fault  (watchdog faults $exc right after dockd's loop stalled: VM starvation)"
+    return 0
+  fi
+  check "${1}_no_fault" test -z "$unexc$exc"
+}
+
 # Value of KEY in a flat one-line JSON object file (dockctl status), without Python (cheap in the VM).
 matrix_field() { sed -n "s/.*\"$2\":\(\"[^\"]*\"\|[^,}]*\).*/\1/p" "$1" 2>/dev/null | tr -d '"' | head -1; }
 # Wall time of the first inject.log entry NAME.

@@ -6,8 +6,7 @@ SC="$SRC/tests/hil/scenarios"
 
 # Host-side checks (tests/hil/matrix.py).
 post_no_fault() {
-  local f; f=$($MATRIX_PY faults "$RD"); echo "INFO $ROW faults: '$f'"
-  check "${ROW}_no_fault" test -z "$f"
+  check_no_fault "$ROW"
 }
 post_no_charge() {
   local states; states=$($MATRIX_PY states "$RD"); echo "INFO motion_no_charge states: $states"
@@ -40,14 +39,16 @@ push_row motion_push_distance push_distance.toml 178
 push_row motion_push_angle push_angle.toml 179
 
 # Obstacle: a 12 cm disc appears 0.4 m ahead of the robot's centre (inside the forward check area, see
-# tests/hil/scenarios/obstacle.toml) for 2 s. It is in the next scan (<= 100 ms) and stops the robot on the next
-# tick: limit 120 ms; no fault (obstacle_timeout 10 s); the robot moves again when it is gone.
+# tests/hil/scenarios/obstacle.toml) for 2 s. Its bearing is swept within 100 ms, but a turn is published only when
+# the sweep wraps past 0 deg (the LD06 parser closes a turn on the next turn's first point; the emitter, like the
+# sensor, sends the turn's last points with the next turn's first ones), up to one more turn later: two scan periods
+# + one tick = limit 220 ms; no fault (obstacle_timeout 10 s); the robot moves again when it is gone.
 ROW_SCENARIO="$SC/obstacle.toml" row_start motion_obstacle
 row_dock
 wait_for 60 truth_has obstacle_gone
 sleep 1.5
 row_stop
-judge --fault obstacle --limit-ms 120 --clear obstacle_gone --recover moving
+judge --fault obstacle --limit-ms 220 --clear obstacle_gone --recover moving
 post post_no_fault
 
 # Dock occluded 1 s: the estimate ages past target_lost_after (0.5 s): the robot holds. The last scan with the dock
@@ -73,13 +74,14 @@ judge --fault occlude_dock --limit-ms 620 --code 181 --status-limit-ms 5640 --re
 
 # Charging never starts (--no-charge): every attempt reaches the contacts, no current; retries (here max_retries 1,
 # charge_confirm_timeout 2 s to keep the row short), then fault 182 after backing off to the staging distance.
-# Fault time = the first DockStatus with 182; the robot must already stand (first zero frame within one tick).
+# Fault time = the first DockStatus with 182; the robot must already stand: the next tick's wheel frame is zero
+# (limit two ticks, 40 ms: a tick may run up to 20 ms late before matrix.py calls the VM starved).
 ROW_TOML=$'[task]\nmax_retries = 1\ncharge_confirm_timeout_s = 2.0' row_start motion_no_charge --no-charge
 row_dock
 wait_for 150 state_is FAULT
 sleep 1
 row_stop
-judge --fault status:182 --no-moving-check --code 182 --limit-ms 20 --recover none
+judge --fault status:182 --no-moving-check --code 182 --limit-ms 40 --recover none
 post post_no_charge
 press=$(tail -2 "$RD/truth.jsonl" | head -1 | grep -o '"press_m":[-0-9.]*' | cut -d: -f2)
 echo "FIGURE motion_no_charge_final_distance_m ${press#-}"
