@@ -7,7 +7,8 @@ bool Dockcore::configure(const DockProfile& profile, const DockcoreConfig& confi
   filter_ = DockPoseFilter(config.filter);
   tasks_.configure(config.task, config.footprint, profile);
   have_scan_ = false;
-  pending_ = DetectionInput{};
+  pending_count_ = 0;
+  pending_dropped_ = 0;
   filter_confirmed_ = false;
   last_estimate_ = DockEstimate{};
   prev_state_ = TaskState::kNotTasking;
@@ -32,15 +33,26 @@ const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_
   }
   last_estimate_ = estimator_.estimate(scan, config_.lidar_mount, hint_ptr);
   if (last_estimate_.found) {
+    // The push test's reference is the filter before this detection: once fused (or adopted by a restart) it
+    // would agree with the detection whatever happened to the robot.
+    DetectionInput d;
+    d.fresh = true;
+    d.dock_in_robot = last_estimate_.pose;
+    d.odom_at_scan = odom_pose;
+    d.stamp_us = stamp_us;
+    d.expectation_set = true;
+    d.expectation_confirmed = filter_.initialised() && filter_confirmed_;
+    if (d.expectation_confirmed) d.expected_in_odom = filter_.dock_in_odom();
+    if (pending_count_ < kMaxDetectionsPerTick) {
+      pending_[pending_count_++] = d;
+    } else {
+      ++pending_dropped_;  // keep the oldest: a push shows in the first detections after it
+    }
     const FilterUpdate u = filter_.update(last_estimate_.pose, last_estimate_.covariance, odom_pose, stamp_us);
     // A (re)started filter rests on this one detection, which may be clutter: confirmed once a second detection
     // agrees with it (is fused).
     if (u == FilterUpdate::kInitialised || u == FilterUpdate::kReinitialised) filter_confirmed_ = false;
     if (u == FilterUpdate::kFused) filter_confirmed_ = true;
-    pending_.fresh = true;
-    pending_.dock_in_robot = last_estimate_.pose;
-    pending_.odom_at_scan = odom_pose;
-    pending_.stamp_us = stamp_us;
   }
   return last_estimate_;
 }
@@ -67,8 +79,9 @@ TickOutput Dockcore::tick(const TickInput& in) {
     t.dock.stamp_us = filter_.last_update_us();
     t.dock.confirmed = filter_confirmed_;
   }
-  t.detection = pending_;
-  pending_.fresh = false;
+  for (std::size_t i = 0; i < pending_count_; ++i) t.detections[i] = pending_[i];
+  t.detection_count = pending_count_;
+  pending_count_ = 0;
 
   TickOutput out = tasks_.tick(t);
   // A new dock task: forget the old dock (the robot may have been carried since), so the push test and the

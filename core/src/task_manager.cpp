@@ -231,31 +231,46 @@ void TaskManager::run_reach(const TaskInput& in) {
   want_.wz_radps = err > 0 ? params_.swing_speed_radps : -params_.swing_speed_radps;
 }
 
+bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in) {
+  if (!det.fresh) return false;
+  const Pose2 detected = det.odom_at_scan.compose(det.dock_in_robot);
+  // An unconfirmed filter rests on one detection: disagreeing with it is no evidence of a push, so only the
+  // distance limit is tested (expected = detected).
+  Pose2 expected = detected;
+  if (det.expectation_set) {
+    if (det.expectation_confirmed) expected = det.expected_in_odom;
+  } else if (in.dock.valid && in.dock.confirmed) {
+    expected = in.odom_pose.compose(in.dock.pose);
+  } else if (!in.dock.valid) {
+    return false;
+  }
+  const Pose2& d = det.dock_in_robot;
+  const Real dist = std::sqrt(d.x_m * d.x_m + d.y_m * d.y_m);
+  const FaultCode f = check_pose_deviation(detected, expected, dist, start_distance_m_, params_.deviation);
+  if (f == FaultCode::kNone) {
+    deviation_count_ = 0;
+    return false;
+  }
+  // A push moves every later detection to the same new place; an outlier is alone. Count only failing
+  // detections that agree with the previous failing one (same tolerances as the push test itself).
+  const bool repeats = deviation_count_ > 0 &&
+      check_pose_deviation(detected, deviation_pose_, static_cast<Real>(0), start_distance_m_, params_.deviation) ==
+          FaultCode::kNone;
+  deviation_count_ = repeats ? static_cast<std::uint8_t>(deviation_count_ + 1) : static_cast<std::uint8_t>(1);
+  deviation_pose_ = detected;
+  if (deviation_count_ >= params_.deviation.confirm_detections) {
+    raise(f, in);
+    return true;
+  }
+  return false;
+}
+
 void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
-  if (in.detection.fresh && in.dock.valid) {
-    const Pose2 detected = in.detection.odom_at_scan.compose(in.detection.dock_in_robot);
-    // An unconfirmed filter rests on one detection: disagreeing with it is no evidence of a push, so only the
-    // distance limit is tested (expected = detected).
-    const Pose2 expected = in.dock.confirmed ? in.odom_pose.compose(in.dock.pose) : detected;
-    const Pose2& d = in.detection.dock_in_robot;
-    const Real dist = std::sqrt(d.x_m * d.x_m + d.y_m * d.y_m);
-    const FaultCode f = check_pose_deviation(detected, expected, dist, start_distance_m_, params_.deviation);
-    if (f == FaultCode::kNone) {
-      deviation_count_ = 0;
-    } else {
-      // A push moves every later detection to the same new place; an outlier is alone. Count only failing
-      // detections that agree with the previous failing one (same tolerances as the push test itself).
-      const bool repeats = deviation_count_ > 0 &&
-          check_pose_deviation(detected, deviation_pose_, static_cast<Real>(0), start_distance_m_,
-                               params_.deviation) ==
-              FaultCode::kNone;
-      deviation_count_ = repeats ? static_cast<std::uint8_t>(deviation_count_ + 1) : static_cast<std::uint8_t>(1);
-      deviation_pose_ = detected;
-      if (deviation_count_ >= params_.deviation.confirm_detections) {
-        raise(f, in);
-        return;
-      }
-    }
+  // Every detection since the last tick, in order: a push followed by a stall shows only in the first scans of the
+  // backlog (the later ones may already have restarted the filter at the pushed pose).
+  const std::size_t n = in.detection_count < kMaxDetectionsPerTick ? in.detection_count : kMaxDetectionsPerTick;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (test_detection(in.detections[i], in)) return;
   }
   ControlInput ci;
   ci.now_us = in.now_us;

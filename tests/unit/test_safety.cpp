@@ -64,12 +64,68 @@ TEST(Safety, SquareForwardAreaStartsAtTheBodyFront) {
     CHECK(!c.check(sc.view(), sc.mount, nullptr).forward);
   }
   {
-    Scan sc;  // inside the body: the robot itself
+    Scan sc;  // inside the body, on no configured self sector: an obstacle the robot overlaps, not the robot
     sc.add(Vec2(0.3, 0.0));
     const ObstacleFlags f = c.check(sc.view(), sc.mount, nullptr);
-    CHECK(!f.forward && !f.rotation);
-    LONGS_EQUAL(2, f.self_points);
+    CHECK(f.forward && f.rotation && !f.backward);
+    LONGS_EQUAL(0, f.self_points);
+    LONGS_EQUAL(2, f.body_points);
+    CHECK(f.nearest_forward_m < 0);
   }
+}
+
+// HIL finding (docs/reliability.md): a disc 1.5 cm beyond the front edge, inside the 2 cm self margin, was taken for
+// the robot and driven through. Only configured self sectors are the robot.
+TEST(Safety, ObstacleWithinTheSelfMarginOfTheBumperBlocks) {
+  ObstacleChecker c;
+  c.configure(square_footprint(), nullptr);
+  Scan sc;
+  sc.add(Vec2(0.385, 0.0));  // 1.5 cm beyond the 0.37 m front edge
+  ObstacleFlags f = c.check(sc.view(), sc.mount, nullptr);
+  CHECK(f.forward);
+  LONGS_EQUAL(0, f.self_points);
+  DOUBLES_EQUAL(0.015, f.nearest_forward_m, 1e-3);
+  // Driven on into the body: still blocked (forward and turning), never invisible.
+  Scan deeper;
+  deeper.add(Vec2(0.2, 0.05));
+  f = c.check(deeper.view(), deeper.mount, nullptr);
+  CHECK(f.forward && f.rotation && !f.backward);
+  Scan behind;  // inside the rear half of the body: blocks backing off, not forward
+  behind.add(Vec2(-0.3, 0.0));
+  f = c.check(behind.view(), behind.mount, nullptr);
+  CHECK(f.backward && !f.forward && f.rotation);
+}
+
+TEST(Safety, ConfiguredSelfSectorsAreTheRobot) {
+  FootprintParams fp = square_footprint();
+  // A lidar post at bearing 135° (lidar frame), 0.3 m from the centre, and a bumper strip across the front seen
+  // through a sector that wraps through ±180° (a lidar mounted backwards).
+  fp.self_sectors[0] = AngleSector{deg_to_rad(static_cast<Real>(130)), deg_to_rad(static_cast<Real>(140))};
+  fp.self_sectors[1] = AngleSector{deg_to_rad(static_cast<Real>(170)), deg_to_rad(static_cast<Real>(-170))};
+  fp.self_sector_count = 2;
+  ObstacleChecker c;
+  c.configure(fp, nullptr);
+  const Vec2 post(0.3 * std::cos(deg_to_rad(135.0)), 0.3 * std::sin(deg_to_rad(135.0)));
+  CHECK(c.is_self_point(post, deg_to_rad(static_cast<Real>(135))));
+  CHECK(!c.is_self_point(post, deg_to_rad(static_cast<Real>(100))));  // same place, another bearing: not the robot
+  Scan sc;
+  sc.add(post);
+  ObstacleFlags f = c.check(sc.view(), sc.mount, nullptr);
+  CHECK(!f.forward && !f.backward && !f.rotation);
+  LONGS_EQUAL(2, f.self_points);
+  // Within the margin beyond the body on a self bearing: range noise on the robot's own structure.
+  Scan edge;
+  Pose2 backwards{0, 0, kPi};
+  edge.mount = backwards;
+  edge.add(Vec2(0.385, 0.0));  // lidar bearing 180°
+  f = c.check(edge.view(), edge.mount, nullptr);
+  CHECK(!f.forward);
+  LONGS_EQUAL(2, f.self_points);
+  // Beyond the margin on the same bearing: an obstacle (the structure cannot return from there).
+  Scan beyond;
+  beyond.mount = backwards;
+  beyond.add(Vec2(0.45, 0.0));
+  CHECK(c.check(beyond.view(), beyond.mount, nullptr).forward);
 }
 
 TEST(Safety, SquareRotationAndBackward) {

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "dockcore/dock_profile.hpp"
@@ -136,14 +137,16 @@ struct Sim {
       if (detectable()) {
         dock_valid = true;
         dock_stamp_us = now_us;
-        in.detection.fresh = true;
-        in.detection.dock_in_robot = world.inverse().compose(dock);
+        DetectionInput& det = in.detections[0];
+        in.detection_count = 1;
+        det.fresh = true;
+        det.dock_in_robot = world.inverse().compose(dock);
         if (!outliers.empty()) {
-          in.detection.dock_in_robot = world.inverse().compose(outliers.front());
+          det.dock_in_robot = world.inverse().compose(outliers.front());
           outliers.erase(outliers.begin());
         }
-        in.detection.odom_at_scan = odom;
-        in.detection.stamp_us = now_us;
+        det.odom_at_scan = odom;
+        det.stamp_us = now_us;
       }
     }
     const ScanView view = scan.view();
@@ -516,6 +519,32 @@ TEST(TaskManager, ObstacleStopsAndResumes) {
   LONGS_EQUAL(0, s->zero_violations);
 }
 
+// HIL finding (docs/reliability.md): a disc appearing 1.5 cm beyond the front edge (inside the old 2 cm self margin)
+// stopped the robot, then vanished as "the robot itself" and was driven through. It must hold the robot as long as
+// it is there, without a fault, and the approach continues once it is gone.
+TEST(TaskManager, ObstacleAtTheBumperHoldsTheRobotUntilItLeaves) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(0.3);
+  const Pose2 at = s->world;
+  s->obstacles.push_back(at.transform(Vec2(kHalfLength + 0.015 + 0.05, 0)));  // 0.1 m box, near face 1.5 cm out
+  int moving_ticks = 0;
+  for (int i = 0; i < 100; ++i) {  // 2 s
+    s->step();
+    CHECK(s->out.status.state == TaskState::kAlign);
+    if (i >= 10 && (s->out.cmd.vx_mps != 0 || s->out.cmd.wz_radps != 0)) ++moving_ticks;
+  }
+  LONGS_EQUAL(0, moving_ticks);
+  CHECK(s->out.blocked);
+  // The robot stopped before reaching the box (it saw it at most one scan period late at <= 0.2 m/s).
+  const double travelled = at.inverse().compose(s->world).x_m;
+  CHECK(travelled < 0.015 + 0.02);
+  s->obstacles.clear();
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
 TEST(TaskManager, ObstacleTimeout180) {
   auto s = std::make_unique<Sim>();
   s->params.obstacle_timeout_s = 2.0;
@@ -843,4 +872,40 @@ TEST(Dockcore, NoScansMeansLidarStaleWhenMoving) {
   const TickOutput o = f.core->tick(in);
   CHECK(o.status.state == TaskState::kFault);
   LONGS_EQUAL(185, static_cast<int>(o.status.fault));
+}
+
+// HIL finding (docs/reliability.md, "Push rows and lidar gaps"): right after a push the host's loop stalled, then
+// drained the lidar backlog — several scans through on_scan before the next tick (dockd: up to 4 per loop). The
+// filter gates the first two jumps and restarts at the pushed pose on the third (reinit_after 3); the push test saw
+// only the newest detection, against the restarted filter, and the robot docked on from the pushed pose. Every
+// detection must be tested against the filter as it was before that detection.
+TEST(Dockcore, PushFollowedByAScanBacklogIsStillReported) {
+  for (int turned = 0; turned <= 1; ++turned) {
+    for (int backlog = 2; backlog <= 10; ++backlog) {
+      FacadeSim f;
+      f.step(HostCommand{HostCommandType::kDock, 0});
+      CHECK(f.run_until(TaskState::kAlign, 5));
+      for (int i = 0; i < 25; ++i) f.step();
+      if (turned != 0) {
+        f.w.world = Pose2{0, 0, deg_to_rad(static_cast<Real>(40))}.compose(f.w.world);  // about the dock: 179
+      } else {
+        f.w.world.y_m += 0.4;  // sideways: 178
+      }
+      // The stall: no tick, the robot stands (its motors time out), scans queue and are then handed over together.
+      for (int k = 0; k < backlog; ++k) {
+        f.w.now_us += 100000;
+        simulate_scan(f.w.world_model(), f.w.world, f.w.model, f.w.rng, &f.w.scan, f.w.now_us);
+        f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.odom);
+      }
+      CHECK(f.core->filter().reinitialisations() >= (backlog >= 3 ? 1u : 0u));  // the filter did adopt the push
+      TickInput in;
+      in.now_us = f.w.now_us + 1000;
+      in.odom_pose = f.w.odom;
+      const TickOutput o = f.core->tick(in);
+      CHECK_TEXT(o.status.state == TaskState::kFault, (std::string("backlog ") + std::to_string(backlog)).c_str());
+      LONGS_EQUAL(turned != 0 ? 179 : 178, static_cast<int>(o.status.fault));
+      CHECK(o.cmd.vx_mps == 0 && o.cmd.wz_radps == 0);
+      LONGS_EQUAL(backlog > 8 ? backlog - 8 : 0, static_cast<long>(f.core->detections_dropped()));
+    }
+  }
 }

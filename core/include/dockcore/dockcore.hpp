@@ -6,9 +6,13 @@
 /// - on_scan(): detection with the filter's prediction as the estimator's hint (tracking mode; global search when
 ///   the filter has no dock or the hint fails), then the filter update. The scan is copied so the tick can run the
 ///   obstacle check and give controllers (seed003) the latest ranges.
-/// - tick(): the filtered dock seen from the current odometry pose, the latest raw detection (for the push test),
-///   the latest scan and the host's flags go to the TaskManager; its twist and status come back. The push test
-///   trusts the filter only once it has fused a second, agreeing detection since it (re)started (DockInput::confirmed).
+/// - tick(): the filtered dock seen from the current odometry pose, every raw detection since the previous tick (for
+///   the push test; up to kMaxDetectionsPerTick, oldest first, each with the filter's expectation from just before
+///   it was fused), the latest scan and the host's flags go to the TaskManager; its twist and status come back. The
+///   push test trusts the filter only once it has fused a second, agreeing detection since it (re)started
+///   (DockInput::confirmed). Recording the expectation per detection matters when several scans arrive between two
+///   ticks (a host draining a backlog after a stall): the filter restarts at a pushed pose on its third jump, and a
+///   test against the filter as it is at the tick would find nothing wrong.
 /// The filter is reset when a new dock task starts (the robot may have been carried since the last one).
 /// No heap; the object is large (estimator buffers plus one LaserScan copy, ~360 kB with double): keep it static or
 /// a member, never on a small stack.
@@ -71,6 +75,8 @@ class Dockcore {
   const DockPoseEstimator& estimator() const { return estimator_; }
   const TaskManager& task_manager() const { return tasks_; }
   const DockcoreConfig& config() const { return config_; }
+  /// Detections that did not fit into one tick's list (more than kMaxDetectionsPerTick scans between two ticks).
+  std::uint32_t detections_dropped() const { return pending_dropped_; }
 
  private:
   DockcoreConfig config_{};
@@ -81,7 +87,9 @@ class Dockcore {
   bool have_scan_ = false;
   std::uint64_t last_scan_us_ = 0;
   DockEstimate last_estimate_{};
-  DetectionInput pending_{};
+  DetectionInput pending_[kMaxDetectionsPerTick] = {};
+  std::uint8_t pending_count_ = 0;
+  std::uint32_t pending_dropped_ = 0;  ///< Detections beyond kMaxDetectionsPerTick between two ticks (not tested).
   TaskState prev_state_ = TaskState::kNotTasking;
   bool filter_confirmed_ = false;  ///< The filter fused a detection since its last (re)initialisation.
 };

@@ -4,7 +4,12 @@
 ///
 /// Obstacle check (seed 004, Table 3). All geometry in the robot frame (x forward, y left, origin at the rotation
 /// centre). A scan point is ignored when it is
-///  - the robot itself: inside the body outline grown by self_margin_m (lidar posts, bumpers seen by the lidar);
+///  - the robot itself: a return on a beam inside one of the configured self sectors (lidar-frame bearings where
+///    the lidar sees the robot's own structure: lidar posts, a bumper in the scan plane) that lies inside the body
+///    outline grown by self_margin_m. Only configured, static structure is the robot: a return anywhere else is
+///    never taken for it, however close — an obstacle that comes within the margin of the body or inside its
+///    outline (the robot touching or driving into it) stays visible and blocks (docs/task-manager.md, "Obstacles").
+///    The default configures no sector: the lidar sees none of the robot (mounted on top, as in the simulator);
 ///  - the dock: within dock_margin_m of the dock profile's polyline placed at the dock estimate, or in the dock zone:
 ///    at or behind the dock's face plane (dock-frame x <= profile's largest x + dock_margin_m) within
 ///    dock_zone_half_width_m of the dock axis — the wall the dock stands against, which the robot must come close
@@ -12,8 +17,10 @@
 /// Of the remaining points:
 ///  - forward-blocked: body front < x <= body front + check_length_m and |y| < check_width_m / 2. The seed measures
 ///    the 0.3 m "in x"; from the robot centre that would lie inside its own 0.37 m half-length square body, so the
-///    area starts at the body's front edge.
-///  - backward-blocked: the same area mirrored behind the body's rear edge (undocking, backing off).
+///    area starts at the body's front edge. Also any point inside the body outline with x >= 0: something the
+///    robot already touches or overlaps must not be driven further into.
+///  - backward-blocked: the same area mirrored behind the body's rear edge (undocking, backing off), and points
+///    inside the body with x <= 0.
 ///  - rotation-blocked: closer than circumscribed_radius_m to the rotation centre (a turning corner would hit it).
 /// A direction is blocked when at least min_points points fall in its area (one stray return is noise).
 /// Cost O(B · S): B beams, S profile segments (only points within the circumscribed radius or the check areas reach
@@ -28,6 +35,16 @@
 #include "dockcore/laser_scan.hpp"
 
 namespace dockcore {
+
+/// A bearing interval in the lidar frame, [min_rad, max_rad] within (-pi, pi]; min_rad > max_rad wraps through pi
+/// (a sector behind a forward-facing lidar).
+struct AngleSector {
+  Real min_rad = 0;
+  Real max_rad = 0;
+};
+
+/// Most self sectors a footprint can hold (four lidar posts).
+constexpr std::size_t kMaxSelfSectors = 4;
 
 /// Body outline used by the obstacle check.
 enum class FootprintShape : std::uint8_t {
@@ -46,7 +63,13 @@ struct FootprintParams {
   Real check_length_m = static_cast<Real>(0.3);  ///< Forward/backward check area depth beyond the body edge (m).
   Real check_width_m = static_cast<Real>(0.5);   ///< Forward/backward check area full width (m).
   Real circumscribed_radius_m = static_cast<Real>(0.45);  ///< Rotation check radius about the centre (m).
-  Real self_margin_m = static_cast<Real>(0.02);  ///< Points inside the body grown by this are the robot itself (m).
+  /// Range noise allowance on the robot's own structure: inside a self sector, returns inside the body grown by
+  /// this are the robot itself (m). Outside the self sectors it has no effect.
+  Real self_margin_m = static_cast<Real>(0.02);
+  /// Lidar-frame bearings where the lidar sees the robot's own (static) structure; the first self_sector_count
+  /// entries are used. Measure them on the robot (returns inside the body on an empty floor). Default none.
+  AngleSector self_sectors[kMaxSelfSectors] = {};
+  std::uint8_t self_sector_count = 0;
   Real dock_margin_m = static_cast<Real>(0.05);  ///< Points this close to the dock polyline are the dock (m).
   Real dock_zone_half_width_m = static_cast<Real>(0.6);  ///< Half-width of the zone at/behind the dock face (m).
   Real min_range_m = static_cast<Real>(0.02);    ///< Closer returns are ignored (lidar blind zone) (m).
@@ -68,8 +91,10 @@ struct ObstacleFlags {
   std::uint16_t backward_points = 0;
   std::uint16_t rotation_points = 0;
   std::uint16_t dock_points = 0;  ///< Points ignored as the dock or the dock zone.
-  std::uint16_t self_points = 0;  ///< Points ignored as the robot's own body.
-  Real nearest_forward_m = 0;     ///< Smallest x beyond the body front among forward points (0 when none).
+  std::uint16_t self_points = 0;  ///< Points ignored as the robot's own body (self sectors only).
+  std::uint16_t body_points = 0;  ///< Obstacle points inside the body outline (the robot touches or overlaps them).
+  /// Smallest x beyond the body front among forward points (0 when none; negative: inside the body outline).
+  Real nearest_forward_m = 0;
 };
 
 /// Scan-based obstacle check. Holds the footprint and a copy of the dock profile (no references kept).
@@ -84,8 +109,11 @@ class ObstacleChecker {
 
   /// Classifies one point (robot frame); exposed for tests. O(S).
   bool is_dock_point(const Vec2& p_robot, const Pose2& dock_in_robot) const;
-  /// True when p_robot lies inside the body grown by self_margin_m. O(1).
-  bool is_self_point(const Vec2& p_robot) const;
+  /// True when a return at p_robot on a beam of lidar-frame bearing `lidar_bearing_rad` is the robot itself: the
+  /// bearing lies in a configured self sector and p_robot inside the body grown by self_margin_m. O(sectors).
+  bool is_self_point(const Vec2& p_robot, Real lidar_bearing_rad) const;
+  /// True when p_robot lies inside the body outline (not grown). O(1).
+  bool is_inside_body(const Vec2& p_robot) const;
 
   const FootprintParams& footprint() const { return fp_; }
   /// Distance from the rotation centre to the body's front (and rear) edge. O(1).

@@ -124,20 +124,35 @@ struct DockInput {
   bool confirmed = true;
 };
 
-/// The raw detection of the scan processed since the previous tick, if any (for the push test).
+/// One raw detection of a scan processed since the previous tick (for the push test).
 struct DetectionInput {
   bool fresh = false;          ///< A detection arrived since the previous tick.
   Pose2 dock_in_robot{};       ///< Dock in the robot frame at the scan time.
   Pose2 odom_at_scan{};        ///< Robot odometry pose at the scan time.
   std::uint64_t stamp_us = 0;
+  /// The filter's expectation just before this detection was fused, as Dockcore records it per detection: the
+  /// push test compares the detection with it, so a detection the filter then adopts (it restarts after
+  /// DockFilterParams::reinit_after jumps, e.g. several scans of a pushed robot fused between two ticks) is still
+  /// judged against what odometry said at its time. When false (callers without a filter) the test uses
+  /// TaskInput::dock as it is on the tick.
+  bool expectation_set = false;
+  bool expectation_confirmed = false;  ///< The expectation rested on two agreeing detections (DockInput::confirmed).
+  Pose2 expected_in_odom{};            ///< Dock in the odometry frame the filter expected (when confirmed).
 };
+
+/// Detections one tick can carry: a host draining a scan backlog after a stall hands several scans to
+/// Dockcore::on_scan before the next tick (dockd: up to 4 per loop). Beyond this the oldest are kept (a push shows in
+/// the first detections after it) and the rest counted.
+constexpr std::size_t kMaxDetectionsPerTick = 8;
 
 /// Everything the task manager sees on one tick.
 struct TaskInput {
   std::uint64_t now_us = 0;  ///< Monotonic time of this tick.
   HostCommand command{};     ///< Command arriving on this tick (edge), or kNone.
   DockInput dock{};
-  DetectionInput detection{};
+  /// Detections since the previous tick, oldest first; the push test (ALIGN) runs on every one of them in order.
+  DetectionInput detections[kMaxDetectionsPerTick] = {};
+  std::uint8_t detection_count = 0;
   Pose2 odom_pose{};
   Twist2 odom_twist{};
   const ScanView* scan = nullptr;  ///< Latest scan for the obstacle check (null: motion blocked). This call only.
@@ -200,6 +215,8 @@ class TaskManager {
   bool run_backoff(const TaskInput& in);
   void run_reach(const TaskInput& in);
   void run_align(const TaskInput& in, TaskOutput& out);
+  /// Push test (178/179) on one detection; returns true when it raised the fault.
+  bool test_detection(const DetectionInput& det, const TaskInput& in);
   void run_wait_for_charge(const TaskInput& in);
   void run_finish(const TaskInput& in);
   void run_retry(const TaskInput& in);
