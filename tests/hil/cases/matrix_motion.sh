@@ -38,7 +38,7 @@ push_row() {
 push_row motion_push_distance push_distance.toml 178
 push_row motion_push_angle push_angle.toml 179
 
-# Obstacle: a 12 cm disc appears 0.4 m ahead of the robot's centre (inside the forward check area, see
+# Obstacle: a 12 cm disc appears 0.30 m ahead of the robot's centre, 1.5 cm from its bumper (inside the self margin, see
 # tests/hil/scenarios/obstacle.toml) for 2 s. Its bearing is swept within 100 ms, but a turn is published only when
 # the sweep wraps past 0 deg (the LD06 parser closes a turn on the next turn's first point; the emitter, like the
 # sensor, sends the turn's last points with the next turn's first ones), up to one more turn later: two scan periods

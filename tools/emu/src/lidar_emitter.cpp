@@ -218,8 +218,14 @@ void LidarEmitter::service_requests() {
 bool LidarEmitter::emit_scan(const ScanView& scan) {
   service_requests();
   const bool rp_idle = opt_.protocol == EmuProtocol::kRplidar && !rplidar_scanning_;
-  // The sensor's clock runs on while it sends nothing (stall, unplugged): the next packets' timestamps show the gap.
-  ms_ += static_cast<std::uint64_t>(std::llround(1000.0 / opt_.rate_hz));
+  // The sensor's clock: the scan's own stamp when it has one (chassis-sim stamps a scan with the time it renders it;
+  // a simulator that runs late renders late, and its sensor clock must say so, or dockd would take the late turn
+  // for a backlog), else one turn period per scan. It runs on while nothing is sent (stall, unplugged).
+  if (scan.stamp_us != 0) {
+    ms_ = scan.stamp_us / 1000u;
+  } else {
+    ms_ += static_cast<std::uint64_t>(std::llround(1000.0 / opt_.rate_hz));
+  }
   if (stalled_ || !plugged() || rp_idle) {
     ++stats_.scans_suppressed;
     return false;
