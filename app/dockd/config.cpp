@@ -196,6 +196,47 @@ class Parser {
   mutable std::map<std::string, toml::source_region> where_;
 };
 
+/// robot.footprint.self_sectors_deg = [[from_deg, to_deg], ...]: the lidar-frame bearings where the lidar sees the
+/// robot's own structure (FootprintParams::self_sectors, at most kMaxSelfSectors). Bounds in [-180, 180]; from > to
+/// wraps through 180 (a sector behind the lidar). Stored through wrap_angle, the core's (-pi, pi] convention, so
+/// -180 is the same bearing as 180. A sector whose bounds name one bearing ([10, 10], [-180, 180]) is refused: it
+/// holds no beam in practice, and [-180, 180] reads as "all round", which would hide every obstacle inside the body
+/// again (the filter b426c4c removed).
+void self_sectors(const Parser& p, const toml::node& n, dockcore::FootprintParams& f) {
+  const std::string key = p.key();
+  const toml::array* a = n.as_array();
+  if (a == nullptr) {
+    p.fail(n.source(), key + " must be an array of [from_deg, to_deg] pairs, not " + type_name(n));
+  }
+  if (a->size() > dockcore::kMaxSelfSectors) {
+    p.fail(n.source(), key + " has " + std::to_string(a->size()) + " sectors (at most " +
+                           std::to_string(dockcore::kMaxSelfSectors) + ")");
+  }
+  dockcore::AngleSector out[dockcore::kMaxSelfSectors] = {};
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    const toml::node& e = (*a)[i];
+    const toml::array* pair = e.as_array();
+    if (pair == nullptr || pair->size() != 2) {
+      p.fail(e.source(), key + " sector " + std::to_string(i + 1) + " must be a [from_deg, to_deg] pair, not " +
+                             (pair == nullptr ? std::string(type_name(e))
+                                              : "an array of " + std::to_string(pair->size())));
+    }
+    // number() reports with the key name; the sector's position is in the file:line:col.
+    const double from_deg = p.number((*pair)[0], -180, 180);
+    const double to_deg = p.number((*pair)[1], -180, 180);
+    out[i].min_rad = dockcore::wrap_angle(static_cast<Real>(from_deg * kDeg));
+    out[i].max_rad = dockcore::wrap_angle(static_cast<Real>(to_deg * kDeg));
+    if (out[i].min_rad == out[i].max_rad) {
+      std::ostringstream s;
+      s << key << " sector " << i + 1 << " [" << from_deg << ", " << to_deg
+        << "] has from and to on the same bearing (an empty sector, or all round: give its real extent)";
+      p.fail(e.source(), s.str());
+    }
+  }
+  for (std::size_t i = 0; i < dockcore::kMaxSelfSectors; ++i) f.self_sectors[i] = out[i];
+  f.self_sector_count = static_cast<std::uint8_t>(a->size());
+}
+
 /// A profile file: name (optional), contact_offset_m (optional), points = [[x, y], ...] (docs/docks.md).
 dockcore::DockProfile load_profile(const Parser& p, const toml::node& at, const std::string& path) {
   toml::table t;
@@ -369,6 +410,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
                       {"check_width_m", p.real(&f.check_width_m, 0, 5)},
                       {"circumscribed_radius_m", p.real(&f.circumscribed_radius_m, 0.01, 10)},
                       {"self_margin_m", p.real(&f.self_margin_m, 0, 1)},
+                      {"self_sectors_deg", [&](const toml::node& n) { self_sectors(p, n, f); }},
                       {"dock_margin_m", p.real(&f.dock_margin_m, 0, 1)},
                       {"min_points", p.integ(&f.min_points, 1, 1000)}};
     }));

@@ -127,7 +127,7 @@ TEST(DockdConfig, RestartOnlyChangesNameTheKeys) {
   const dockd::DockdConfig b = dockd::parse_config_toml(
       "[watchdog]\nchassis_stale_ms = 300\n[controller.smooth]\nv_max_mps = 0.2\n[task]\nmax_retries = 5\n"
       "[host]\nallowlist = [\"10.1.0.0/16\"]\n[[docks]]\nid = 4\n[dock]\ndefault_id = 4\n[log]\nlevel = \"debug\"\n"
-      "[lidar]\nmount_x_m = 0.1\n[can]\nstatus_rate_hz = 20\n",
+      "[lidar]\nmount_x_m = 0.1\n[can]\nstatus_rate_hz = 20\n[robot.footprint]\nself_sectors_deg = [[80, 100]]\n",
       "t.toml");
   CHECK_TRUE(dockd::restart_only_changes(a, b).empty());
   const dockd::DockdConfig c = dockd::parse_config_toml(
@@ -151,4 +151,48 @@ TEST(DockdConfig, CrossKeyErrorsPointAtTheKey) {
   STRCMP_CONTAINS("t.toml:2:15: lidar.min_range_m must be <", error_of("[lidar]\nmin_range_m = 3\nmax_range_m = 2\n").c_str());
   STRCMP_CONTAINS("t.toml:5:8: camera.port must differ",
                   error_of("[host]\nport = 7400\n[camera]\nenabled = true\nport = 7400\n").c_str());
+}
+
+// robot.footprint.self_sectors_deg -> FootprintParams::self_sectors (b426c4c: only configured sectors are the robot).
+TEST(DockdConfig, SelfSectorsAreParsedInRadians) {
+  CHECK_EQUAL(0u, dockd::parse_config_toml("", "t.toml").footprint.self_sector_count);
+  const dockd::DockdConfig c = dockd::parse_config_toml(
+      "[robot.footprint]\nself_sectors_deg = [[-100, -80.5], [80, 100], [170, -170], [-180, -175]]\n", "t.toml");
+  const dockcore::FootprintParams& f = c.footprint;
+  CHECK_EQUAL(4u, f.self_sector_count);
+  const double deg = 3.14159265358979323846 / 180.0;
+  const double want[4][2] = {{-100, -80.5}, {80, 100}, {170, -170}, {180, -175}};  // -180 is stored as 180 (wrap)
+  for (int i = 0; i < 4; ++i) {
+    REAL_EQUAL(want[i][0] * deg, static_cast<double>(f.self_sectors[i].min_rad), 1e-12);
+    REAL_EQUAL(want[i][1] * deg, static_cast<double>(f.self_sectors[i].max_rad), 1e-12);
+  }
+  // The parsed sectors act in the core: a return at the body edge on bearing 90 deg is the robot, at 0 deg it is not.
+  dockcore::ObstacleChecker chk;
+  chk.configure(f, nullptr);
+  CHECK_TRUE(chk.is_self_point(dockcore::Vec2(0, f.half_width_m), dockcore::kPi / 2));
+  CHECK_FALSE(chk.is_self_point(dockcore::Vec2(f.half_length_m, 0), 0));
+  CHECK_TRUE(chk.is_self_point(dockcore::Vec2(-f.half_length_m, 0), dockcore::kPi));  // the wrapping sector
+  // An empty array clears them (a reload can remove sectors).
+  CHECK_EQUAL(0u, dockd::parse_config_toml("[robot.footprint]\nself_sectors_deg = []\n", "t.toml").footprint.self_sector_count);
+}
+
+TEST(DockdConfig, BadSelfSectorsAreRejectedWithPositions) {
+  STRCMP_CONTAINS("t.toml:2:20: robot.footprint.self_sectors_deg has 5 sectors (at most 4)",
+                  error_of("[robot.footprint]\nself_sectors_deg = [[1, 2], [3, 4], [5, 6], [7, 8], [9, 10]]\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:22: robot.footprint.self_sectors_deg must be a number, not a string",
+                  error_of("[robot.footprint]\nself_sectors_deg = [[\"a\", 2]]\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:37: robot.footprint.self_sectors_deg = 181 is out of range [-180, 180]",
+                  error_of("[robot.footprint]\nself_sectors_deg = [[80, 100], [10, 181]]\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:25: robot.footprint.self_sectors_deg is not finite",
+                  error_of("[robot.footprint]\nself_sectors_deg = [[1, nan]]\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:21: robot.footprint.self_sectors_deg sector 1 must be a [from_deg, to_deg] pair, not an array of 3",
+                  error_of("[robot.footprint]\nself_sectors_deg = [[1, 2, 3]]\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:21: robot.footprint.self_sectors_deg sector 1 must be a [from_deg, to_deg] pair, not an integer",
+                  error_of("[robot.footprint]\nself_sectors_deg = [1, 2]\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:20: robot.footprint.self_sectors_deg must be an array of [from_deg, to_deg] pairs, not an integer",
+                  error_of("[robot.footprint]\nself_sectors_deg = 90\n").c_str());
+  // -180 and 180 are one bearing: refused rather than read as "all round", which would hide every obstacle inside
+  // the body again.
+  STRCMP_CONTAINS("t.toml:2:21: robot.footprint.self_sectors_deg sector 1 [-180, 180] has from and to on the same bearing",
+                  error_of("[robot.footprint]\nself_sectors_deg = [[-180, 180]]\n").c_str());
 }
