@@ -150,6 +150,12 @@ class Row:
         return v[0] if v else None
 
 
+# Every limit counts one nominal 20 ms tick for the phase of dockd's loop. The tick itself may run late: a wheel-frame
+# gap up to 40 ms is still an un-starved loop (starvation is a gap over 40 ms), so a limit may be missed by up to one
+# more tick without the VM being called starved. That slack is added here, once, to every timing check.
+TICK_SLACK_MS = 20
+
+
 def nonzero(e):
     s = e["signals"]
     return bool(s.get("enable", 1)) and (s["wheel0"] != 0 or s["wheel1"] != 0)
@@ -248,10 +254,10 @@ def judge_row(argv):
         stall = tick_gap(wheels, t_f, t_z)
         figure("tick_gap_in_reaction_ms", f"{stall:.1f}")
         if a.limit_ms is not None:
-            why = f"{ms:.1f} ms > {a.limit_ms:g} ms"
+            why = f"{ms:.1f} ms > {a.limit_ms:g} ms + {TICK_SLACK_MS} ms tick slack"
             if stall > 40:
                 why += f"; dockd's wheel frames stalled {stall:.0f} ms inside the window: VM starvation"
-            check("reaction", ms <= a.limit_ms, why, starved=stall > 40)
+            check("reaction", ms <= a.limit_ms + TICK_SLACK_MS, why, starved=stall > 40)
     # The longest gap between dockd's wheel commands around the fault: a starved VM shows here (nominal 20 ms).
     around = [e["wall"] for e in wheels if t_f - 1.0 <= e["wall"] <= t_f + 1.0]
     gap = max((b - a_) for a_, b in zip(around, around[1:])) * 1000 if len(around) > 1 else float("nan")
@@ -269,11 +275,11 @@ def judge_row(argv):
             ms = (st["wall"] - t_f) * 1000
             figure("status_ms", f"{ms:.1f}")
             if a.status_limit_ms is not None:
-                why = f"{ms:.1f} ms > {a.status_limit_ms:g} ms"
+                why = f"{ms:.1f} ms > {a.status_limit_ms:g} ms + {TICK_SLACK_MS} ms tick slack"
                 stall = tick_gap(wheels, t_f, st["wall"])
                 if stall > 40:
                     why += f"; dockd's wheel frames stalled {stall:.0f} ms inside the window: VM starvation"
-                check("status_in_time", ms <= a.status_limit_ms, why, starved=stall > 40)
+                check("status_in_time", ms <= a.status_limit_ms + TICK_SLACK_MS, why, starved=stall > 40)
     t_hold_end = t_c if t_c is not None else (r.event(a.hold_end) if a.hold_end else None)
     if t_hold_end is None:
         t_hold_end = float("inf")
@@ -369,7 +375,7 @@ def main(argv):
         gap = max((b - a) for a, b in zip(ts, ts[1:])) * 1000 if len(ts) > 1 else float("nan")
         print(f"{gap:.1f} {len(ts)}")
         return 0
-    if cmd == "summary":
+    if cmd in ("summary", "table"):
         # Per row of one or more case results dirs: verdict, failed checks and every FIGURE (for docs/reliability.md).
         rows = {}
         for d in argv[2:]:
@@ -392,6 +398,33 @@ def main(argv):
                             e["pass"] += 1
                         else:
                             e["fig"][parts[1][len(row) + 1:]] = parts[2] if len(parts) > 2 else ""
+        if cmd == "table":
+            # Markdown rows for docs/reliability.md's measured table, in ROW_NAMES order.
+            print("| row | reaction (candump) | fault status | recovery | worst tick | other figures | verdict |")
+            print("|---|---|---|---|---|---|---|")
+            for row in ROW_NAMES:
+                e = rows.get(row)
+                if e is None:
+                    continue
+                f = dict(e["fig"])
+                react = f.pop("reaction_ms", "—")
+                if react not in ("—", "n/a", "none"):
+                    react += " ms"
+                gap = f.pop("tick_gap_in_reaction_ms", None)
+                if gap is not None and react.endswith(" ms"):
+                    react += f" (tick gap {float(gap):.0f} ms)"
+                status = f.pop("status_ms", None)
+                rec = f.pop("recovery_s", None)
+                worst = f.pop("worst_tick_ms", None)
+                for k in ("first_zero_ms", "wheel_gap_near_fault_ms", "tick_overruns"):
+                    f.pop(k, None)
+                other = ", ".join(f"{k} {v}" for k, v in f.items())
+                verdict = ("FAIL " + ",".join(e["fail"])) if e["fail"] else "PASS"
+                if e["starved"]:
+                    verdict += " (STARVED: " + ",".join(e["starved"]) + ")"
+                print(f"| `{row}` | {react} | {status + ' ms' if status else '—'} | {rec + ' s' if rec else '—'} | "
+                      f"{worst + ' ms' if worst else '—'} | {other or '—'} | {verdict} |")
+            return 0
         for row, e in rows.items():
             figs = " ".join(f"{k}={v}" for k, v in e["fig"].items())
             starved = f" starved: {','.join(e['starved'])}" if e["starved"] else ""
@@ -462,11 +495,19 @@ def main(argv):
         # follows a stall of dockd's own 20 ms wheel frames longer than the watchdog limit (200 ms) within the 1.5 s
         # before it (stale limit + fault_after) is the watchdog reacting, correctly, to dockd itself not running
         # (the TCG VM starved): excused, listed with the stall. Anything else is unexcused.
+        # The simulated robot starves too: chassis-sim logs "sim_scan_skipped" when its loop fell a scan period
+        # behind and skipped a turn; a 185 within 0.5 s after that is the simulated sensor's, excused likewise.
         r = Row(argv[2])
         wheels = [e["wall"] for e in r.wheels()]
+        skipped = r.events.get("sim_scan_skipped", [])
         unexcused, excused = [], []
         prev = 0
+        started = False
         for e in r.status():
+            # From the task's start on: before the first command the lidar may not have delivered yet (185 idle).
+            started = started or int(e["signals"]["state"]) != STATE["NOT_TASKING"]
+            if not started:
+                continue
             c = int(e["signals"]["fault"])
             if c and c != prev:
                 t = e["wall"]
@@ -474,6 +515,8 @@ def main(argv):
                 stall = max((b - a) for a, b in zip(ts, ts[1:])) * 1000 if len(ts) > 1 else 0.0
                 if c in (184, 185) and stall > 200:
                     excused.append(f"{c}(stall {stall:.0f} ms)")
+                elif c == 185 and any(t - 0.5 <= k <= t for k in skipped):
+                    excused.append(f"{c}(simulated lidar skipped a turn)")
                 else:
                     unexcused.append(str(c))
             prev = c

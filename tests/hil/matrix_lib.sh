@@ -71,15 +71,16 @@ rbg() {
 # is read by bash itself: `date` is a process start, which takes up to a second in the loaded VM.
 inject() { echo "$1 $EPOCHREALTIME" >> "$RD/inject.log"; }
 
-# row_start NAME [chassis-sim options...]: $ROW_SCENARIO (default scenario) and $ROW_TOML (extra dockd config
-# text appended, e.g. a [task] table) apply. Starts candump (dockcore ids 0x100-0x1FF only), chassis-sim, dockd.
+# row_start NAME [chassis-sim options...]: $ROW_SCENARIO (default scenario), $ROW_SED (sed expressions applied to
+# dockd-hil.toml, e.g. to change a key of a table it already has) and $ROW_TOML (extra dockd config text appended,
+# e.g. a [task] table) apply. Starts candump (dockcore ids 0x100-0x1FF only), chassis-sim, dockd.
 row_start() {
   ROW="$1"; shift
   RD="$OUT/$ROW"
   rm -rf "$RD"; mkdir -p "$RD"
   ROW_T0=$(hil_now)
   echo "INFO row $ROW begins at ${ROW_T0} s"
-  sed -e "s|@OUT@|$RD|g" "$SRC/tests/hil/dockd-hil.toml" > "$RD/dockd.toml"
+  sed -e "s|@OUT@|$RD|g" -e "${ROW_SED:-}" "$SRC/tests/hil/dockd-hil.toml" > "$RD/dockd.toml"
   if [ -n "${ROW_TOML:-}" ]; then printf '%s\n' "$ROW_TOML" >> "$RD/dockd.toml"; fi
   candump -L vcan0,100:700 > "$RD/candump.log" 2> "$RD/candump.stderr" &
   PID_candump=$!; HIL_PIDS+=("$PID_candump")

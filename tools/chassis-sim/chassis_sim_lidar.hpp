@@ -78,6 +78,7 @@ inline std::unique_ptr<dockcore::emu::LidarEmitter> open_lidar_out(const LidarOu
   e.drop_fraction = o.drop_fraction;
   e.seed = o.seed;
   e.rplidar_wait_for_scan_request = !o.rplidar_autostart;
+  e.paced = true;  // packets leave as the sensor sends them: main loop pumps every step
   return dockcore::emu::LidarEmitter::open(e, err);
 }
 

@@ -456,22 +456,24 @@ int run(const Options& opt) {
       }
     }
 
-    // 5. Lidar at the model's rate from the true pose.
+    // 5. Lidar at the model's rate from the true pose; the turn's packets leave paced over the next turn period.
+    lidar->pump(now_us);
+    last_scan_wall_us = lidar->stats().last_turn_written_wall_us;
     if (t >= next_scan_t) {
       next_scan_t += scan_period_s;
-      if (next_scan_t < t) next_scan_t = t + scan_period_s;  // fell behind (slow VM): skip, do not burst
+      if (next_scan_t < t) {
+        // Fell behind (slow VM): skip, do not burst. The truth log says so: the lidar rows of the HIL matrix must
+        // not blame dockd for a stale lidar that the simulated sensor caused (tests/hil/matrix.py faults-split).
+        next_scan_t = t + scan_period_s;
+        write_truth(truth, t, mt, chassis.state(), relay, silent, "sim_scan_skipped");
+      }
       if (!(motion_t0 >= 0 && mt < dropout_until)) {
         const bool occluded = motion_t0 >= 0 && mt < occluded_until;
         docksim::World w = occluded ? world_no_dock : world_with_dock;
         for (const auto& d : discs) w.add_circle(d.c, d.r);
         const Pose2 lidar_world = cs.true_pose.compose(sc.lidar_mount);
         docksim::simulate_scan(w, lidar_world, sc.lidar, lidar_rng, &scan, now_us);
-        if (lidar->emit_scan(scan.view())) {
-          ++scans_sent;
-          timespec sent_at{};
-          clock_gettime(CLOCK_REALTIME, &sent_at);
-          last_scan_wall_us = static_cast<std::int64_t>(sent_at.tv_sec) * 1000000 + sent_at.tv_nsec / 1000;
-        }
+        if (lidar->emit_scan(scan.view())) ++scans_sent;
       }
     }
     lidar_faults(*lidar, opt.lidar, mt, lidar_fault_state, [&](const char* ev) {

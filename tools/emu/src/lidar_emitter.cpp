@@ -4,6 +4,8 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <ctime>
+#include <deque>
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <pty.h>
@@ -23,6 +25,12 @@ struct LidarEmitter::Impl {
   RplidarEncoder rplidar;
   LakibeamEncoder lakibeam;
   std::vector<std::uint8_t> bytes;
+  struct Queued {
+    std::uint64_t due_us;
+    std::vector<std::uint8_t> bytes;
+    bool last_of_turn;
+  };
+  std::deque<Queued> queue;  ///< Paced mode: packets not yet due.
 };
 
 bool parse_emu_protocol(const std::string& name, EmuProtocol* out) {
@@ -235,7 +243,7 @@ bool LidarEmitter::emit_scan(const ScanView& scan) {
     case EmuProtocol::kLd06: {
       b.resize(static_cast<std::size_t>(scan_points_per_turn(scan) / 12 + 2) * kLd06PacketBytes);
       const std::size_t n = impl_->ld06.encode_scan(scan, static_cast<std::uint16_t>(ms_ % 30000u), b.data(), b.size());
-      send_stream_packets(b.data(), n, kLd06PacketBytes);
+      send_stream_packets(b.data(), n, kLd06PacketBytes, scan.stamp_us);
       break;
     }
     case EmuProtocol::kRplidar: {
@@ -248,7 +256,7 @@ bool LidarEmitter::emit_scan(const ScanView& scan) {
       }
       b.resize(static_cast<std::size_t>(scan_points_per_turn(scan)) * kRplidarNodeBytes);
       const std::size_t n = impl_->rplidar.encode_scan(scan, b.data(), b.size());
-      send_stream_packets(b.data(), n, kRplidarNodeBytes);
+      send_stream_packets(b.data(), n, kRplidarNodeBytes, scan.stamp_us);
       break;
     }
     case EmuProtocol::kLakibeam: {
@@ -263,10 +271,14 @@ bool LidarEmitter::emit_scan(const ScanView& scan) {
   return true;
 }
 
-void LidarEmitter::send_stream_packets(const std::uint8_t* data, std::size_t n, std::size_t packet_bytes) {
+void LidarEmitter::send_stream_packets(const std::uint8_t* data, std::size_t n, std::size_t packet_bytes,
+                                       std::uint64_t stamp_us) {
   std::vector<std::uint8_t> out;
   out.reserve(n);
-  for (std::size_t off = 0; off + packet_bytes <= n; off += packet_bytes) {
+  const bool paced = opt_.paced && stamp_us != 0 && udp_fd_ < 0 && n >= packet_bytes;
+  const std::size_t count = n / packet_bytes;
+  const double turn_us = 1e6 / opt_.rate_hz;
+  for (std::size_t off = 0, k = 0; off + packet_bytes <= n; off += packet_bytes, ++k) {
     ++stats_.packets;
     if (opt_.drop_fraction > 0 && uniform() < opt_.drop_fraction) {
       ++stats_.packets_dropped;
@@ -278,7 +290,13 @@ void LidarEmitter::send_stream_packets(const std::uint8_t* data, std::size_t n, 
       x = static_cast<std::uint8_t>(x ^ (1u << static_cast<unsigned>(uniform() * 8)));
       ++stats_.bytes_corrupted;
     }
+    if (paced) {
+      const auto due = stamp_us + static_cast<std::uint64_t>(turn_us * static_cast<double>(k + 1) / static_cast<double>(count));
+      impl_->queue.push_back({due, std::move(out), k + 1 == count});
+      out = std::vector<std::uint8_t>();
+    }
   }
+  if (paced) return;
   if (udp_fd_ >= 0) {
     // LD06 over UDP: ten packets per datagram.
     const std::size_t chunk = 10 * packet_bytes;
@@ -294,9 +312,36 @@ void LidarEmitter::send_stream_packets(const std::uint8_t* data, std::size_t n, 
       if (w == static_cast<ssize_t>(d.size())) stats_.bytes_written += d.size();
       else stats_.bytes_unwritten += d.size();
     }
+    note_turn_written();
     return;
   }
   write_bytes(out);
+  note_turn_written();
+}
+
+void LidarEmitter::note_turn_written() {
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  stats_.last_turn_written_wall_us = static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
+}
+
+void LidarEmitter::pump(std::uint64_t now_us) {
+  auto& q = impl_->queue;
+  if (q.empty()) return;
+  if (stalled_ || !plugged()) {
+    stats_.paced_packets_discarded += q.size();
+    q.clear();
+    return;
+  }
+  std::vector<std::uint8_t> out;
+  bool turn_done = false;
+  while (!q.empty() && q.front().due_us <= now_us) {
+    out.insert(out.end(), q.front().bytes.begin(), q.front().bytes.end());
+    turn_done = turn_done || q.front().last_of_turn;
+    q.pop_front();
+  }
+  if (!out.empty()) write_bytes(out);
+  if (turn_done) note_turn_written();
 }
 
 void LidarEmitter::write_bytes(std::vector<std::uint8_t>& bytes) {

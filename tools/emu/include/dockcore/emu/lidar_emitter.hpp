@@ -43,6 +43,12 @@ struct LidarEmitterOptions {
   std::uint64_t seed = 1;         ///< Seeds the fault injection (deterministic for a seed).
   /// RPLIDAR: stream nodes only after the host sent SCAN (A5 20), as the sensor does; false = stream at once.
   bool rplidar_wait_for_scan_request = true;
+  /// pty mode: send each packet (LD06) / node (RPLIDAR) when the sensor would, spread over the turn that begins at
+  /// the scan's stamp (packet k of n at stamp + (k+1)/n turn periods), instead of the whole turn at once; the owner
+  /// calls pump() at least every few ms. A turn sent at once carries packet timestamps up to a turn in the future of
+  /// its arrival, which a receiver mapping the sensor clock (dockd) reads as a turn measured a period earlier than it
+  /// was rendered. Needs scans with a stamp (monotonic µs); unstamped scans are sent at once.
+  bool paced = false;
 };
 
 /// What the emitter did (all monotonic counters).
@@ -55,6 +61,10 @@ struct LidarEmitterStats {
   std::uint64_t bytes_unwritten = 0;  ///< Bytes that could not be written without blocking (pty full, EAGAIN).
   std::uint64_t bytes_corrupted = 0;  ///< Bytes with a flipped bit.
   std::uint64_t requests_seen = 0;    ///< RPLIDAR requests (A5 xx) read from the host.
+  /// CLOCK_REALTIME µs at which the last turn's final packet was written (paced or not); 0 = none yet. The reference
+  /// of chassis-sim's "last good scan" for the stale-lidar rows.
+  std::int64_t last_turn_written_wall_us = 0;
+  std::uint64_t paced_packets_discarded = 0;  ///< Queued packets dropped because the sensor stalled or was unplugged.
 };
 
 class LidarEmitter {
@@ -73,6 +83,9 @@ class LidarEmitter {
   /// Reads and answers pending RPLIDAR requests (SCAN -> descriptor, STOP, GET_HEALTH -> health). emit_scan calls
   /// it; call it yourself between scans for a faster reply. No-op for other protocols.
   void service_requests();
+  /// Paced mode: writes the queued packets due at monotonic `now_us`; drops the queue while stalled or unplugged
+  /// (the sensor stopped mid-turn). No-op otherwise. O(packets written).
+  void pump(std::uint64_t now_us);
 
   /// Stops sending (the sensor freezes) while true; the pty stays open.
   void set_stalled(bool stalled) { stalled_ = stalled; }
@@ -100,7 +113,8 @@ class LidarEmitter {
   explicit LidarEmitter(const LidarEmitterOptions& options);
   bool open_pty(std::string& error);
   bool open_udp(std::string& error);
-  void send_stream_packets(const std::uint8_t* data, std::size_t n, std::size_t packet_bytes);
+  void send_stream_packets(const std::uint8_t* data, std::size_t n, std::size_t packet_bytes, std::uint64_t stamp_us);
+  void note_turn_written();
   void write_bytes(std::vector<std::uint8_t>& bytes);
   void send_datagram(const std::uint8_t* data, std::size_t n);
   double uniform();
