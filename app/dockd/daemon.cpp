@@ -692,6 +692,7 @@ void Daemon::on_tick(std::uint64_t now_us) {
     }
     // Dock (and undock on the contacts) are accepted from FAULT directly: the task manager clears the fault.
     in.command = dockcore::HostCommand{cmd.type, cmd.dock_id};
+    in.resume = cmd.resume;  // the core keeps the pre-outage dock for the push test (docs/faults.md, 178)
     ++counters_.commands;
   }
 

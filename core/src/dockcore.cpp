@@ -10,6 +10,8 @@ bool Dockcore::configure(const DockProfile& profile, const DockcoreConfig& confi
   pending_count_ = 0;
   pending_dropped_ = 0;
   filter_confirmed_ = false;
+  restart_ref_set_ = false;
+  push_ref_set_ = false;
   last_estimate_ = DockEstimate{};
   prev_state_ = TaskState::kNotTasking;
   return estimator_.configure(profile, config.estimator);
@@ -43,6 +45,13 @@ const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_
     d.expectation_set = true;
     d.expectation_confirmed = filter_.initialised() && filter_confirmed_;
     if (d.expectation_confirmed) d.expected_in_odom = filter_.dock_in_odom();
+    if (push_ref_set_) {  // a resumed task: the pre-outage estimate, not the filter restarted since
+      d.expectation_confirmed = true;
+      d.expected_in_odom = push_ref_in_odom_;
+    }
+    const bool was_confirmed = filter_.initialised() && filter_confirmed_;
+    const Pose2 before = filter_.dock_in_odom();
+    const std::uint64_t before_us = filter_.last_update_us();
     if (pending_count_ < kMaxDetectionsPerTick) {
       pending_[pending_count_++] = d;
     } else {
@@ -52,6 +61,11 @@ const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_
     // A (re)started filter rests on this one detection, which may be clutter: confirmed once a second detection
     // agrees with it (is fused).
     if (u == FilterUpdate::kInitialised || u == FilterUpdate::kReinitialised) filter_confirmed_ = false;
+    if (u == FilterUpdate::kReinitialised && was_confirmed) {  // the estimate a resume may still need
+      restart_ref_set_ = true;
+      restart_ref_in_odom_ = before;
+      restart_ref_us_ = before_us;
+    }
     if (u == FilterUpdate::kFused) filter_confirmed_ = true;
   }
   return last_estimate_;
@@ -83,13 +97,38 @@ TickOutput Dockcore::tick(const TickInput& in) {
   t.detection_count = pending_count_;
   pending_count_ = 0;
 
+  const TaskState before = tasks_.state();
   TickOutput out = tasks_.tick(t);
   // A new dock task: forget the old dock (the robot may have been carried since), so the push test and the
-  // controller start from this task's own detections.
+  // controller start from this task's own detections. A resumed one keeps the pre-outage estimate for the push test.
   if (out.status.state == TaskState::kGetTaskingCmd && prev_state_ != TaskState::kGetTaskingCmd) {
+    push_ref_set_ = false;
+    if (in.resume && in.command.type == HostCommandType::kDock) {
+      // The filter may have restarted at a pushed pose while the task stood in the fault: its estimate from before
+      // that restart is the pre-outage one.
+      const bool own = filter_.initialised() && filter_confirmed_ && !restart_ref_set_;
+      const std::uint64_t ref_us = own ? filter_.last_update_us() : restart_ref_us_;
+      if ((own || restart_ref_set_) &&
+          (in.now_us <= ref_us ||
+           static_cast<Real>(in.now_us - ref_us) * static_cast<Real>(1e-6) <= config_.push_check_max_gap_s)) {
+        push_ref_set_ = true;
+        push_ref_in_odom_ = own ? filter_.dock_in_odom() : restart_ref_in_odom_;
+      }
+    }
+    restart_ref_set_ = false;
     filter_.reset();
     filter_confirmed_ = false;
   }
+  // A detection in ALIGN agreed with the push test's reference: the reference has done its job (no push), and an
+  // earlier restart was no push either (the restarted filter is the reference now). Both end with the task.
+  const bool agreed = before == TaskState::kAlign && t.detection_count > 0 && !tasks_.push_suspected() &&
+                      out.status.state == TaskState::kAlign;
+  const bool ended = out.status.state == TaskState::kNotTasking || out.status.state == TaskState::kFinishTasking;
+  if (agreed || ended) {
+    push_ref_set_ = false;
+    restart_ref_set_ = false;
+  }
+  if (out.status.state == TaskState::kFault) push_ref_set_ = false;
   prev_state_ = out.status.state;
   return out;
 }

@@ -536,3 +536,44 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   r.host.command(1, 0);
   CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 90.0));
 }
+
+// Issue #6 HIL: dockd stalled ~0.9 s around a 0.5 m push and then dropped the late scans. The core's scan-age
+// backstop faulted 185, the watchdog resume re-issued the dock command once scans were fresh, the new task restarted
+// the filter at the pushed pose, and the robot docked from there. Pushed (sideways 0.5 m, or turned 40 deg about the
+// dock) during a gap of late scans, the resumed task must report the push (178/179) and not dock.
+TEST(DockdDaemon, PushDuringALateScanGapIsReportedAfterTheResume) {
+  const double gaps_s[] = {0.6, 1.0, 2.0};
+  for (const double gap_s : gaps_s) {
+    for (int turned = 0; turned <= 1; ++turned) {
+      char what[64];
+      std::snprintf(what, sizeof what, "gap %.1f s %s", gap_s, turned != 0 ? "turned" : "sideways");
+      Rig r("pushgap");
+      r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+      r.host.command(1, 0);
+      CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kAlign && !r.wheels_zero(); }, 20.0));
+      r.run_until([] { return false; }, 0.3);
+      r.scan_lag_us = 600000;  // every scan arrives measured 0.6 s ago: dropped as late
+      const int n = static_cast<int>(gap_s / 0.02 + 0.5);
+      for (int i = 0; i < n; ++i) {
+        if (i == n / 2) {
+          dockcore::Pose2 p = r.chassis->state().true_pose;
+          if (turned != 0) {
+            const dockcore::Pose2 dock = r.sc.dock_pose;
+            p = dock.compose(dockcore::Pose2{0, 0, dockcore::deg_to_rad(static_cast<dockcore::Real>(40))})
+                    .compose(dock.inverse().compose(p));
+          } else {
+            p = p.compose(dockcore::Pose2{0, 0.5, 0});
+          }
+          r.chassis->set_true_pose(p);
+        }
+        r.tick();
+      }
+      r.scan_lag_us = 0;
+      const int want = turned != 0 ? 179 : 178;
+      CHECK_TEXT(r.run_until([&] { return static_cast<int>(r.daemon->fault()) == want ||
+                                          r.daemon->state() == TaskState::kFinishTasking; }, 30.0), what);
+      CHECK_EQUAL_TEXT(want, static_cast<int>(r.daemon->fault()), what);
+      CHECK_TEXT(r.wheels_zero(), what);
+    }
+  }
+}

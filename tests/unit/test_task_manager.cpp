@@ -789,14 +789,16 @@ struct FacadeSim {
     cfg.task.detect_wait_s = 0.3;
     CHECK(core->configure(w.profile, cfg));
   }
-  TickOutput step(HostCommand cmd = HostCommand{}) {
-    if (w.ticks % 5 == 0) {
+  bool scans_on = true;  // false: a lidar gap (the host drops late scans); ticks and odometry go on
+  TickOutput step(HostCommand cmd = HostCommand{}, bool resume = false) {
+    if (scans_on && w.ticks % 5 == 0) {
       simulate_scan(w.world_model(), w.world, w.model, w.rng, &w.scan, w.now_us);
       core->on_scan(w.scan.view(), w.now_us, w.odom);
     }
     TickInput in;
     in.now_us = w.now_us;
     in.command = cmd;
+    in.resume = resume;
     in.odom_pose = w.odom;
     in.contact = w.contact;
     const bool current = w.contact && w.charge_enable && w.now_us - w.contact_since_us >= 500000;
@@ -906,6 +908,84 @@ TEST(Dockcore, PushFollowedByAScanBacklogIsStillReported) {
       LONGS_EQUAL(turned != 0 ? 179 : 178, static_cast<int>(o.status.fault));
       CHECK(o.cmd.vx_mps == 0 && o.cmd.wz_radps == 0);
       LONGS_EQUAL(backlog > 8 ? backlog - 8 : 0, static_cast<long>(f.core->detections_dropped()));
+    }
+  }
+}
+
+// HIL finding (issue #6): dockd stalled ~0.9 s around a 0.5 m push and then dropped the late scans, so the core got
+// no detection for ~1 s and then only post-push ones. Wheel odometry runs through a lidar gap, so the pre-gap estimate
+// carried by odometry is still the expectation: the push must be reported on the second agreeing post-gap detection
+// (178 sideways, 179 turned about the dock). When the ticks ran through the gap the scan-age backstop (185 after
+// lidar_stale_s) stops the robot first, and dockd's watchdog resume re-issues the dock command: the resumed task must
+// still report the push (it docked from the pushed pose: the new task had reset the filter and the push test had no
+// pre-push reference). `ticking`: the host kept ticking through the gap (dropped scans) or stalled (no ticks).
+TEST(Dockcore, PushDuringALidarGapIsStillReported) {
+  const double gaps_s[] = {0.6, 1.0, 2.0};
+  for (int ticking = 0; ticking <= 1; ++ticking) {
+    for (const double gap_s : gaps_s) {
+      for (int turned = 0; turned <= 1; ++turned) {
+        char what[96];
+        std::snprintf(what, sizeof what, "gap %.1f s, %s, %s", gap_s, turned != 0 ? "turned" : "sideways",
+                      ticking != 0 ? "ticking" : "stalled");
+        FacadeSim f;
+        f.step(HostCommand{HostCommandType::kDock, 0});
+        CHECK_TEXT(f.run_until(TaskState::kAlign, 5), what);
+        for (int i = 0; i < 25; ++i) f.step();
+        while (f.w.ticks % 5 != 1) f.step();  // just after a scan
+        const int gap_ticks = static_cast<int>(gap_s / 0.02 + 0.5);
+        FaultCode fault = FaultCode::kNone;
+        f.scans_on = false;
+        for (int k = 0; k < gap_ticks; ++k) {
+          if (k == gap_ticks / 2) {
+            if (turned != 0) {
+              f.w.world = Pose2{0, 0, deg_to_rad(static_cast<Real>(40))}.compose(f.w.world);
+            } else {
+              f.w.world = f.w.world.compose(Pose2{0, 0.5, 0});
+            }
+          }
+          if (ticking != 0) {
+            const TickOutput o = f.step();
+            if (o.status.state == TaskState::kFault && fault == FaultCode::kNone) fault = o.status.fault;
+          } else {
+            f.w.now_us += Sim::kTickUs;  // the host stalls: no tick; the wheels stop (motor timeout)
+            ++f.w.ticks;
+          }
+        }
+        // The gap ends with a fresh scan handed over before the next tick (HIL: late scans dropped, then a fresh one).
+        while (f.w.ticks % 5 != 0) {
+          f.w.now_us += Sim::kTickUs;
+          ++f.w.ticks;
+        }
+        f.scans_on = true;
+        if (fault != FaultCode::kNone) {
+          // The scan-age backstop fired in the gap (documented: lidar_stale_s), the robot stands. A host's watchdog
+          // resume re-issues the dock command once scans are fresh again (dockd: after 0.5 s); the resumed task
+          // must still report the push, not dock on from the pushed pose.
+          LONGS_EQUAL_TEXT(185, static_cast<int>(fault), what);
+          CHECK_TEXT(ticking != 0 && gap_s > 0.5, what);
+          const Pose2 at = f.w.world;
+          for (int i = 0; i < 25; ++i) f.step();
+          CHECK_TEXT(f.core->task_manager().state() == TaskState::kFault, what);
+          const Pose2 moved = at.inverse().compose(f.w.world);
+          CHECK_TEXT(std::fabs(moved.x_m) < 1e-4 && std::fabs(moved.y_m) < 1e-4, what);  // float rounding only
+          f.step(HostCommand{HostCommandType::kDock, 0}, true);
+          TickOutput o;
+          for (int i = 0; i < 500; ++i) {
+            o = f.step();
+            if (o.status.state == TaskState::kFault || o.status.state == TaskState::kFinishTasking) break;
+          }
+          CHECK_TEXT(o.status.state == TaskState::kFault, what);
+          LONGS_EQUAL_TEXT(turned != 0 ? 179 : 178, static_cast<int>(o.status.fault), what);
+          continue;
+        }
+        while (f.w.ticks % 5 != 0) f.step();
+        const TickOutput first = f.step();  // first post-gap detection: suspect only
+        CHECK_TEXT(first.status.state == TaskState::kAlign, what);
+        while (f.w.ticks % 5 != 0) f.step();
+        const TickOutput o = f.step();  // the second, agreeing one confirms the push
+        CHECK_TEXT(o.status.state == TaskState::kFault, what);
+        LONGS_EQUAL_TEXT(turned != 0 ? 179 : 178, static_cast<int>(o.status.fault), what);
+      }
     }
   }
 }

@@ -13,7 +13,11 @@
 ///   (DockInput::confirmed). Recording the expectation per detection matters when several scans arrive between two
 ///   ticks (a host draining a backlog after a stall): the filter restarts at a pushed pose on its third jump, and a
 ///   test against the filter as it is at the tick would find nothing wrong.
-/// The filter is reset when a new dock task starts (the robot may have been carried since the last one).
+/// The filter is reset when a new dock task starts (the robot may have been carried since the last one). A resumed
+/// dock command (TickInput::resume: the host's watchdog re-issues a command a lidar/chassis outage interrupted) resets
+/// it too, but the push test keeps the confirmed estimate from before the outage as its reference — the filter's own,
+/// or the one it had before it restarted at a pushed pose during the outage — carried by odometry, up to
+/// DockcoreConfig::push_check_max_gap_s old, until a detection in ALIGN agrees with it (docs/faults.md, 178).
 /// No heap; the object is large (estimator buffers plus one LaserScan copy, ~360 kB with double): keep it static or
 /// a member, never on a small stack.
 
@@ -38,6 +42,11 @@ struct DockcoreConfig {
   FootprintParams footprint{};
   Pose2 lidar_mount{};                               ///< Lidar in the robot frame.
   Real lidar_stale_s = static_cast<Real>(0.5);       ///< No scan for this long: lidar stale (fault 185 when moving).
+  /// A resumed dock command (TickInput::resume) keeps the dock estimate from before the outage as the push test's
+  /// reference when its last detection is at most this old at the resume (s). Wheel odometry runs through a lidar
+  /// outage, so the old estimate carried by odometry still says where the dock must be; beyond this, odometry drift
+  /// (and the chance that the robot was carried) make it no evidence of a push, and the task starts afresh.
+  Real push_check_max_gap_s = static_cast<Real>(3.0);
 };
 
 /// Per-tick input from the chassis and the host.
@@ -51,6 +60,11 @@ struct TickInput {
   Real charge_current_a = 0;
   bool chassis_ok = true;     ///< Chassis feedback fresh (host's judgement).
   bool lidar_ok = true;       ///< Host's lidar health; Dockcore also checks scan age against lidar_stale_s.
+  /// `command` re-issues a dock command that a data-outage fault (lidar/chassis stale) interrupted — the host's
+  /// watchdog resume — not a new task: the robot has not been carried, so a push during the outage must still be
+  /// reported (178/179). Dockcore then keeps the pre-outage dock estimate (push_check_max_gap_s) as the push test's
+  /// reference until a detection in ALIGN has agreed with it. False for every command a host or operator sends.
+  bool resume = false;
 };
 
 using TickOutput = TaskOutput;
@@ -92,6 +106,13 @@ class Dockcore {
   std::uint32_t pending_dropped_ = 0;  ///< Detections beyond kMaxDetectionsPerTick between two ticks (not tested).
   TaskState prev_state_ = TaskState::kNotTasking;
   bool filter_confirmed_ = false;  ///< The filter fused a detection since its last (re)initialisation.
+  /// The confirmed estimate from before the filter's most recent restart (this task), for a resumed command.
+  bool restart_ref_set_ = false;
+  Pose2 restart_ref_in_odom_{};
+  std::uint64_t restart_ref_us_ = 0;  ///< Last detection fused into it.
+  /// The push test's reference after a resume (see TickInput::resume), replacing the restarted filter.
+  bool push_ref_set_ = false;
+  Pose2 push_ref_in_odom_{};
 };
 
 }  // namespace dockcore

@@ -202,6 +202,8 @@ class TaskManager {
   TaskOutput tick(const TaskInput& in);
 
   TaskState state() const { return state_; }
+  /// A detection failed the push test and the next agreeing one would raise 178/179 (ALIGN). O(1).
+  bool push_suspected() const { return deviation_count_ > 0; }
   FaultCode fault() const { return fault_; }
   const TaskParams& params() const { return params_; }
   const ObstacleChecker& obstacle_checker() const { return obstacles_; }
