@@ -187,13 +187,28 @@ def judge_row(argv):
     # only (no_motion_while_status_faulted), not by the window reaction..clear.
     ap.add_argument("--hold-by-status", action="store_true")
     ap.add_argument("--log", help="candump-format log to judge, relative to the row (default candump.log)")
+    # Push rows: a stall of dockd's own loop longer than this around the fault (1 s either side) means the VM, not the
+    # product, decided the row: every failing check is reported STARVED (docs/reliability.md, push rows).
+    ap.add_argument("--starved-if-stall-ms", type=float)
     a = ap.parse_args(argv)
     r = Row(a.dir, a.log)
     name = a.row
     fails = 0
+    row_stall = None
+    if a.starved_if_stall_ms is not None:
+        t0 = r.event(a.fault)
+        if t0 is not None:
+            near = [e["wall"] for e in r.wheels() if t0 - 1.0 <= e["wall"] <= t0 + 1.0]
+            g = max((b - x) for x, b in zip(near, near[1:])) * 1000 if len(near) > 1 else 2000.0
+            if g > a.starved_if_stall_ms:
+                row_stall = g
 
     def check(what, ok, why="", starved=False):
         nonlocal fails
+        if row_stall is not None:
+            starved = True
+            why = (why + "; " if why else "") + (f"dockd's wheel frames stalled {row_stall:.0f} ms around the fault "
+                                                  f"(> {a.starved_if_stall_ms:g} ms): VM starvation")
         # A timing check whose window shows dockd's own 20 ms wheel frames stalled (the TCG VM or the loop not
         # running) cannot judge dockd's reaction: it is reported as STARVED (counted, never silent) instead of
         # failing, unless HIL_STRICT_TIMING=1. Functional checks (codes, holds, recoveries) always count.
