@@ -511,10 +511,11 @@ def main(argv):
         # before it (stale limit + fault_after) is the watchdog reacting, correctly, to dockd itself not running
         # (the TCG VM starved): excused, listed with the stall. Anything else is unexcused.
         # The simulated robot starves too: chassis-sim logs "sim_scan_skipped" when its loop fell a scan period
-        # behind and skipped a turn; a 185 within 0.5 s after that is the simulated sensor's, excused likewise.
+        # behind and skipped a turn, and "sim_lidar_late" when its paced LD06 packets left > 50 ms after their time;
+        # a 185 within 0.5 s after either is the simulated sensor's, excused likewise.
         r = Row(argv[2])
         wheels = [e["wall"] for e in r.wheels()]
-        skipped = r.events.get("sim_scan_skipped", [])
+        skipped = r.events.get("sim_scan_skipped", []) + r.events.get("sim_lidar_late", [])
         unexcused, excused = [], []
         prev = 0
         started = False
@@ -531,7 +532,7 @@ def main(argv):
                 if c in (184, 185) and stall > 200:
                     excused.append(f"{c}(stall {stall:.0f} ms)")
                 elif c == 185 and any(t - 0.5 <= k <= t for k in skipped):
-                    excused.append(f"{c}(simulated lidar skipped a turn)")
+                    excused.append(f"{c}(simulated lidar skipped a turn or sent late)")
                 else:
                     unexcused.append(str(c))
             prev = c

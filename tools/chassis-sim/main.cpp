@@ -228,6 +228,7 @@ int run(const Options& opt) {
   v1::CounterTracker cmd_tracker;
   LidarFaultState lidar_fault_state;
   std::int64_t last_scan_wall_us = 0;
+  std::uint64_t lidar_late_seen = 0;
   double charging_since_t = -1;
   bool contact_broken = false;
   // A LaserScan is ~64 kB: keep it off the stack.
@@ -459,6 +460,12 @@ int run(const Options& opt) {
     // 5. Lidar at the model's rate from the true pose; the turn's packets leave paced over the next turn period.
     lidar->pump(now_us);
     last_scan_wall_us = lidar->stats().last_turn_written_wall_us;
+    if (lidar->stats().paced_packets_late != lidar_late_seen) {
+      // This process ran late and the simulated sensor's packets left > 50 ms after their time: a stale lidar in
+      // dockd right after is the simulator's, not dockd's (tests/hil/matrix.py faults-split).
+      lidar_late_seen = lidar->stats().paced_packets_late;
+      write_truth(truth, t, mt, chassis.state(), relay, silent, "sim_lidar_late");
+    }
     if (t >= next_scan_t) {
       next_scan_t += scan_period_s;
       if (next_scan_t < t) {
