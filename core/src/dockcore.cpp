@@ -43,13 +43,13 @@ const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_
     d.odom_at_scan = odom_pose;
     d.stamp_us = stamp_us;
     d.expectation_set = true;
-    d.expectation_confirmed = filter_.initialised() && filter_confirmed_;
-    if (d.expectation_confirmed) d.expected_in_odom = filter_.dock_in_odom();
+    const bool was_confirmed = filter_.initialised() && filter_confirmed_;
+    d.expectation_confirmed = was_confirmed;
+    if (was_confirmed) d.expected_in_odom = filter_.dock_in_odom();
     if (push_ref_set_) {  // a resumed task: the pre-outage estimate, not the filter restarted since
       d.expectation_confirmed = true;
       d.expected_in_odom = push_ref_in_odom_;
     }
-    const bool was_confirmed = filter_.initialised() && filter_confirmed_;
     const Pose2 before = filter_.dock_in_odom();
     const std::uint64_t before_us = filter_.last_update_us();
     if (pending_count_ < kMaxDetectionsPerTick) {

@@ -31,7 +31,8 @@ candump log's stamps, chassis-sim's truth "wall" field and the case's inject log
   matrix.py summary CASE_DIR...       -> one line per row: verdict, failed checks, figures (job.log + post.log)
   matrix.py delta ROW_DIR EV1 EV2     -> ms from the first EV1 to the first EV2 at or after it (truth/inject events)
   matrix.py last-signal ROW_DIR FRAME SIGNAL -> that signal in the last frame of that name (dock-decode names)
-  matrix.py faults ROW_DIR            -> distinct non-zero DockStatus fault codes in order
+  matrix.py faults-split ROW_DIR      -> "UNEXCUSED;EXCUSED" fault codes since the task started (VM-starvation split)
+  matrix.py table CASE_DIR...         -> the measured table of docs/reliability.md (markdown)
   matrix.py states ROW_DIR            -> deduplicated DockStatus state sequence
 """
 import json
@@ -161,12 +162,16 @@ def nonzero(e):
     return bool(s.get("enable", 1)) and (s["wheel0"] != 0 or s["wheel1"] != 0)
 
 
+def max_gap_ms(times, empty=0.0):
+    """Longest gap (ms) between consecutive wall times (s, ascending); `empty` when there are fewer than two."""
+    return max((b - a) for a, b in zip(times, times[1:])) * 1000 if len(times) > 1 else empty
+
+
 def tick_gap(wheels, t0, t1):
     """Longest gap (ms) between dockd's consecutive wheel frames from the last one before t0 to t1: dockd sends one
     every 20 ms tick, so a longer gap is its loop (or the VM) not running."""
     before = [e["wall"] for e in wheels if e["wall"] < t0]
-    win = before[-1:] + [e["wall"] for e in wheels if t0 <= e["wall"] <= t1]
-    return max((b - a) for a, b in zip(win, win[1:])) * 1000 if len(win) > 1 else 0.0
+    return max_gap_ms(before[-1:] + [e["wall"] for e in wheels if t0 <= e["wall"] <= t1])
 
 
 def judge_row(argv):
@@ -198,8 +203,7 @@ def judge_row(argv):
     if a.starved_if_stall_ms is not None:
         t0 = r.event(a.fault)
         if t0 is not None:
-            near = [e["wall"] for e in r.wheels() if t0 - 1.0 <= e["wall"] <= t0 + 1.0]
-            g = max((b - x) for x, b in zip(near, near[1:])) * 1000 if len(near) > 1 else 2000.0
+            g = max_gap_ms([e["wall"] for e in r.wheels() if t0 - 1.0 <= e["wall"] <= t0 + 1.0], 2000.0)
             if g > a.starved_if_stall_ms:
                 row_stall = g
 
@@ -231,8 +235,7 @@ def judge_row(argv):
     if not a.no_moving_check:
         # A watchdog hold caused by dockd's own loop stalling just before the fault (the VM starved) can leave the
         # robot standing at the fault time: that row cannot show a reaction, reported as STARVED.
-        recent = [e["wall"] for e in before if e["wall"] >= t_f - 0.5]
-        pre_stall = max((b - a_) for a_, b in zip(recent, recent[1:])) * 1000 if len(recent) > 1 else 0.0
+        pre_stall = max_gap_ms([e["wall"] for e in before if e["wall"] >= t_f - 0.5])
         check("moving_at_fault", bool(before) and nonzero(before[-1]),
               "the last wheel command before the fault was zero: nothing to stop" +
               (f"; dockd's wheel frames stalled {pre_stall:.0f} ms in the 0.5 s before: VM starvation"
@@ -274,8 +277,7 @@ def judge_row(argv):
                 why += f"; dockd's wheel frames stalled {stall:.0f} ms inside the window: VM starvation"
             check("reaction", ms <= a.limit_ms + TICK_SLACK_MS, why, starved=stall > 40)
     # The longest gap between dockd's wheel commands around the fault: a starved VM shows here (nominal 20 ms).
-    around = [e["wall"] for e in wheels if t_f - 1.0 <= e["wall"] <= t_f + 1.0]
-    gap = max((b - a_) for a_, b in zip(around, around[1:])) * 1000 if len(around) > 1 else float("nan")
+    gap = max_gap_ms([e["wall"] for e in wheels if t_f - 1.0 <= e["wall"] <= t_f + 1.0], float("nan"))
     figure("wheel_gap_near_fault_ms", f"{gap:.1f}")
     t_c = r.event(a.clear) if a.clear else None
     if a.clear and t_c is None:
@@ -387,8 +389,7 @@ def main(argv):
         r = Row(argv[2])
         t0, t1 = float(argv[3]), float(argv[4])
         ts = [e["wall"] for e in r.wheels() if t0 <= e["wall"] <= t1]
-        gap = max((b - a) for a, b in zip(ts, ts[1:])) * 1000 if len(ts) > 1 else float("nan")
-        print(f"{gap:.1f} {len(ts)}")
+        print(f"{max_gap_ms(ts, float('nan')):.1f} {len(ts)}")
         return 0
     if cmd in ("summary", "table"):
         # Per row of one or more case results dirs: verdict, failed checks and every FIGURE (for docs/reliability.md).
@@ -496,15 +497,6 @@ def main(argv):
         e = next((e for e in r.wheels() if t is not None and e["wall"] >= t), None)
         print("none" if e is None else ("zero" if not nonzero(e) else "moving"))
         return 0
-    if cmd == "faults":
-        r = Row(argv[2])
-        seq = []
-        for e in r.status():
-            c = int(e["signals"]["fault"])
-            if c and (not seq or seq[-1] != c):
-                seq.append(c)
-        print(" ".join(map(str, seq)))
-        return 0
     if cmd == "faults-split":
         # "UNEXCUSED;EXCUSED": fault codes of the status frames, split by cause. A watchdog fault (184/185) whose onset
         # follows a stall of dockd's own 20 ms wheel frames longer than the watchdog limit (200 ms) within the 1.5 s
@@ -527,8 +519,7 @@ def main(argv):
             c = int(e["signals"]["fault"])
             if c and c != prev:
                 t = e["wall"]
-                ts = [w for w in wheels if t - 1.5 <= w <= t]
-                stall = max((b - a) for a, b in zip(ts, ts[1:])) * 1000 if len(ts) > 1 else 0.0
+                stall = max_gap_ms([w for w in wheels if t - 1.5 <= w <= t])
                 if c in (184, 185) and stall > 200:
                     excused.append(f"{c}(stall {stall:.0f} ms)")
                 elif c == 185 and any(t - 0.5 <= k <= t for k in skipped):

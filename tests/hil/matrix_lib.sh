@@ -28,11 +28,12 @@ judge_now() {
 }
 
 # check_no_fault NAME: no fault in the row's status frames (host side). Watchdog faults that followed a stall of
-# dockd's own loop (matrix.py faults-split) are reported as STARVED instead, unless HIL_STRICT_TIMING=1.
+# dockd's own loop (matrix.py faults-split) are reported as STARVED instead, unless HIL_STRICT_TIMING=1. Leaves the
+# split in FAULTS_SPLIT.
 check_no_fault() {
-  local split unexc exc
-  split=$($MATRIX_PY faults-split "$RD")
-  unexc=${split%%;*}; exc=${split#*;}
+  local unexc exc
+  FAULTS_SPLIT=$($MATRIX_PY faults-split "$RD")  # kept for the caller (e.g. the flood rows' state check)
+  unexc=${FAULTS_SPLIT%%;*}; exc=${FAULTS_SPLIT#*;}
   echo "INFO $1 faults: '$unexc' starvation-excused: '$exc'"
   if [ -z "$unexc" ] && [ -n "$exc" ] && [ "${HIL_STRICT_TIMING:-0}" != 1 ]; then
     echo "STARVED ${1}_no_fault  (watchdog faults $exc right after dockd's loop stalled: VM starvation)"

@@ -15,7 +15,7 @@ post_flood() {
   states=$($MATRIX_PY states "$RD"); echo "INFO $ROW states: $states"
   # The docking ran once through to charging (4), never cancelled back to NOT_TASKING (0) on the way; a watchdog
   # FAULT (8) with its resume (1 2 3 ...) is allowed only when check_no_fault excused it as starvation above.
-  if [ "$($MATRIX_PY faults-split "$RD")" = ";" ] || [ "${HIL_STRICT_TIMING:-0}" = 1 ]; then
+  if [ "$FAULTS_SPLIT" = ";" ] || [ "${HIL_STRICT_TIMING:-0}" = 1 ]; then
     check "${ROW}_state_sequence" grep -qE '^0 1 (2 )?3 5 4$' <<< "$states"
   else
     check "${ROW}_state_sequence" grep -qE '^0 1 (2 )?3 ([0-9 ]* )?5 4$' <<< "${states// 0 / X }"
