@@ -25,6 +25,7 @@ candump log's stamps, chassis-sim's truth "wall" field and the case's inject log
   matrix.py frame ID HEX14            -> cansend "ID#DATA" with the dockcore v1 CRC-8 appended (7 data bytes given)
   matrix.py last-counter CANDUMP ID   -> counter (byte 6 low nibble) of the last frame with that id in a candump log
   matrix.py json-field FILE KEY       -> the value of KEY in a one-line JSON object file ("" when absent)
+  matrix.py frame-stall ROW_DIR FRAME T0 T1 -> longest gap (ms) of FRAME overlapping the wall times T0..T1
   matrix.py wheel-gaps ROW_DIR T0 T1  -> "max_gap_ms count" of dockd's WheelCmdA between wall times T0 and T1
   matrix.py first-wheels ROW_DIR REF  -> zero | moving | none: the first WheelCmdA at or after REF
   matrix.py nonzero-count ROW_DIR [T0 [T1]] -> number of non-zero WheelCmdA frames (between wall times T0, T1)
@@ -35,6 +36,7 @@ candump log's stamps, chassis-sim's truth "wall" field and the case's inject log
   matrix.py table CASE_DIR...         -> the measured table of docs/reliability.md (markdown)
   matrix.py states ROW_DIR            -> deduplicated DockStatus state sequence
 """
+import bisect
 import json
 import os
 import sys
@@ -167,6 +169,57 @@ def max_gap_ms(times, empty=0.0):
     return max((b - a) for a, b in zip(times, times[1:])) * 1000 if len(times) > 1 else empty
 
 
+def stall_ms(times, t0, t1):
+    """Longest gap (ms) between consecutive wall times (s, ascending) that overlaps the window [t0, t1], the gaps
+    running into and out of the window included: a window that falls inside one long gap reports that whole gap."""
+    i = bisect.bisect_left(times, t0)
+    j = bisect.bisect_right(times, t1)
+    return max_gap_ms(times[max(i - 1, 0):j + 1])
+
+
+# The margins of dockd's watchdogs over the data's own period: the lidar watchdog (lidar_stale_ms 200, measured from
+# the end of the newest turn) sees a turn one 100 ms turn old at best, so a reader or a sensor more than 100 ms late
+# trips it; the chassis watchdog (chassis_stale_ms 200) sees feedback 20 ms old at best.
+LIDAR_WATCHDOG_MARGIN_MS = 100
+CHASSIS_WATCHDOG_MARGIN_MS = 180
+
+
+def watchdog_onsets(r):
+    """[(wall, code, excuse)] for every fault onset in the status frames from the task's start on; excuse says why a
+    watchdog fault (184/185) was the test machine's and not dockd's ("" when nothing excuses it):
+    - dockd's own 20 ms wheel frames stalled longer than the watchdog's margin in the 1.5 s before (the VM starved
+      dockd: it could not read the data in time);
+    - 184: chassis-sim's 20 ms feedback frames stalled longer than the margin (the simulated chassis starved);
+    - 185: chassis-sim logged "sim_scan_skipped" (its loop fell a turn behind) or "sim_lidar_late" (a turn or its
+      paced packets left late) in the 0.5 s before."""
+    wheels = [e["wall"] for e in r.wheels()]
+    feedback = [e["wall"] for e in r.timeline if e["name"] == "WheelFbA"]
+    skipped = r.events.get("sim_scan_skipped", []) + r.events.get("sim_lidar_late", [])
+    out = []
+    prev = 0
+    started = False
+    for e in r.status():
+        # From the task's start on: before the first command the lidar may not have delivered yet (185 idle).
+        started = started or int(e["signals"]["state"]) != STATE["NOT_TASKING"]
+        if not started:
+            continue
+        c = int(e["signals"]["fault"])
+        if c and c != prev:
+            t = e["wall"]
+            stall = stall_ms(wheels, t - 1.5, t)
+            fb = stall_ms(feedback, t - 1.5, t)
+            why = ""
+            if c == 185 and stall > LIDAR_WATCHDOG_MARGIN_MS or c == 184 and stall > CHASSIS_WATCHDOG_MARGIN_MS:
+                why = f"stall {stall:.0f} ms"
+            elif c == 184 and fb > CHASSIS_WATCHDOG_MARGIN_MS:
+                why = f"simulated chassis silent {fb:.0f} ms"
+            elif c == 185 and any(t - 0.5 <= k <= t for k in skipped):
+                why = "simulated lidar skipped a turn or sent late"
+            out.append((t, c, why))
+        prev = c
+    return out
+
+
 def tick_gap(wheels, t0, t1):
     """Longest gap (ms) between dockd's consecutive wheel frames from the last one before t0 to t1: dockd sends one
     every 20 ms tick, so a longer gap is its loop (or the VM) not running."""
@@ -235,7 +288,7 @@ def judge_row(argv):
     if not a.no_moving_check:
         # A watchdog hold caused by dockd's own loop stalling just before the fault (the VM starved) can leave the
         # robot standing at the fault time: that row cannot show a reaction, reported as STARVED.
-        pre_stall = max_gap_ms([e["wall"] for e in before if e["wall"] >= t_f - 0.5])
+        pre_stall = stall_ms([e["wall"] for e in wheels], t_f - 0.5, t_f)
         check("moving_at_fault", bool(before) and nonzero(before[-1]),
               "the last wheel command before the fault was zero: nothing to stop" +
               (f"; dockd's wheel frames stalled {pre_stall:.0f} ms in the 0.5 s before: VM starvation"
@@ -285,9 +338,13 @@ def judge_row(argv):
     if a.code is not None:
         st = next((e for e in r.status() if e["wall"] >= t_f and int(e["signals"]["fault"]) == a.code and
                    (a.state is None or int(e["signals"]["state"]) == a.state)), None)
+        # A watchdog fault that the VM's starvation explains (watchdog_onsets) can take the task to FAULT first and
+        # so decide which code the status shows: then the missing code is STARVED, reported with that cause.
+        wd = [f"{c}({why})" for t, c, why in watchdog_onsets(r) if why and t >= t_f - 0.5 and c != a.code]
         check(f"fault_code_{a.code}", st is not None,
               "status faults after the fault time: " +
-              " ".join(sorted({str(int(e["signals"]["fault"])) for e in r.status() if e["wall"] >= t_f})))
+              " ".join(sorted({str(int(e["signals"]["fault"])) for e in r.status() if e["wall"] >= t_f})) +
+              (f"; watchdog faults {' '.join(wd)} came first: VM starvation" if wd else ""), starved=bool(wd))
         if st is not None:
             ms = (st["wall"] - t_f) * 1000
             figure("status_ms", f"{ms:.1f}")
@@ -384,6 +441,12 @@ def main(argv):
         except (OSError, ValueError):
             v = ""
         print(str(v).lower() if isinstance(v, bool) else v)
+        return 0
+    if cmd == "frame-stall":
+        # Longest gap (ms) of FRAME overlapping [T0, T1] (stall_ms): e.g. chassis-sim's 20 ms WheelFbA.
+        r = Row(argv[2])
+        ts = [e["wall"] for e in r.timeline if e["name"] == argv[3]]
+        print(f"{stall_ms(ts, float(argv[4]), float(argv[5])):.1f}")
         return 0
     if cmd == "wheel-gaps":
         r = Row(argv[2])
@@ -498,35 +561,14 @@ def main(argv):
         print("none" if e is None else ("zero" if not nonzero(e) else "moving"))
         return 0
     if cmd == "faults-split":
-        # "UNEXCUSED;EXCUSED": fault codes of the status frames, split by cause. A watchdog fault (184/185) whose onset
-        # follows a stall of dockd's own 20 ms wheel frames longer than the watchdog limit (200 ms) within the 1.5 s
-        # before it (stale limit + fault_after) is the watchdog reacting, correctly, to dockd itself not running
-        # (the TCG VM starved): excused, listed with the stall. Anything else is unexcused.
-        # The simulated robot starves too: chassis-sim logs "sim_scan_skipped" when its loop fell a scan period
-        # behind and skipped a turn, and "sim_lidar_late" when its paced LD06 packets left > 50 ms after their time;
-        # a 185 within 0.5 s after either is the simulated sensor's, excused likewise.
-        r = Row(argv[2])
-        wheels = [e["wall"] for e in r.wheels()]
-        skipped = r.events.get("sim_scan_skipped", []) + r.events.get("sim_lidar_late", [])
+        # "UNEXCUSED;EXCUSED": fault codes of the status frames, split by cause (watchdog_onsets): a watchdog fault
+        # that the test machine's starvation explains is listed as excused, with that cause.
         unexcused, excused = [], []
-        prev = 0
-        started = False
-        for e in r.status():
-            # From the task's start on: before the first command the lidar may not have delivered yet (185 idle).
-            started = started or int(e["signals"]["state"]) != STATE["NOT_TASKING"]
-            if not started:
-                continue
-            c = int(e["signals"]["fault"])
-            if c and c != prev:
-                t = e["wall"]
-                stall = max_gap_ms([w for w in wheels if t - 1.5 <= w <= t])
-                if c in (184, 185) and stall > 200:
-                    excused.append(f"{c}(stall {stall:.0f} ms)")
-                elif c == 185 and any(t - 0.5 <= k <= t for k in skipped):
-                    excused.append(f"{c}(simulated lidar skipped a turn or sent late)")
-                else:
-                    unexcused.append(str(c))
-            prev = c
+        for _, c, why in watchdog_onsets(Row(argv[2])):
+            if why:
+                excused.append(f"{c}({why})")
+            else:
+                unexcused.append(str(c))
         print(" ".join(unexcused) + ";" + " ".join(excused))
         return 0
     if cmd == "last-signal":

@@ -461,12 +461,18 @@ int run(const Options& opt) {
     lidar->pump(now_us);
     last_scan_wall_us = lidar->stats().last_turn_written_wall_us;
     if (lidar->stats().paced_packets_late != lidar_late_seen) {
-      // This process ran late and the simulated sensor's packets left > 50 ms after their time: a stale lidar in
-      // dockd right after is the simulator's, not dockd's (tests/hil/matrix.py faults-split).
+      // This process ran late and the simulated sensor's packets left > 30 ms after their time (or a turn started
+      // > 30 ms late, below): a stale lidar in dockd right after is the simulator's, not dockd's (tests/hil/matrix.py
+      // watchdog_onsets).
       lidar_late_seen = lidar->stats().paced_packets_late;
       write_truth(truth, t, mt, chassis.state(), relay, silent, "sim_lidar_late");
     }
     if (t >= next_scan_t) {
+      if (t - next_scan_t > 0.03 && t < next_scan_t + scan_period_s) {
+        // The turn starts > 30 ms after its time: the gap between turns grows by that much, which eats into dockd's
+        // lidar watchdog margin (one turn) just like a late packet does.
+        write_truth(truth, t, mt, chassis.state(), relay, silent, "sim_lidar_late");
+      }
       next_scan_t += scan_period_s;
       if (next_scan_t < t) {
         // Fell behind (slow VM): skip, do not burst. The truth log says so: the lidar rows of the HIL matrix must

@@ -40,7 +40,19 @@ post_sigkill() {
   local base
   base=$($MATRIX_PY delta "$RD" last_wheel_cmd command_timeout)
   echo "FIGURE process_sigkill_reaction_ms $base"
-  check process_sigkill_base_stops_by_timeout awk -v m="$base" 'BEGIN{exit !(m != "none" && m + 0 <= 525)}'
+  # chassis-sim checks its command timeout every loop iteration and sends its feedback every 20 ms: a feedback gap
+  # over 45 ms (20 ms + the limit's 25 ms) around the timeout is the simulated chassis not running (VM starvation).
+  local sim_stall
+  sim_stall=$($MATRIX_PY frame-stall "$RD" WheelFbA "$(inject_time last_wheel_cmd)" "$(awk -v t="$(inject_time last_wheel_cmd)" \
+    -v m="$base" 'BEGIN{printf "%.6f", t + (m == "none" ? 1 : m / 1000)}')")
+  echo "FIGURE process_sigkill_sim_feedback_gap_ms $sim_stall"
+  if awk -v m="$base" 'BEGIN{exit !(m != "none" && m + 0 <= 525)}'; then
+    echo "PASS process_sigkill_base_stops_by_timeout"
+  elif [ "$base" != none ] && awk -v g="$sim_stall" 'BEGIN{exit !(g > 45)}' && [ "${HIL_STRICT_TIMING:-0}" != 1 ]; then
+    echo "STARVED process_sigkill_base_stops_by_timeout  ($base ms > 525 ms; chassis-sim's feedback stalled $sim_stall ms: VM starvation)"
+  else
+    check process_sigkill_base_stops_by_timeout false
+  fi
   # The record up to the kill: every line whole JSON, the last state event = the last DockStatus state on the bus.
   $MATRIX_PY record-check "$RD" "$RD/events_at_kill.jsonl" sigkill | sed 's/^/INFO process_sigkill /'
   check process_sigkill_record_intact $MATRIX_PY record-check "$RD" "$RD/events_at_kill.jsonl" sigkill

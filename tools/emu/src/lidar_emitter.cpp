@@ -336,7 +336,7 @@ void LidarEmitter::pump(std::uint64_t now_us) {
   std::vector<std::uint8_t> out;
   bool turn_done = false;
   while (!q.empty() && q.front().due_us <= now_us) {
-    if (now_us - q.front().due_us > 50000u) ++stats_.paced_packets_late;
+    if (now_us - q.front().due_us > 30000u) ++stats_.paced_packets_late;
     out.insert(out.end(), q.front().bytes.begin(), q.front().bytes.end());
     turn_done = turn_done || q.front().last_of_turn;
     q.pop_front();

@@ -65,7 +65,7 @@ struct LidarEmitterStats {
   /// of chassis-sim's "last good scan" for the stale-lidar rows.
   std::int64_t last_turn_written_wall_us = 0;
   std::uint64_t paced_packets_discarded = 0;  ///< Queued packets dropped because the sensor stalled or was unplugged.
-  /// Paced packets written more than 50 ms after they were due: the emulator's own process ran late (a starved
+  /// Paced packets written more than 30 ms after they were due: the emulator's own process ran late (a starved
   /// simulator), which a receiver sees as a late sensor.
   std::uint64_t paced_packets_late = 0;
 };
