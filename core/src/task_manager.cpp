@@ -65,6 +65,7 @@ void TaskManager::configure(const TaskParams& params, const FootprintParams& foo
   obstacles_.configure(footprint, &profile);
   state_ = TaskState::kNotTasking;
   fault_ = FaultCode::kNone;
+  faulted_in_ = TaskState::kNotTasking;
   last_result_ = TaskResult::kNone;
   last_command_ = CommandResult::kNone;
   retries_ = 0;
@@ -100,6 +101,7 @@ void TaskManager::enter(TaskState s, const TaskInput& in) {
 
 void TaskManager::raise(FaultCode f, const TaskInput& in) {
   fault_ = f;
+  faulted_in_ = state_;
   last_result_ = TaskResult::kFaulted;
   enter(TaskState::kFault, in);
 }
@@ -146,7 +148,11 @@ void TaskManager::handle_command(const TaskInput& in, TaskOutput& out) {
       if (state_ == TaskState::kUndocking) {
         r = CommandResult::kAccepted;
       } else if (state_ == TaskState::kWaitForCharge || state_ == TaskState::kFinishTasking ||
-                 ((state_ == TaskState::kNotTasking || state_ == TaskState::kFault) && in.contact)) {
+                 ((state_ == TaskState::kNotTasking || state_ == TaskState::kFault) && in.contact) ||
+                 (state_ == TaskState::kFault && faulted_in_ == TaskState::kUndocking)) {
+        // A fault during the back-off (a watchdog hold, an obstacle timeout) leaves the robot between the contacts
+        // and the staging point: undock again finishes the back-off (the distance still needed is measured anew),
+        // where "not docked" would strand it there.
         r = CommandResult::kAccepted;
         fault_ = FaultCode::kNone;
         enter(TaskState::kUndocking, in);

@@ -297,6 +297,27 @@ TEST(DockdDaemon, ChassisStaleStopsWithinOneTickFaultsAndResumes) {
   CHECK_EQUAL(1u, r.daemon->counters().chassis_stale_trips);
 }
 
+TEST(DockdDaemon, LidarOutageMidUndockResumesTheBackOff) {
+  // Found by the HIL soak on a loaded host: a 185 mid back-off faulted the undocking off the contacts, and the
+  // resume's undock was refused as "not docked", leaving the robot in FAULT between the dock and the staging point.
+  Rig r("undock");
+  r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
+  r.host.command(3, 0);
+  CHECK_TRUE(r.run_until([&] { return !r.chassis->state().contact && !r.wheels_zero(); }, 10.0));
+  r.lidar_blocked = true;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFault; }, 2.0));
+  CHECK_EQUAL(185, static_cast<int>(r.daemon->fault()));
+  CHECK_TRUE(r.wheels_zero());
+  r.lidar_blocked = false;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kNotTasking; }, 30.0));
+  CHECK_EQUAL(1u, r.daemon->counters().resumes);
+  CHECK_EQUAL(static_cast<int>(dockcore::TaskResult::kUndocked), static_cast<int>(r.daemon->last_status().last_result));
+  CHECK_FALSE(r.chassis->state().contact);
+  CHECK_TRUE(r.wheels_zero());
+}
+
 TEST(DockdDaemon, LidarStaleStopsWithinOneTickAndFaults) {
   Rig r("lidar");
   r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);

@@ -630,6 +630,32 @@ TEST(TaskManager, UndockBacksOffToStagingAndReportsDone) {
   LONGS_EQUAL(0, s->zero_violations);
 }
 
+TEST(TaskManager, UndockAfterAFaultMidBackOffFinishesTheBackOff) {
+  // A lidar hold mid back-off faults the undocking with the robot off the contacts, short of the staging point
+  // (dockd resumes it with another undock): it must finish backing off, not be refused as "not docked".
+  auto s = docked_sim();
+  s->command(HostCommandType::kUndock);
+  s->run_for(1.0);
+  CHECK(s->out.status.state == TaskState::kUndocking);
+  CHECK_FALSE(s->contact);
+  const double part = s->centre_to_dock();
+  CHECK(part < s->params.staging_distance_m - 0.05);
+  s->lidar_ok = false;
+  s->step();
+  LONGS_EQUAL(185, static_cast<int>(s->out.status.fault));
+  s->lidar_ok = true;
+  s->run_for(0.5);
+  REAL_EQUAL(part, s->centre_to_dock(), 0.01);  // stopped while faulted
+  TaskOutput o = s->command(HostCommandType::kUndock);
+  CHECK(o.command_result == CommandResult::kAccepted);
+  CHECK(o.status.state == TaskState::kUndocking);
+  LONGS_EQUAL(0, static_cast<int>(o.status.fault));
+  CHECK(s->run_until(TaskState::kNotTasking, 20));
+  CHECK(s->out.status.last_result == TaskResult::kUndocked);
+  REAL_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.01);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
 TEST(TaskManager, UndockWaitsForAnObstacleBehind) {
   auto s = docked_sim();
   s->obstacles.push_back(s->world.transform(Vec2(-kHalfLength - 0.15, 0)));

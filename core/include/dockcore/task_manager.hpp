@@ -31,7 +31,8 @@ enum class TaskState : std::uint8_t {
   kWaitForCharge = 5,     ///< At the contacts, charge requested; waiting for contact + current.
   kRetry = 6,             ///< Backing off to the staging distance before another attempt (or the final fault).
   kUndocking = 7,         ///< Charge off, then backing off to the staging distance.
-  kFault = 8,             ///< Stopped with a fault code. Cleared by cancel, dock or (when on the contacts) undock.
+  kFault = 8,             ///< Stopped with a fault code. Cleared by cancel, dock or undock (on the contacts, or to
+                          ///< finish an undocking the fault interrupted).
   kTestMode = 9,          ///< Recognition only: the dock estimate is reported, the robot never moves.
 };
 
@@ -60,7 +61,7 @@ enum class CommandResult : std::uint8_t {
   kAlreadyDocked = 2,     ///< Dock while docked/charging: no motion; charging is (re)confirmed.
   kRejectedUnknown = 3,   ///< Unknown command code.
   kRejectedDockId = 4,    ///< Dock id not accepted (>= 32 or not in accepted_dock_ids).
-  kRejectedNotDocked = 5, ///< Undock while not on the contacts: no blind driving.
+  kRejectedNotDocked = 5, ///< Undock while not on the contacts (and not resuming an interrupted undocking).
   kRejectedBusy = 6,      ///< Dock/test while a task runs, or undock while docking: cancel first.
 };
 
@@ -236,6 +237,7 @@ class TaskManager {
 
   TaskState state_ = TaskState::kNotTasking;
   FaultCode fault_ = FaultCode::kNone;
+  TaskState faulted_in_ = TaskState::kNotTasking;  // the state the current fault was raised in
   TaskResult last_result_ = TaskResult::kNone;
   CommandResult last_command_ = CommandResult::kNone;
   std::uint16_t dock_id_ = 0;
