@@ -9,12 +9,15 @@
 
 #include <toml++/toml.h>
 
+#include "dockcore/drivers/toml_reader.hpp"
+
 namespace docksim {
 namespace {
 
 using dockcore::DockProfile;
 using dockcore::Real;
 using dockcore::Vec2;
+using dockcore::drivers::toml_reader::type_name;
 
 [[noreturn]] void fail_at(const std::string& source, const toml::source_region& where, const std::string& what) {
   const int line = static_cast<int>(where.begin.line);
@@ -34,21 +37,6 @@ bool number_of(const toml::node& n, double* out) {
     return true;
   }
   return false;
-}
-
-const char* type_name(const toml::node& n) {
-  switch (n.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-    default: return "nothing";
-  }
 }
 
 std::string fmt(double v) {
