@@ -13,14 +13,9 @@
 #include <memory>
 #include <string>
 
-#include "config.hpp"
-#include "daemon.hpp"
 #include "dockcore/drivers/udp_host_link.hpp"
-#include "docksim/chassis.hpp"
-#include "docksim/lidar_sim.hpp"
+#include "dockd_sim_rig.hpp"
 #include "docksim/rng.hpp"
-#include "docksim/scenario.hpp"
-#include "docksim/sim_run.hpp"
 
 #include "CppUTest/TestHarness.h"
 
@@ -28,103 +23,15 @@ using dockcore::TaskState;
 
 namespace {
 
-std::string scenario_path() { return std::string(DOCKCORE_SOURCE_DIR) + "/tools/scenarios/default.toml"; }
-
-struct SimClock final : dockcore::hal::Clock {
-  std::uint64_t t = 1000000;
-  std::uint64_t now_us() const override { return t; }
-};
-
-struct SimChassis final : dockcore::hal::ChassisLink {
-  docksim::Chassis* ch = nullptr;
-  const SimClock* clock = nullptr;
-  bool silent = false;  // feedback stops (the base or the bus died)
-  dockcore::hal::ChassisFeedback fb{};
-  dockcore::hal::ChassisCounters c{};
-  dockcore::hal::WheelCommand last{};
-  int sends = 0;
-  bool send_wheels(const dockcore::hal::WheelCommand& w) override {
-    last = w;
-    ++sends;
-    docksim::WheelRadps r{};
-    for (std::size_t i = 0; i < w.count && i < 4; ++i) r[i] = static_cast<double>(w.radps[i]);
-    ch->command_wheels(r);
-    return true;
-  }
-  bool request_charging(bool on) override {
-    ch->set_charging_inhibited(!on);  // the base's charger relay
-    return true;
-  }
-  const dockcore::hal::ChassisFeedback& poll() override {
-    const docksim::ChassisState& s = ch->state();
-    if (!silent && s.responding) {
-      for (std::size_t i = 0; i < 4; ++i) fb.wheel_radps[i] = static_cast<dockcore::Real>(s.wheel_measured_radps[i]);
-      fb.wheels_stamp_us = clock->t;
-      fb.charging_contact = s.contact;
-      fb.battery_current_a = static_cast<dockcore::Real>(s.charge_current_a);
-      fb.battery_voltage_v = static_cast<dockcore::Real>(s.battery_voltage_v);
-      fb.soc = static_cast<dockcore::Real>(s.battery_soc);
-      fb.power_stamp_us = fb.status_stamp_us = clock->t;
-    }
-    return fb;
-  }
-  int fd() const override { return -1; }
-  const dockcore::hal::ChassisCounters& counters() const override { return c; }
-};
-
-struct SimLidar final : dockcore::hal::LidarSource {
-  std::unique_ptr<dockcore::LaserScan> scan = std::make_unique<dockcore::LaserScan>();
-  bool pending = false;
-  dockcore::hal::LidarCounters c{};
-  bool poll_scan(dockcore::LaserScan& out) override {
-    if (!pending) return false;
-    out = *scan;
-    pending = false;
-    return true;
-  }
-  int fd() const override { return -1; }
-  const dockcore::hal::LidarCounters& counters() const override { return c; }
-};
-
-struct FakeHost final : dockcore::hal::HostLink {
-  bool has = false;
-  dockcore::hal::HostCommandMessage next{};
-  dockcore::hal::StatusMessage last{};
-  int statuses = 0;
-  void command(std::uint8_t cmd, std::uint16_t dock) {
-    next.command = cmd;
-    next.dock_id = dock;
-    ++next.sequence;
-    has = true;
-  }
-  bool poll_command(dockcore::hal::HostCommandMessage& out) override {
-    if (!has) return false;
-    out = next;
-    has = false;
-    return true;
-  }
-  bool send_status(const dockcore::hal::StatusMessage& s) override {
-    last = s;
-    ++statuses;
-    return true;
-  }
-  int fd() const override { return -1; }
-};
-
-dockcore::DriveGeometry core_geometry(const docksim::DriveGeometry& g) {
-  dockcore::DriveGeometry c;
-  c.kind = g.kind == docksim::DriveKind::kMecanum ? dockcore::DriveKind::kMecanum : dockcore::DriveKind::kDifferential;
-  c.wheel_radius_m = static_cast<dockcore::Real>(g.wheel_radius_m);
-  c.wheel_base_m = static_cast<dockcore::Real>(g.wheel_base_m);
-  c.lx_m = static_cast<dockcore::Real>(g.lx_m);
-  c.ly_m = static_cast<dockcore::Real>(g.ly_m);
-  return c;
-}
+using dockd_test::FakeHost;
+using dockd_test::SimChassis;
+using dockd_test::SimClock;
+using dockd_test::SimLidar;
 
 /// The default scenario's robot and dock, as a dockd config, plus the simulated world around a Daemon.
 struct Rig {
-  docksim::Scenario sc = docksim::load_scenario_file(scenario_path());
-  dockd::DockdConfig cfg;
+  docksim::Scenario sc = docksim::load_scenario_file(dockd_test::default_scenario_path());
+  dockd::DockdConfig cfg = dockd_test::scenario_config(sc);
   SimClock clock;
   std::unique_ptr<docksim::Chassis> chassis;
   SimChassis link;
@@ -143,33 +50,15 @@ struct Rig {
     state_file = std::string("/tmp/dockd_test_") + std::to_string(::getpid()) + "_" + state_name;
     std::remove(state_file.c_str());
     std::remove((state_file + ".bak").c_str());
-    cfg.drive = core_geometry(sc.chassis.geometry);
-    cfg.limits = sc.limits;
-    cfg.footprint = sc.safety;
-    cfg.lidar_mount = sc.lidar_mount;
-    cfg.estimator = sc.estimator;
-    cfg.task = sc.task;
-    cfg.smooth = sc.smooth;
-    cfg.pad_reach_m = static_cast<double>(sc.smooth.common.pad_reach_m);
-    cfg.pads_rear = sc.smooth.backwards;
     cfg.state_file = state_file;
     cfg.teach_scans = 10;
-    dockd::DockEntry d0;
-    d0.id = 0;
-    d0.profile = sc.profile;
-    dockd::DockEntry d3 = d0;
+    dockd::DockEntry d3 = cfg.docks[0];
     d3.id = 3;
-    cfg.docks = {d0, d3};
+    cfg.docks.push_back(d3);
     cfg.task.accepted_dock_ids = (1u << 0) | (1u << 3);
-    chassis = std::make_unique<docksim::Chassis>(sc.chassis, 11);
-    docksim::DockPlacement dp;
-    dp.pose_world = sc.dock_pose;
-    dp.face_half_width_m = sc.dock_face_half_width_m;
-    chassis->set_dock(dp);
+    chassis = dockd_test::scenario_chassis(sc, link, clock);
     const docksim::StartPose sp = docksim::start_from(sc, start_distance, 0.2, 0.1);
     chassis->set_true_pose(sp.robot_world);
-    link.ch = chassis.get();
-    link.clock = &clock;
     world = docksim::scenario_world(sc, true);
     dockd::DaemonIo io;
     io.lidar = &lidar;

@@ -19,15 +19,10 @@
 #include <string>
 #include <vector>
 
-#include "config.hpp"
-#include "daemon.hpp"
-#include "session_record.hpp"
 #include "dockcore/drivers/udp_host_link.hpp"
-#include "docksim/chassis.hpp"
-#include "docksim/lidar_sim.hpp"
+#include "dockd_sim_rig.hpp"
 #include "docksim/rng.hpp"
-#include "docksim/scenario.hpp"
-#include "docksim/sim_run.hpp"
+#include "session_record.hpp"
 
 #include "CppUTest/TestHarness.h"
 
@@ -79,78 +74,15 @@ long rss_kib() {
   return kib;
 }
 
-struct SimClock final : dockcore::hal::Clock {
-  std::uint64_t t = 1000000;
-  std::uint64_t now_us() const override { return t; }
-};
-
-struct SimChassis final : dockcore::hal::ChassisLink {
-  docksim::Chassis* ch = nullptr;
-  const SimClock* clock = nullptr;
-  dockcore::hal::ChassisFeedback fb{};
-  dockcore::hal::ChassisCounters c{};
-  bool send_wheels(const dockcore::hal::WheelCommand& w) override {
-    docksim::WheelRadps r{};
-    for (std::size_t i = 0; i < w.count && i < 4; ++i) r[i] = static_cast<double>(w.radps[i]);
-    ch->command_wheels(r);
-    return true;
-  }
-  bool request_charging(bool on) override {
-    ch->set_charging_inhibited(!on);
-    return true;
-  }
-  const dockcore::hal::ChassisFeedback& poll() override {
-    const docksim::ChassisState& s = ch->state();
-    for (std::size_t i = 0; i < 4; ++i) fb.wheel_radps[i] = static_cast<dockcore::Real>(s.wheel_measured_radps[i]);
-    fb.wheels_stamp_us = clock->t;
-    fb.charging_contact = s.contact;
-    fb.battery_current_a = static_cast<dockcore::Real>(s.charge_current_a);
-    fb.battery_voltage_v = static_cast<dockcore::Real>(s.battery_voltage_v);
-    fb.soc = static_cast<dockcore::Real>(s.battery_soc);
-    fb.power_stamp_us = fb.status_stamp_us = clock->t;
-    return fb;
-  }
-  int fd() const override { return -1; }
-  const dockcore::hal::ChassisCounters& counters() const override { return c; }
-};
-
-struct SimLidar final : dockcore::hal::LidarSource {
-  std::unique_ptr<dockcore::LaserScan> scan = std::make_unique<dockcore::LaserScan>();
-  bool pending = false;
-  dockcore::hal::LidarCounters c{};
-  bool poll_scan(dockcore::LaserScan& out) override {
-    if (!pending) return false;
-    out = *scan;
-    pending = false;
-    return true;
-  }
-  int fd() const override { return -1; }
-  const dockcore::hal::LidarCounters& counters() const override { return c; }
-};
-
-struct FakeHost final : dockcore::hal::HostLink {
-  bool has = false;
-  dockcore::hal::HostCommandMessage next{};
-  void command(std::uint8_t cmd, std::uint16_t dock) {
-    next.command = cmd;
-    next.dock_id = dock;
-    ++next.sequence;
-    has = true;
-  }
-  bool poll_command(dockcore::hal::HostCommandMessage& out) override {
-    if (!has) return false;
-    out = next;
-    has = false;
-    return true;
-  }
-  bool send_status(const dockcore::hal::StatusMessage&) override { return true; }
-  int fd() const override { return -1; }
-};
+using dockd_test::FakeHost;
+using dockd_test::SimChassis;
+using dockd_test::SimClock;
+using dockd_test::SimLidar;
 
 /// The default scenario's robot and dock around a Daemon with an event log, a CAN host and a UDP host link.
 struct HeapRig {
-  docksim::Scenario sc = docksim::load_scenario_file(std::string(DOCKCORE_SOURCE_DIR) + "/tools/scenarios/default.toml");
-  dockd::DockdConfig cfg;
+  docksim::Scenario sc = docksim::load_scenario_file(dockd_test::default_scenario_path());
+  dockd::DockdConfig cfg = dockd_test::scenario_config(sc);
   SimClock clock;
   std::unique_ptr<docksim::Chassis> chassis;
   SimChassis link;
@@ -171,29 +103,8 @@ struct HeapRig {
   HeapRig() {
     dir = std::string("/tmp/dockd_heap_") + std::to_string(::getpid());
     ::mkdir(dir.c_str(), 0700);
-    const dockcore::DriveGeometry g = docksim::core_drive_geometry(sc.chassis.geometry);
-    cfg.drive = g;
-    cfg.limits = sc.limits;
-    cfg.footprint = sc.safety;
-    cfg.lidar_mount = sc.lidar_mount;
-    cfg.estimator = sc.estimator;
-    cfg.task = sc.task;
-    cfg.smooth = sc.smooth;
-    cfg.pad_reach_m = static_cast<double>(sc.smooth.common.pad_reach_m);
-    cfg.pads_rear = sc.smooth.backwards;
     cfg.state_file = dir + "/state";
-    dockd::DockEntry d0;
-    d0.id = 0;
-    d0.profile = sc.profile;
-    cfg.docks = {d0};
-    cfg.task.accepted_dock_ids = 1u;
-    chassis = std::make_unique<docksim::Chassis>(sc.chassis, 11);
-    docksim::DockPlacement dp;
-    dp.pose_world = sc.dock_pose;
-    dp.face_half_width_m = sc.dock_face_half_width_m;
-    chassis->set_dock(dp);
-    link.ch = chassis.get();
-    link.clock = &clock;
+    chassis = dockd_test::scenario_chassis(sc, link, clock);
     world = docksim::scenario_world(sc, true);
     std::string err;
     // 1 KiB per file: the log rotates every cycle or so, so rotation runs inside the counted ticks too.
