@@ -10,28 +10,16 @@
 #include "dockcore/lidar_lakibeam.hpp"
 #include "dockcore/lidar_ld06.hpp"
 
+#include "lidar_capture.hpp"
 #include "real_tolerance.hpp"
 
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
+using lidar_test::capture_dist_mm;
+using lidar_test::read_capture;
 
 namespace {
-
-std::vector<std::uint8_t> read_capture(const char* name) {
-  std::string path = __FILE__;
-  path = path.substr(0, path.rfind('/')) + "/../data/lidar/" + name;
-  std::vector<std::uint8_t> out;
-  FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return out;
-  std::uint8_t buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) out.insert(out.end(), buf, buf + n);
-  std::fclose(f);
-  return out;
-}
-
-int capture_dist_mm(int j) { return j % 37 == 0 ? 0 : 1000 + 10 * (j % 50); }
 
 std::unique_ptr<LakibeamParser> make_parser() {
   auto p = std::make_unique<LakibeamParser>();

@@ -9,29 +9,18 @@
 
 #include "dockcore/lidar_ld06.hpp"
 
+#include "lidar_capture.hpp"
 #include "real_tolerance.hpp"
 
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
+using lidar_test::capture_dist_mm;
+using lidar_test::check_accounting;
+using lidar_test::read_capture;
+using lidar_test::replay_bytes;
 
 namespace {
-
-std::vector<std::uint8_t> read_capture(const char* name) {
-  std::string path = __FILE__;
-  path = path.substr(0, path.rfind('/')) + "/../data/lidar/" + name;
-  std::vector<std::uint8_t> out;
-  FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return out;
-  std::uint8_t buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) out.insert(out.end(), buf, buf + n);
-  std::fclose(f);
-  return out;
-}
-
-// The synthetic turn of tests/data/lidar/make_captures.py.
-int capture_dist_mm(int j) { return j % 37 == 0 ? 0 : 1000 + 10 * (j % 50); }
 
 std::vector<std::uint8_t> packet(std::uint16_t start, std::uint16_t end, std::uint16_t dist = 1500,
                                  std::uint16_t speed = 3600) {
@@ -65,11 +54,6 @@ std::unique_ptr<Ld06Parser> make_parser() {
   auto p = std::make_unique<Ld06Parser>();
   CHECK(p->configure(Ld06Config{}));
   return p;
-}
-
-void check_accounting(const Ld06Parser& p) {
-  const auto& c = p.counters();
-  CHECK_EQUAL(c.bytes, c.bytes_accepted + c.dropped_bytes + p.buffered());
 }
 
 }  // namespace
@@ -419,13 +403,7 @@ TEST(Ld06, RecordedCaptureGivesExactCounters) {
   const auto cap = read_capture("ld06_capture.bin");
   CHECK_EQUAL(5314u, cap.size());
   auto p = make_parser();
-  std::vector<LaserScan> scans;
-  for (std::uint8_t b : cap) {
-    if (p->feed(b, 0)) {
-      scans.emplace_back();
-      CHECK(p->take_scan(scans.back()));
-    }
-  }
+  const std::vector<LaserScan> scans = replay_bytes(*p, cap);
   const auto& c = p->counters();
   CHECK_EQUAL(3u, c.scans);
   CHECK_EQUAL(2u, c.crc_errors);

@@ -9,28 +9,18 @@
 
 #include "dockcore/lidar_rplidar.hpp"
 
+#include "lidar_capture.hpp"
 #include "real_tolerance.hpp"
 
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
+using lidar_test::capture_dist_mm;
+using lidar_test::check_accounting;
+using lidar_test::read_capture;
+using lidar_test::replay_bytes;
 
 namespace {
-
-std::vector<std::uint8_t> read_capture(const char* name) {
-  std::string path = __FILE__;
-  path = path.substr(0, path.rfind('/')) + "/../data/lidar/" + name;
-  std::vector<std::uint8_t> out;
-  FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return out;
-  std::uint8_t buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) out.insert(out.end(), buf, buf + n);
-  std::fclose(f);
-  return out;
-}
-
-int capture_dist_mm(int j) { return j % 37 == 0 ? 0 : 1000 + 10 * (j % 50); }
 
 std::unique_ptr<RplidarParser> make_parser(bool require_descriptor = true) {
   auto p = std::make_unique<RplidarParser>();
@@ -38,11 +28,6 @@ std::unique_ptr<RplidarParser> make_parser(bool require_descriptor = true) {
   c.require_descriptor = require_descriptor;
   CHECK(p->configure(c));
   return p;
-}
-
-void check_accounting(const RplidarParser& p) {
-  const auto& c = p.counters();
-  CHECK_EQUAL(c.bytes, c.bytes_accepted + c.dropped_bytes + p.buffered());
 }
 
 // Descriptor + n nodes at 1 deg steps from sensor 0 deg, 360 per turn, range 500 + j mm.
@@ -239,13 +224,7 @@ TEST(Rplidar, RecordedCaptureGivesExactCounters) {
   const auto cap = read_capture("rplidar_capture.bin");
   CHECK_EQUAL(4174u, cap.size());
   auto p = make_parser();
-  std::vector<LaserScan> scans;
-  for (std::uint8_t b : cap) {
-    if (p->feed(b, 0)) {
-      scans.emplace_back();
-      CHECK(p->take_scan(scans.back()));
-    }
-  }
+  const std::vector<LaserScan> scans = replay_bytes(*p, cap);
   const auto& c = p->counters();
   CHECK_EQUAL(2u, c.scans);
   CHECK_EQUAL(1u, c.resyncs);
