@@ -8,6 +8,7 @@
 #include <sstream>
 #include <utility>
 
+#include <arpa/inet.h>
 #include <sys/stat.h>
 
 #include <toml++/toml.h>
@@ -216,6 +217,13 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
            l.baud = static_cast<std::uint32_t>(p.integer(n, 9600, 4000000));
          }},
         {"udp_bind", p.str(&l.udp_bind_address)},
+        {"udp_source", [&](const toml::node& n) {
+           l.udp_source_address = p.string(n);
+           in_addr a{};
+           if (!l.udp_source_address.empty() && ::inet_pton(AF_INET, l.udp_source_address.c_str(), &a) != 1) {
+             p.fail(n.source(), p.key() + " = \"" + l.udp_source_address + "\" is not an IPv4 address");
+           }
+         }},
         {"udp_port", p.integ(&l.udp_port, 1, 65535)},
         {"reconnect_min_ms", p.integ(&l.reconnect_min_ms, 10, 60000)},
         {"reconnect_max_ms", p.integ(&l.reconnect_max_ms, 10, 600000)},
@@ -568,6 +576,7 @@ std::vector<std::string> restart_only_changes(const DockdConfig& a, const DockdC
   check(a.lidar.baud == b.lidar.baud, "lidar.baud");
   check(a.lidar.udp_bind_address == b.lidar.udp_bind_address, "lidar.udp_bind");
   check(a.lidar.udp_port == b.lidar.udp_port, "lidar.udp_port");
+  check(a.lidar.udp_source_address == b.lidar.udp_source_address, "lidar.udp_source");
   check(a.lidar.reconnect_min_ms == b.lidar.reconnect_min_ms, "lidar.reconnect_min_ms");
   check(a.lidar.reconnect_max_ms == b.lidar.reconnect_max_ms, "lidar.reconnect_max_ms");
   check(a.can_interface == b.can_interface, "can.interface");

@@ -868,7 +868,8 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       "\"lidar_stale\":%s,\"chassis_stale\":%s,\"odom_x_m\":%.4f,\"odom_y_m\":%.4f,\"odom_yaw_deg\":%.2f,"
       "\"cmd_vx_mps\":%.3f,\"cmd_wz_radps\":%.3f,\"teaching\":%s,\"taught\":%s,\"ticks\":%llu,"
       "\"tick_worst_us\":%llu,\"tick_overruns\":%llu,\"tick_work_worst_us\":%llu,\"scans\":%u,\"detections\":%u,"
-      "\"lidar_crc_errors\":%u,\"lidar_resyncs\":%u,\"lidar_dropped_bytes\":%u,\"lidar_reconnects\":%u,"
+      "\"lidar_crc_errors\":%u,\"lidar_resyncs\":%u,\"lidar_dropped_bytes\":%u,\"lidar_foreign_datagrams\":%u,"
+      "\"lidar_reconnects\":%u,"
       "\"lidar_late_scans\":%u,"
       "\"can_bad_frames\":%u,"
       "\"can_send_failures\":%u,\"commands\":%u,\"commands_rejected\":%u,\"resumes\":%u,\"can_host_rejected\":%u,"
@@ -886,7 +887,7 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       teach_.active ? "true" : "false", state_.find(s.dock_id) != nullptr ? "true" : "false",
       static_cast<unsigned long long>(stats_.ticks), static_cast<unsigned long long>(stats_.worst_period_us),
       static_cast<unsigned long long>(stats_.overruns), static_cast<unsigned long long>(stats_.worst_work_us),
-      counters_.scans, counters_.detections, lc.crc_errors, lc.resyncs, lc.dropped_bytes, lc.reconnects,
+      counters_.scans, counters_.detections, lc.crc_errors, lc.resyncs, lc.dropped_bytes, lc.foreign_datagrams, lc.reconnects,
       counters_.late_scans, cc.bad_frames,
       cc.send_failures, counters_.commands, commands_rejected_total(), counters_.resumes,
       io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u,

@@ -360,6 +360,10 @@ class UdpLidarDriver final : public LidarDriver {
       error = "bad UDP bind address '" + opt_.udp_bind_address + "'";
       return false;
     }
+    if (!opt_.udp_source_address.empty() && ::inet_pton(AF_INET, opt_.udp_source_address.c_str(), &source_) != 1) {
+      error = "bad UDP source address '" + opt_.udp_source_address + "'";
+      return false;
+    }
     fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
     if (fd_ < 0) {
       error = errno_text("socket", "udp");
@@ -392,6 +396,7 @@ class UdpLidarDriver final : public LidarDriver {
   int fd() const override { return fd_; }
   const hal::LidarCounters& counters() const override {
     copy_hal_counters(decoder_.counters(), 0, hal_);
+    hal_.foreign_datagrams = foreign_;
     return hal_;
   }
   LidarParserCounters parser_counters() const override { return decoder_.counters(); }
@@ -402,12 +407,18 @@ class UdpLidarDriver final : public LidarDriver {
   void service(std::uint64_t) override {
     if (fd_ < 0) return;
     for (int rounds = 0; rounds < 256; ++rounds) {
-      const ssize_t n = ::recv(fd_, buf_.data(), buf_.size(), 0);
+      sockaddr_in from{};
+      socklen_t from_len = sizeof from;
+      const ssize_t n = ::recvfrom(fd_, buf_.data(), buf_.size(), 0, reinterpret_cast<sockaddr*>(&from), &from_len);
       if (n < 0) {
         if (errno == EAGAIN || errno == EWOULDBLOCK) break;
         if (errno == EINTR) continue;
-        error_ = errno_text("recv", "udp");
+        error_ = errno_text("recvfrom", "udp");
         break;
+      }
+      if (!opt_.udp_source_address.empty() && (from.sin_family != AF_INET || from.sin_addr.s_addr != source_.s_addr)) {
+        ++foreign_;
+        continue;
       }
       // buf_ holds the largest UDP payload, so n is the datagram's true size and a wrong-size Lakibeam datagram
       // is rejected (and counted) by the parser.
@@ -423,6 +434,8 @@ class UdpLidarDriver final : public LidarDriver {
   mutable hal::LidarCounters hal_{};
   int fd_ = -1;
   std::uint16_t port_ = 0;
+  in_addr source_{};            // opt_.udp_source_address, parsed (when set)
+  std::uint32_t foreign_ = 0;   // datagrams from another source, dropped
   std::vector<std::uint8_t> buf_ = std::vector<std::uint8_t>(65536);
   std::string error_;
 };

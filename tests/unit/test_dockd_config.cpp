@@ -1,6 +1,7 @@
 // dockd's config: every error names file:line:column; defaults and derived values; the docked-target correction.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -139,6 +140,18 @@ TEST(DockdConfig, RestartOnlyChangesNameTheKeys) {
   STRCMP_EQUAL("can.interface", ch[1].c_str());
   STRCMP_CONTAINS("wheel_radius_m", ch[2].c_str());
   STRCMP_EQUAL("host.port", ch[3].c_str());
+}
+
+TEST(DockdConfig, LidarUdpSourceIsAnIpv4AddressAndNeedsARestart) {
+  const dockd::DockdConfig a = dockd::parse_config_toml("", "t.toml");
+  CHECK_TRUE(a.lidar.udp_source_address.empty());  // any source unless configured
+  const dockd::DockdConfig b = dockd::parse_config_toml(
+      "[lidar]\nprotocol = \"lakibeam\"\ntransport = \"udp\"\nudp_source = \"192.168.198.2\"\n", "t.toml");
+  STRCMP_EQUAL("192.168.198.2", b.lidar.udp_source_address.c_str());
+  const std::vector<std::string> ch = dockd::restart_only_changes(a, b);
+  CHECK(std::find(ch.begin(), ch.end(), "lidar.udp_source") != ch.end());
+  STRCMP_CONTAINS("t.toml:2:14: lidar.udp_source = \"lidar.local\" is not an IPv4 address",
+                  error_of("[lidar]\nudp_source = \"lidar.local\"\n").c_str());
 }
 
 // Cross-key errors point at the key at fault, not at 1:1 (found while writing fuzz_config: every message was

@@ -37,6 +37,9 @@ struct LidarDriverOptions {
   std::uint32_t baud = 230400;                ///< Serial baud rate; must be a rate termios supports.
   std::string udp_bind_address = "0.0.0.0";   ///< UDP transport: local address to bind.
   std::uint16_t udp_port = 2368;              ///< UDP transport: local port to bind.
+  /// UDP transport: accept datagrams only from this IPv4 address ("" = from any source). Others are dropped unread
+  /// and counted (hal::LidarCounters::foreign_datagrams): another host on the sensor's network cannot inject scans.
+  std::string udp_source_address;
   std::uint32_t reconnect_min_ms = 100;       ///< First reopen delay after the device vanished; doubles per failure.
   std::uint32_t reconnect_max_ms = 2000;      ///< Cap on the reopen delay.
   /// Grid of the published scans (bins per full turn); 0 = the protocol's default (LD06 450, RPLIDAR 360,

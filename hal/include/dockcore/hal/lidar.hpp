@@ -15,6 +15,7 @@ struct LidarCounters {
   std::uint32_t resyncs = 0;        ///< Times the parser lost and regained packet framing.
   std::uint32_t dropped_bytes = 0;  ///< Bytes discarded while resynchronising.
   std::uint32_t reconnects = 0;     ///< Device reopened after it vanished.
+  std::uint32_t foreign_datagrams = 0;  ///< UDP datagrams from a source other than the configured sensor, dropped.
 };
 
 /// A lidar delivering complete turns.
