@@ -189,20 +189,34 @@ TEST(LidarDrivers, SerialRplidarSendsStopAndScanAfterOpen) {
   CHECK_EQUAL(1u, d->parser_counters().descriptors);
 }
 
-TEST(LidarDrivers, UdpLakibeamOnLoopback) {
+namespace {
+
+LidarDriverOptions udp_lakibeam_options() {
   LidarDriverOptions o;
   o.protocol = LidarProtocol::kLakibeam;
   o.transport = LidarTransport::kUdp;
   o.udp_bind_address = "127.0.0.1";
   o.udp_port = 0;
-  std::string err;
-  auto d = make_lidar_driver(o, err);
-  CHECK(d != nullptr);
-  CHECK(d->bound_port() != 0);
+  return o;
+}
+
+/// A UDP socket bound to `addr` (any loopback address: all of 127/8 is local), or unbound for nullptr.
+int udp_sender(const char* addr) {
   const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
+  if (addr != nullptr) {
+    sockaddr_in b{};
+    b.sin_family = AF_INET;
+    ::inet_pton(AF_INET, addr, &b.sin_addr);
+    CHECK_EQUAL(0, ::bind(s, reinterpret_cast<const sockaddr*>(&b), sizeof b));
+  }
+  return s;
+}
+
+/// Sends `turns` Lakibeam turns of a 1440-bin test scan from socket `s` to 127.0.0.1:port; returns the datagrams sent.
+int send_lakibeam_turns(int s, std::uint16_t port, int turns) {
   sockaddr_in a{};
   a.sin_family = AF_INET;
-  a.sin_port = htons(d->bound_port());
+  a.sin_port = htons(port);
   a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   auto scan = std::make_unique<LaserScan>(test_scan(1440));
   LakibeamEncoder enc;
@@ -210,12 +224,30 @@ TEST(LidarDrivers, UdpLakibeamOnLoopback) {
   struct Ctx {
     int s;
     sockaddr_in a;
-  } ctx{s, a};
-  for (int t = 0; t < 3; ++t)
+    int sent;
+  } ctx{s, a, 0};
+  for (int t = 0; t < turns; ++t)
     enc.encode_scan(scan->view(), 0, [](const std::uint8_t* p, std::size_t n, void* u) {
       auto* c = static_cast<Ctx*>(u);
-      ::sendto(c->s, p, n, 0, reinterpret_cast<const sockaddr*>(&c->a), sizeof c->a);
+      if (::sendto(c->s, p, n, 0, reinterpret_cast<const sockaddr*>(&c->a), sizeof c->a) == static_cast<ssize_t>(n))
+        ++c->sent;
     }, &ctx);
+  return ctx.sent;
+}
+
+}  // namespace
+
+TEST(LidarDrivers, UdpLakibeamOnLoopback) {
+  std::string err;
+  auto d = make_lidar_driver(udp_lakibeam_options(), err);
+  CHECK(d != nullptr);
+  CHECK(d->bound_port() != 0);
+  const int s = udp_sender(nullptr);
+  CHECK(send_lakibeam_turns(s, d->bound_port(), 3) > 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(d->bound_port());
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   const std::uint8_t junk[100] = {};
   ::sendto(s, junk, sizeof junk, 0, reinterpret_cast<const sockaddr*>(&a), sizeof a);
   ::close(s);
@@ -229,54 +261,26 @@ TEST(LidarDrivers, UdpLakibeamOnLoopback) {
 }
 
 TEST(LidarDrivers, UdpSourceFilterDropsAndCountsForeignDatagrams) {
-  LidarDriverOptions o;
-  o.protocol = LidarProtocol::kLakibeam;
-  o.transport = LidarTransport::kUdp;
-  o.udp_bind_address = "127.0.0.1";
-  o.udp_port = 0;
+  LidarDriverOptions o = udp_lakibeam_options();
   o.udp_source_address = "127.0.0.1";
   std::string err;
   auto d = make_lidar_driver(o, err);
   CHECK_TEXT(d != nullptr, err.c_str());
   // Two senders on loopback: the sensor's address (127.0.0.1) and another host's (127.0.0.2).
-  auto sender = [](const char* addr) {
-    const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
-    sockaddr_in b{};
-    b.sin_family = AF_INET;
-    ::inet_pton(AF_INET, addr, &b.sin_addr);
-    CHECK_EQUAL(0, ::bind(s, reinterpret_cast<const sockaddr*>(&b), sizeof b));
-    return s;
-  };
-  const int sensor = sender("127.0.0.1"), intruder = sender("127.0.0.2");
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(d->bound_port());
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  auto scan = std::make_unique<LaserScan>(test_scan(1440));
-  LakibeamEncoder enc;
-  enc.configure(LidarAngleConvention{false, -kPi});
-  struct Ctx {
-    int s;
-    sockaddr_in a;
-    int sent;
-  } from_intruder{intruder, a, 0}, from_sensor{sensor, a, 0};
-  const auto send = [](const std::uint8_t* p, std::size_t n, void* u) {
-    auto* c = static_cast<Ctx*>(u);
-    if (::sendto(c->s, p, n, 0, reinterpret_cast<const sockaddr*>(&c->a), sizeof c->a) == static_cast<ssize_t>(n)) ++c->sent;
-  };
+  const int sensor = udp_sender("127.0.0.1"), intruder = udp_sender("127.0.0.2");
   // The intruder sends three whole turns first: none may become a scan.
-  for (int t = 0; t < 3; ++t) enc.encode_scan(scan->view(), 0, send, &from_intruder);
+  const int foreign = send_lakibeam_turns(intruder, d->bound_port(), 3);
   ::usleep(5000);
   auto out = std::make_unique<LaserScan>();
   CHECK_FALSE(d->poll_scan(*out));
-  CHECK(from_intruder.sent > 0);
-  CHECK_EQUAL(static_cast<std::uint32_t>(from_intruder.sent), d->counters().foreign_datagrams);
+  CHECK(foreign > 0);
+  CHECK_EQUAL(static_cast<std::uint32_t>(foreign), d->counters().foreign_datagrams);
   CHECK_EQUAL(0u, d->parser_counters().bytes);  // dropped unread: the parser never saw them
-  for (int t = 0; t < 3; ++t) enc.encode_scan(scan->view(), 0, send, &from_sensor);
+  CHECK(send_lakibeam_turns(sensor, d->bound_port(), 3) > 0);
   ::usleep(5000);
   CHECK(d->poll_scan(*out));
   CHECK_EQUAL(2u, d->counters().scans);
-  CHECK_EQUAL(static_cast<std::uint32_t>(from_intruder.sent), d->counters().foreign_datagrams);
+  CHECK_EQUAL(static_cast<std::uint32_t>(foreign), d->counters().foreign_datagrams);
   ::close(sensor);
   ::close(intruder);
   o.udp_source_address = "lidar.local";
