@@ -374,6 +374,12 @@ class UdpLidarDriver final : public LidarDriver {
       error = errno_text("setsockopt SO_REUSEADDR", "udp");
       return false;
     }
+    // The kernel's receive time of each datagram: a backlog that waited in the socket while dockd did not run is
+    // stamped when it arrived, not when it was read, so dockd's watchdog does not take it for fresh data.
+    if (::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof one) != 0) {
+      error = errno_text("setsockopt SO_TIMESTAMPNS", "udp");
+      return false;
+    }
     if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
       error = errno_text("bind", opt_.udp_bind_address + ":" + std::to_string(opt_.udp_port));
       return false;
@@ -408,12 +414,20 @@ class UdpLidarDriver final : public LidarDriver {
     if (fd_ < 0) return;
     for (int rounds = 0; rounds < 256; ++rounds) {
       sockaddr_in from{};
-      socklen_t from_len = sizeof from;
-      const ssize_t n = ::recvfrom(fd_, buf_.data(), buf_.size(), 0, reinterpret_cast<sockaddr*>(&from), &from_len);
+      iovec iov{buf_.data(), buf_.size()};
+      alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
+      msghdr msg{};
+      msg.msg_name = &from;
+      msg.msg_namelen = sizeof from;
+      msg.msg_iov = &iov;
+      msg.msg_iovlen = 1;
+      msg.msg_control = control;
+      msg.msg_controllen = sizeof control;
+      const ssize_t n = ::recvmsg(fd_, &msg, 0);
       if (n < 0) {
         if (errno == EAGAIN || errno == EWOULDBLOCK) break;
         if (errno == EINTR) continue;
-        error_ = errno_text("recvfrom", "udp");
+        error_ = errno_text("recvmsg", "udp");
         break;
       }
       if (!opt_.udp_source_address.empty() && (from.sin_family != AF_INET || from.sin_addr.s_addr != source_.s_addr)) {
@@ -424,7 +438,7 @@ class UdpLidarDriver final : public LidarDriver {
       // is rejected (and counted) by the parser.
       const std::size_t len = std::min(static_cast<std::size_t>(n), buf_.size());
       if (opt_.raw_tap) opt_.raw_tap(buf_.data(), len);
-      decoder_.feed_datagram(buf_.data(), len, monotonic_us());
+      decoder_.feed_datagram(buf_.data(), len, arrival_us(msg));
     }
   }
 
@@ -432,6 +446,25 @@ class UdpLidarDriver final : public LidarDriver {
   LidarDriverOptions opt_;
   LidarDecoder decoder_;
   mutable hal::LidarCounters hal_{};
+  /// The datagram's kernel receive time (SCM_TIMESTAMPNS, CLOCK_REALTIME) on the monotonic clock; the time of
+  /// reading when the kernel gave none or it lies in the future (a wall-clock step).
+  static std::uint64_t arrival_us(const msghdr& msg) {
+    const std::uint64_t now_mono = monotonic_us();
+    for (const cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(const_cast<msghdr*>(&msg), const_cast<cmsghdr*>(c))) {
+      if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_TIMESTAMPNS) continue;
+      timespec rx{};
+      std::memcpy(&rx, CMSG_DATA(c), sizeof rx);
+      timespec now{};
+      clock_gettime(CLOCK_REALTIME, &now);
+      const std::int64_t age_ns = (static_cast<std::int64_t>(now.tv_sec) - static_cast<std::int64_t>(rx.tv_sec)) *
+                                      1000000000 + (now.tv_nsec - rx.tv_nsec);
+      if (age_ns <= 0) return now_mono;
+      const std::uint64_t age_us = static_cast<std::uint64_t>(age_ns / 1000);
+      return now_mono > age_us ? now_mono - age_us : 0;
+    }
+    return now_mono;
+  }
+
   int fd_ = -1;
   std::uint16_t port_ = 0;
   in_addr source_{};            // opt_.udp_source_address, parsed (when set)

@@ -251,13 +251,18 @@ TEST(LidarDrivers, UdpLakibeamOnLoopback) {
   const std::uint8_t junk[100] = {};
   ::sendto(s, junk, sizeof junk, 0, reinterpret_cast<const sockaddr*>(&a), sizeof a);
   ::close(s);
-  ::usleep(5000);
+  const std::uint64_t sent_us = monotonic_us();
+  // Read 150 ms late (a reader that stalled): the scans are stamped with the kernel's receive time, not the read.
+  ::usleep(150000);
   auto out = std::make_unique<LaserScan>();
+  const std::uint64_t read_us = monotonic_us();
   CHECK(d->poll_scan(*out));
   CHECK_EQUAL(2u, d->counters().scans);
   CHECK_EQUAL(1u, d->parser_counters().bad_packets);
   CHECK_EQUAL(100u, d->counters().dropped_bytes);
   CHECK_EQUAL(1440u, out->count);
+  CHECK(out->stamp_us <= sent_us);
+  CHECK(out->stamp_us + 100000 < read_us);
 }
 
 TEST(LidarDrivers, UdpSourceFilterDropsAndCountsForeignDatagrams) {
