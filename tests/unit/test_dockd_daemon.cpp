@@ -487,3 +487,32 @@ TEST(DockdDaemon, PushDuringALateScanGapIsReportedAfterTheResume) {
     }
   }
 }
+
+// A chassis outage (184, resumed when the feedback returns) keeps the pre-outage dock as the push reference too
+// (docs/faults.md, 178): the wheels are held meanwhile, so a robot that still stands where it stopped docks on, and
+// one pushed during the outage is reported. Odometry does not see a push while the feedback is silent.
+TEST(DockdDaemon, ChassisOutageResumeKeepsThePushReference) {
+  for (int pushed = 0; pushed <= 1; ++pushed) {
+    const char* what = pushed != 0 ? "pushed" : "not pushed";
+    Rig r("chassisgap");
+    r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+    r.host.command(1, 0);
+    CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kAlign && !r.wheels_zero(); }, 20.0));
+    r.run_until([] { return false; }, 0.3);
+    r.link.silent = true;
+    CHECK_TRUE_TEXT(r.run_until([&] { return r.daemon->state() == TaskState::kFault; }, 3.0), what);
+    CHECK_EQUAL_TEXT(184, static_cast<int>(r.daemon->fault()), what);
+    if (pushed != 0) r.chassis->set_true_pose(r.chassis->state().true_pose.compose(dockcore::Pose2{0, 0.5, 0}));
+    r.run_until([] { return false; }, 0.5);
+    r.link.silent = false;
+    if (pushed != 0) {
+      CHECK_TEXT(r.run_until([&] { return static_cast<int>(r.daemon->fault()) == 178 ||
+                                          r.daemon->state() == TaskState::kFinishTasking; }, 30.0), what);
+      CHECK_EQUAL_TEXT(178, static_cast<int>(r.daemon->fault()), what);
+      CHECK_TEXT(r.wheels_zero(), what);
+    } else {
+      CHECK_TEXT(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0), what);
+    }
+    CHECK_EQUAL_TEXT(1u, r.daemon->counters().resumes, what);
+  }
+}
