@@ -375,11 +375,10 @@ class UdpLidarDriver final : public LidarDriver {
       return false;
     }
     // The kernel's receive time of each datagram: a backlog that waited in the socket while dockd did not run is
-    // stamped when it arrived, not when it was read, so dockd's watchdog does not take it for fresh data.
-    if (::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof one) != 0) {
-      error = errno_text("setsockopt SO_TIMESTAMPNS", "udp");
-      return false;
-    }
+    // stamped when it arrived, not when it was read, so dockd's watchdog does not take it for fresh data. A kernel
+    // (or emulator: qemu-user) without SO_TIMESTAMPNS gets SO_TIMESTAMP; without either, the time of reading.
+    receive_stamps_ = ::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof one) == 0 ||
+                      ::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMP, &one, sizeof one) == 0;
     if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
       error = errno_text("bind", opt_.udp_bind_address + ":" + std::to_string(opt_.udp_port));
       return false;
@@ -409,13 +408,14 @@ class UdpLidarDriver final : public LidarDriver {
   bool connected() const override { return fd_ >= 0; }
   const char* last_error() const override { return error_.c_str(); }
   std::uint16_t bound_port() const override { return port_; }
+  bool receive_stamps() const override { return receive_stamps_; }
 
   void service(std::uint64_t) override {
     if (fd_ < 0) return;
     for (int rounds = 0; rounds < 256; ++rounds) {
       sockaddr_in from{};
       iovec iov{buf_.data(), buf_.size()};
-      alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
+      alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec)) + CMSG_SPACE(sizeof(timeval))];
       msghdr msg{};
       msg.msg_name = &from;
       msg.msg_namelen = sizeof from;
@@ -446,14 +446,23 @@ class UdpLidarDriver final : public LidarDriver {
   LidarDriverOptions opt_;
   LidarDecoder decoder_;
   mutable hal::LidarCounters hal_{};
-  /// The datagram's kernel receive time (SCM_TIMESTAMPNS, CLOCK_REALTIME) on the monotonic clock; the time of
-  /// reading when the kernel gave none or it lies in the future (a wall-clock step).
+  /// The datagram's kernel receive time (SCM_TIMESTAMPNS or SCM_TIMESTAMP, CLOCK_REALTIME) on the monotonic clock;
+  /// the time of reading when the kernel gave none or it lies in the future (a wall-clock step).
   static std::uint64_t arrival_us(const msghdr& msg) {
     const std::uint64_t now_mono = monotonic_us();
     for (const cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(const_cast<msghdr*>(&msg), const_cast<cmsghdr*>(c))) {
-      if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_TIMESTAMPNS) continue;
+      if (c->cmsg_level != SOL_SOCKET) continue;
       timespec rx{};
-      std::memcpy(&rx, CMSG_DATA(c), sizeof rx);
+      if (c->cmsg_type == SCM_TIMESTAMPNS) {
+        std::memcpy(&rx, CMSG_DATA(c), sizeof rx);
+      } else if (c->cmsg_type == SCM_TIMESTAMP) {
+        timeval tv{};
+        std::memcpy(&tv, CMSG_DATA(c), sizeof tv);
+        rx.tv_sec = tv.tv_sec;
+        rx.tv_nsec = static_cast<long>(tv.tv_usec) * 1000;
+      } else {
+        continue;
+      }
       timespec now{};
       clock_gettime(CLOCK_REALTIME, &now);
       const std::int64_t age_ns = (static_cast<std::int64_t>(now.tv_sec) - static_cast<std::int64_t>(rx.tv_sec)) *
@@ -467,6 +476,7 @@ class UdpLidarDriver final : public LidarDriver {
 
   int fd_ = -1;
   std::uint16_t port_ = 0;
+  bool receive_stamps_ = false;  // the kernel stamps each datagram (SO_TIMESTAMPNS / SO_TIMESTAMP)
   in_addr source_{};            // opt_.udp_source_address, parsed (when set)
   std::uint32_t foreign_ = 0;   // datagrams from another source, dropped
   std::vector<std::uint8_t> buf_ = std::vector<std::uint8_t>(65536);

@@ -261,8 +261,14 @@ TEST(LidarDrivers, UdpLakibeamOnLoopback) {
   CHECK_EQUAL(1u, d->parser_counters().bad_packets);
   CHECK_EQUAL(100u, d->counters().dropped_bytes);
   CHECK_EQUAL(1440u, out->count);
-  CHECK(out->stamp_us <= sent_us);
-  CHECK(out->stamp_us + 100000 < read_us);
+  if (d->receive_stamps()) {
+    CHECK(out->stamp_us <= sent_us);
+    CHECK(out->stamp_us + 100000 < read_us);
+  } else {
+    // qemu-user (the cross stages) implements neither SO_TIMESTAMPNS nor SO_TIMESTAMP: stamped when read.
+    std::printf("\n  (no kernel receive stamps here: the UDP backlog stamp is not tested)\n");
+    CHECK(out->stamp_us >= read_us);
+  }
 }
 
 TEST(LidarDrivers, UdpSourceFilterDropsAndCountsForeignDatagrams) {

@@ -63,6 +63,9 @@ class LidarDriver : public hal::LidarSource {
   virtual const char* last_error() const = 0;
   /// The parser's full counters (superset of counters(): bad span, health packets, bin collisions ...).
   virtual LidarParserCounters parser_counters() const { return LidarParserCounters{}; }
+  /// UDP transport: the kernel stamps each datagram's arrival (SO_TIMESTAMPNS or SO_TIMESTAMP), so a backlog in the
+  /// socket keeps its arrival times; false (stamped when read) for serial or where the kernel refused both.
+  virtual bool receive_stamps() const { return false; }
   /// UDP transport: the local port actually bound (useful with udp_port 0); 0 for serial.
   virtual std::uint16_t bound_port() const { return 0; }
 };
