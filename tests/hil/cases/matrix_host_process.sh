@@ -42,9 +42,10 @@ post_sigkill() {
   echo "FIGURE process_sigkill_reaction_ms $base"
   # chassis-sim checks its command timeout every loop iteration and sends its feedback every 20 ms: a feedback gap
   # over 45 ms (20 ms + the limit's 25 ms) around the timeout is the simulated chassis not running (VM starvation).
-  local sim_stall
-  sim_stall=$($MATRIX_PY frame-stall "$RD" WheelFbA "$(inject_time last_wheel_cmd)" "$(awk -v t="$(inject_time last_wheel_cmd)" \
-    -v m="$base" 'BEGIN{printf "%.6f", t + (m == "none" ? 1 : m / 1000)}')")
+  local sim_stall t_last
+  t_last=$(inject_time last_wheel_cmd)
+  sim_stall=$($MATRIX_PY frame-stall "$RD" WheelFbA "$t_last" \
+    "$(awk -v t="$t_last" -v m="$base" 'BEGIN{printf "%.6f", t + (m == "none" ? 1 : m / 1000)}')")
   echo "FIGURE process_sigkill_sim_feedback_gap_ms $sim_stall"
   if awk -v m="$base" 'BEGIN{exit !(m != "none" && m + 0 <= 525)}'; then
     echo "PASS process_sigkill_base_stops_by_timeout"
