@@ -150,6 +150,22 @@ TEST(Scenario, UnknownKeyHasLineAndColumn) {
   CHECK(m.find("robot.wheel_radios_m") != std::string::npos);
 }
 
+TEST(Scenario, HostStallEventAndMotorCommandTimeout) {
+  const docksim::Scenario sc = docksim::parse_scenario_toml(
+      "[robot.motor]\ncommand_timeout_s = 0.5\n[[events]]\nt_s = 2\ntype = \"host_stall\"\nduration_s = 0.4\n",
+      "s.toml");
+  REAL_EQUAL(0.5, sc.chassis.motor.command_timeout_s, 1e-12);
+  CHECK_EQUAL(1u, sc.events.size());
+  CHECK(sc.events[0].kind == docksim::EventKind::kHostStall);
+  STRCMP_EQUAL("host_stall", docksim::to_string(sc.events[0].kind));
+  REAL_EQUAL(0.4, sc.events[0].duration_s, 1e-12);
+  // A host stall has no motion of its own: "motion" belongs to chassis_silent.
+  const docksim::ScenarioError e =
+      expect_error("[[events]]\nt_s = 1\ntype = \"host_stall\"\nduration_s = 1\nmotion = \"hold\"\n");
+  CHECK_EQUAL(5, e.line());
+  CHECK_EQUAL(2, expect_error("[robot.motor]\ncommand_timeout_s = -1\n").line());
+}
+
 TEST(Scenario, UnknownTopLevelTableAndEventKey) {
   const docksim::ScenarioError a = expect_error("seed = 1\n[robots]\n");
   CHECK_EQUAL(2, a.line());

@@ -149,6 +149,71 @@ TEST(SimRun, OneSecondOcclusionIsRecovered) {
   CHECK(back);
 }
 
+// dockd stalled (a starved machine): no scan read, no tick, the motors keep the last command until the chassis'
+// command timeout. The robot travels blind for exactly the timeout, then stands; the run resumes afterwards.
+TEST(SimRun, HostStallHoldsTheLastCommandUntilTheChassisTimeout) {
+  docksim::Scenario sc = default_scenario();
+  sc.chassis.motor.command_timeout_s = 0.2;
+  docksim::ScenarioEvent ev;
+  ev.t_s = 1.5;
+  ev.kind = docksim::EventKind::kHostStall;
+  ev.duration_s = 1.0;
+  sc.events.push_back(ev);
+  const docksim::StartPose start = docksim::start_from(sc, 1.5, 0, 0);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  opt.trajectory_period_s = 0.05;
+  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 5, opt);
+  auto pose_at = [&](double t) {
+    for (const auto& s : r.trajectory)
+      if (s.t_s >= t - 1e-9) return s.pose;
+    return r.trajectory.back().pose;
+  };
+  auto moved = [&](double a, double b) {
+    const docksim::Pose2 p = pose_at(a), q = pose_at(b);
+    return std::hypot(static_cast<double>(q.x_m - p.x_m), static_cast<double>(q.y_m - p.y_m));
+  };
+  // Moving into the stall, driving on through the 0.2 s timeout, then (after the motors' lag) standing still.
+  CHECK(moved(1.3, 1.5) > 0.01);
+  CHECK(moved(1.5, 1.7) > 0.01);
+  CHECK(moved(2.1, 2.5) < 2e-4);
+  bool stalled = false, resumed = false;
+  for (const auto& e : r.timeline) {
+    stalled |= e.kind == docksim::TimelineKind::kEvent && e.t_s == 1.5 && e.text.find("host stalled") == 0;
+    resumed |= e.kind == docksim::TimelineKind::kEvent && std::fabs(e.t_s - 2.5) < 1e-9 && e.text == "host runs again";
+    // No state change can happen while dockcore is not stepped.
+    CHECK(!(e.kind == docksim::TimelineKind::kState && e.t_s > 1.5 && e.t_s < 2.5));
+  }
+  CHECK(stalled);
+  CHECK(resumed);
+  check_docked(r);
+}
+
+// A 0.5 s stall close to the dock at approach speed: the robot overshoots blind, lines up short and presses the
+// dock face off the contacts; the controller's stall timeout ends the attempt and one retry docks (the recovery the
+// HIL flood rows see on a starved machine; tests/hil/matrix.py retry_onsets).
+TEST(SimRun, HostStallNearTheDockIsRecoveredByARetry) {
+  docksim::Scenario sc = default_scenario();
+  sc.chassis.motor.command_timeout_s = 0.5;
+  docksim::ScenarioEvent ev;
+  ev.t_s = 1.5;
+  ev.kind = docksim::EventKind::kHostStall;
+  ev.duration_s = 0.5;
+  sc.events.push_back(ev);
+  const docksim::StartPose start = docksim::start_from(sc, 0.516784, 13.077118 * kDeg, 20.577731 * kDeg);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 1, opt);
+  CHECK_EQUAL(1, r.outcome.retries);
+  CHECK(r.outcome.faults.empty());
+  check_docked(r);
+  // Without the stall the same start docks at the first attempt.
+  sc.events.clear();
+  const docksim::SimRun calm = docksim::run_docking(sc, "smooth", 1, opt);
+  CHECK_EQUAL(0, calm.outcome.retries);
+  CHECK(calm.outcome.charging_confirmed);
+}
+
 TEST(SimRun, ChargingNeverStartsEndsInFault182) {
   docksim::Scenario sc = default_scenario();
   docksim::ScenarioEvent ev;

@@ -113,6 +113,14 @@ int run(const Options& opt) {
     std::fprintf(stderr, "chassis-sim: unknown --protocol '%s' (dockcore-v1 | agilex-v2)\n", opt.protocol.c_str());
     return 2;
   }
+  for (const docksim::ScenarioEvent& ev : sc.events) {
+    if (ev.kind == docksim::EventKind::kHostStall) {
+      // dockd is another process: its stalls come from the machine (or SIGSTOP), not from this program.
+      std::fprintf(stderr, "chassis-sim: %s: event host_stall at %.2f s is dock-sim only (stall dockd with SIGSTOP)\n",
+                   opt.scenario_path.c_str(), ev.t_s);
+      return 2;
+    }
+  }
   const bool agilex = *proto == dockcore::drivers::ChassisProtocol::kAgilexV2;
   v1::Ids ids;
   ids.chassis_base = opt.chassis_base_id;
@@ -256,6 +264,7 @@ int run(const Options& opt) {
           break;
         case docksim::EventKind::kLidarDropout: dropout_until = std::max(dropout_until, mt + ev.duration_s); break;
         case docksim::EventKind::kChargingNeverStarts: chassis.set_charging_inhibited(true); break;
+        case docksim::EventKind::kHostStall: break;  // refused at start-up
         case docksim::EventKind::kChassisSilent:
           silent_until = std::max(silent_until, mt + ev.duration_s);
           silent = true;

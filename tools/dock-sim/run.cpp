@@ -133,6 +133,7 @@ nlohmann::ordered_json outcome_json(const docksim::SimRun& r) {
   j["path_length_m"] = r6(o.path_length_m);
   j["reversals"] = o.reversals;
   j["inplace_turns_45"] = o.inplace_turns_45;
+  j["retries"] = o.retries;
   j["min_clearance_m"] = std::isfinite(o.min_clearance_m) ? nlohmann::ordered_json(r6(o.min_clearance_m)) : nlohmann::ordered_json();
   nlohmann::ordered_json f = nlohmann::ordered_json::object();
   for (const auto& kv : o.faults) f[std::to_string(kv.first)] = kv.second;
@@ -237,7 +238,7 @@ struct Summary {
   std::string name;
   int trials = 0, successes = 0;
   std::vector<double> lat_mm, lon_mm, yaw_deg, time_s, path_m;
-  long reversals = 0, runs_with_reversals = 0, inplace = 0, runs_with_inplace = 0;
+  long reversals = 0, runs_with_reversals = 0, inplace = 0, runs_with_inplace = 0, retries = 0, runs_with_retries = 0;
   double min_clearance_m = std::numeric_limits<double>::infinity();
   std::map<int, int> faults;
   int timeouts = 0;
@@ -262,6 +263,8 @@ Summary summarise(const std::string& name, const std::vector<docksim::SimRun>& r
     s.runs_with_reversals += o.reversals > 0;
     s.inplace += o.inplace_turns_45;
     s.runs_with_inplace += o.inplace_turns_45 > 0;
+    s.retries += o.retries;
+    s.runs_with_retries += o.retries > 0;
     s.min_clearance_m = std::min(s.min_clearance_m, o.min_clearance_m);
     for (const auto& kv : o.faults) s.faults[kv.first] += kv.second;
     s.timeouts += o.timed_out;
@@ -286,18 +289,19 @@ std::string faults_str(const std::map<int, int>& f) {
 }
 
 void print_table(const std::vector<Summary>& sums) {
-  std::printf("%-8s %8s %16s %16s %16s %12s %8s %10s %12s %10s  %s\n", "ctrl", "success", "lat mm p50/95/max",
+  std::printf("%-8s %8s %16s %16s %16s %12s %8s %10s %12s %10s %10s  %s\n", "ctrl", "success", "lat mm p50/95/max",
               "lon mm p50/95/max", "yaw deg p50/95/max", "t s p50/p95", "path m", "reversals", "inplace>45",
-              "clearance", "faults");
+              "retries", "clearance", "faults");
   for (const auto& s : sums) {
     const std::string rate = fmt("%.1f%%", 100.0 * s.successes / std::max(1, s.trials));
     const std::string t = s.time_s.empty() ? "-" : fmt("%.1f", pct(s.time_s, 50)) + "/" + fmt("%.1f", pct(s.time_s, 95));
     const std::string rev = std::to_string(s.reversals) + " (" + std::to_string(s.runs_with_reversals) + ")";
     const std::string inp = std::to_string(s.inplace) + " (" + std::to_string(s.runs_with_inplace) + ")";
+    const std::string ret = std::to_string(s.retries) + " (" + std::to_string(s.runs_with_retries) + ")";
     const std::string clr = std::isfinite(s.min_clearance_m) ? fmt("%.3f", s.min_clearance_m) : "-";
-    std::printf("%-8s %8s %16s %16s %16s %12s %8s %10s %12s %10s  %s\n", s.name.c_str(), rate.c_str(),
+    std::printf("%-8s %8s %16s %16s %16s %12s %8s %10s %12s %10s %10s  %s\n", s.name.c_str(), rate.c_str(),
                 triple(s.lat_mm, "%.1f").c_str(), triple(s.lon_mm, "%.1f").c_str(), triple(s.yaw_deg, "%.2f").c_str(),
-                t.c_str(), fmt("%.2f", pct(s.path_m, 50)).c_str(), rev.c_str(), inp.c_str(), clr.c_str(),
+                t.c_str(), fmt("%.2f", pct(s.path_m, 50)).c_str(), rev.c_str(), inp.c_str(), ret.c_str(), clr.c_str(),
                 faults_str(s.faults).c_str());
   }
   for (const auto& s : sums) {
@@ -466,6 +470,8 @@ int run_mc(const McOptions& opt) {
       c["runs_with_reversals"] = s.runs_with_reversals;
       c["inplace_turns_45"] = s.inplace;
       c["runs_with_inplace_turns"] = s.runs_with_inplace;
+      c["retries"] = s.retries;
+      c["runs_with_retries"] = s.runs_with_retries;
       c["min_clearance_m"] = std::isfinite(s.min_clearance_m) ? nlohmann::ordered_json(r6(s.min_clearance_m)) : nlohmann::ordered_json();
       nlohmann::ordered_json f = nlohmann::ordered_json::object();
       for (const auto& kv : s.faults) f[std::to_string(kv.first)] = kv.second;

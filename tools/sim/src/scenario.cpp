@@ -24,6 +24,7 @@ const char* to_string(EventKind k) {
     case EventKind::kLidarDropout: return "lidar_dropout";
     case EventKind::kChargingNeverStarts: return "charging_never_starts";
     case EventKind::kChassisSilent: return "chassis_silent";
+    case EventKind::kHostStall: return "host_stall";
   }
   return "?";
 }
@@ -195,7 +196,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
                       {"time_constant_s", p.num(&m.time_constant_s, 0, 10)},
                       {"max_accel_radps2", p.num(&m.max_accel_radps2, 0, 1e4)},
                       {"max_speed_radps", p.num(&m.max_speed_radps, 0, 1e4)},
-                      {"deadband_radps", p.num(&m.deadband_radps, 0, 100)}};
+                      {"deadband_radps", p.num(&m.deadband_radps, 0, 100)},
+                      {"command_timeout_s", p.num(&m.command_timeout_s, 0, 60)}};
     }));
     h.emplace_back("odometry", p.sub("robot.odometry.", [&]() {
       NoiseParams& o = c.noise;
@@ -330,7 +332,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
       if (type == nullptr) p.fail(t->source(), "event without 'type'");
       if (t->get("t_s") == nullptr) p.fail(t->source(), "event without 't_s'");
       const std::string kind = p.choice(*type, {"push", "occlude_dock", "obstacle", "lidar_dropout",
-                                                "charging_never_starts", "chassis_silent"});
+                                                "charging_never_starts", "chassis_silent", "host_stall"});
       Handlers h{{"type", [](const toml::node&) {}}, {"t_s", p.num(&ev.t_s, 0, 1e5)}};
       const Handler dur = p.num(&ev.duration_s, 0, 1e5);
       if (kind == "push") {
@@ -352,6 +354,9 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         h.emplace_back("duration_s", dur);
       } else if (kind == "charging_never_starts") {
         ev.kind = EventKind::kChargingNeverStarts;
+      } else if (kind == "host_stall") {
+        ev.kind = EventKind::kHostStall;
+        h.emplace_back("duration_s", dur);
       } else {
         ev.kind = EventKind::kChassisSilent;
         h.emplace_back("duration_s", dur);

@@ -276,8 +276,8 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     double until_s;
   };
   std::vector<ActiveObstacle> active_obs;
-  double occluded_until = -1, dropout_until = -1, silent_until = -1;
-  bool silent = false;
+  double occluded_until = -1, dropout_until = -1, silent_until = -1, host_stalled_until = -1;
+  bool silent = false, host_stalled = false;
   std::size_t next_event = 0;
 
   // Lidar pipeline.
@@ -362,6 +362,11 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
           std::snprintf(buf, sizeof buf, "chassis silent for %.2f s (%s)", ev.duration_s,
                         ev.hold_last_command ? "motors hold the last command" : "motors stop");
           break;
+        case EventKind::kHostStall:
+          host_stalled_until = std::max(host_stalled_until, t + ev.duration_s);
+          host_stalled = true;
+          std::snprintf(buf, sizeof buf, "host stalled for %.2f s (motors keep the last command)", ev.duration_s);
+          break;
       }
       add(t, TimelineKind::kEvent, static_cast<int>(ev.kind), buf);
     }
@@ -369,6 +374,10 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       chassis.set_frozen(false);
       silent = false;
       add(t, TimelineKind::kEvent, static_cast<int>(EventKind::kChassisSilent), "chassis answers again");
+    }
+    if (host_stalled && t >= host_stalled_until) {
+      host_stalled = false;
+      add(t, TimelineKind::kEvent, static_cast<int>(EventKind::kHostStall), "host runs again");
     }
     active_obs.erase(std::remove_if(active_obs.begin(), active_obs.end(),
                                     [&](const ActiveObstacle& o) { return t >= o.until_s; }),
@@ -395,7 +404,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
         pending.push_back(std::move(ps));
       }
     }
-    while (!pending.empty() &&
+    // A stalled host reads nothing: the scans wait in its input (dockd's serial or socket buffer) and are read, in
+    // order, when it runs again.
+    while (!host_stalled && !pending.empty() &&
            static_cast<double>(now_us - pending.front()->stamp_us) * 1e-6 + 1e-9 >= sc.scan_latency_s) {
       core->on_scan(pending.front()->scan.view(), pending.front()->stamp_us, pending.front()->odom);
       last_scan = std::move(pending.front());
@@ -406,7 +417,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     if (sc.camera.enabled) camera.update(now_us, cs.true_pose, target_world, !occluded);
 
     // 4. Control tick.
-    if (k % kStepsPerTick == 0) {
+    if (k % kStepsPerTick == 0 && !host_stalled) {
       dockcore::TickInput in;
       in.now_us = now_us;
       // The host sends the first dock command once the lidar has delivered a scan (dockd would not start blind).
@@ -500,7 +511,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
         if (last_vx_sign != 0 && sgn != last_vx_sign) ++out.reversals;
         last_vx_sign = sgn;
       }
-      // Clearance.
+    }
+    // Measured on the tick clock whether or not the host ran: a stalled host's robot still moves.
+    if (k % kStepsPerTick == 0) {
       if (!static_obs.segments.empty() || !static_obs.discs.empty() || !active_obs.empty()) {
         Obstacles obs = static_obs;
         for (const auto& a : active_obs) obs.discs.push_back({pd(a.c), a.r});
@@ -510,7 +523,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
         out.min_clearance_m = std::min(out.min_clearance_m, clearance(poly, disc, centre, sc.chassis.footprint.radius_m, obs));
       }
       if (opt.record_trajectory && t + 1e-9 >= next_traj_t) {
-        run.trajectory.push_back(TrajectorySample{t, cs.true_pose, vx, static_cast<std::uint8_t>(s.state)});
+        run.trajectory.push_back(TrajectorySample{t, cs.true_pose, dd(prev_cmd.vx_mps), static_cast<std::uint8_t>(prev_state)});
         next_traj_t += opt.trajectory_period_s;
       }
     }

@@ -45,6 +45,8 @@ enum class EventKind : std::uint8_t {
   kLidarDropout,        ///< "lidar_dropout": no scans for duration_s.
   kChargingNeverStarts, ///< "charging_never_starts": the charger delivers no current from t_s on.
   kChassisSilent,       ///< "chassis_silent": the chassis stops answering for duration_s.
+  kHostStall,           ///< "host_stall": the control host (dockd and dockcore) does not run for duration_s: no scan
+                        ///< is read, no tick runs, the motors keep the last command (up to their command timeout).
 };
 
 /// Stable TOML name of an event kind ("push", ...). Never null.
@@ -56,7 +58,7 @@ struct ScenarioEvent {
   double t_s = 0;
   EventKind kind = EventKind::kPush;
   double dx_m = 0, dy_m = 0, dyaw_rad = 0;  ///< push (world frame).
-  double duration_s = 0;                    ///< occlude_dock, obstacle, lidar_dropout, chassis_silent.
+  double duration_s = 0;                    ///< occlude_dock, obstacle, lidar_dropout, chassis_silent, host_stall.
   double x_m = 0, y_m = 0, r_m = 0.1;       ///< obstacle: centre (world) and radius.
   bool hold_last_command = false;           ///< chassis_silent: motors keep the last command (else they stop).
 };
