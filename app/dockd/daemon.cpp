@@ -779,10 +779,18 @@ void Daemon::on_tick(std::uint64_t now_us) {
   // Events.
   const dockcore::TaskStatus& s = out.status;
   if (!prev_status_valid_ || s.state != prev_status_.state) {
-    char f[160];
-    std::snprintf(f, sizeof f, "\"from\":\"%s\",\"to\":\"%s\",\"dock_id\":%u,\"result\":\"%s\"",
-                  prev_status_valid_ ? dockcore::to_string(prev_status_.state) : "START", dockcore::to_string(s.state),
-                  s.dock_id, to_string_result(s.last_result));
+    char f[224];
+    int n = std::snprintf(f, sizeof f, "\"from\":\"%s\",\"to\":\"%s\",\"dock_id\":%u,\"result\":\"%s\"",
+                          prev_status_valid_ ? dockcore::to_string(prev_status_.state) : "START",
+                          dockcore::to_string(s.state), s.dock_id, to_string_result(s.last_result));
+    if (s.state == TaskState::kRetry && n > 0 && static_cast<std::size_t>(n) < sizeof f) {
+      // Why the attempt ended, and in which controller phase: what a user needs to tell a bad line-up from a
+      // charger that never delivered.
+      std::snprintf(f + n, sizeof f - static_cast<std::size_t>(n), ",\"reason\":\"%s\",\"code\":%u,\"phase\":\"%s\"",
+                    dockcore::to_string(s.retry_reason), static_cast<unsigned>(s.retry_reason),
+                    prev_status_.state == TaskState::kAlign ? controller_->phase_name(prev_status_.phase)
+                                                            : dockcore::to_string(prev_status_.state));
+    }
     log_event(now_us, "state", f);
   }
   if (s.state == TaskState::kAlign && (!prev_status_valid_ || s.phase != prev_status_.phase ||

@@ -460,6 +460,7 @@ void TaskManager::emit(const TaskInput& in, TaskOutput& out) {
   s.phase = state_ == TaskState::kAlign ? phase_ : static_cast<std::uint8_t>(0);
   s.fault = fault_;
   s.retries = retries_;
+  s.retry_reason = state_ == TaskState::kRetry ? retry_reason_ : FaultCode::kNone;
   s.dock_valid = dock_fresh(in);
   s.dock_pose = in.dock.pose;
   s.charge_enable = state_ == TaskState::kWaitForCharge || state_ == TaskState::kFinishTasking;

@@ -38,8 +38,9 @@ struct SimChassis final : dockcore::hal::ChassisLink {
     ch->command_wheels(r);
     return true;
   }
+  bool relay_broken = false;  ///< The base's charger relay never closes (the charger delivers no current).
   bool request_charging(bool on) override {
-    ch->set_charging_inhibited(!on);  // the base's charger relay
+    ch->set_charging_inhibited(!on || relay_broken);  // the base's charger relay
     return true;
   }
   const dockcore::hal::ChassisFeedback& poll() override {

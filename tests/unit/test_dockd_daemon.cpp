@@ -5,6 +5,7 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -15,6 +16,7 @@
 
 #include "dockcore/drivers/udp_host_link.hpp"
 #include "dockd_sim_rig.hpp"
+#include "session_record.hpp"
 #include "docksim/rng.hpp"
 
 #include "CppUTest/TestHarness.h"
@@ -46,11 +48,21 @@ struct Rig {
   std::string state_file;
   std::unique_ptr<dockcore::drivers::UdpHostLink> udp;
 
-  explicit Rig(const char* state_name, bool with_udp = false, double start_distance = 1.2) {
+  std::string record_dir;  ///< The session record's directory when `record`.
+  dockd::RotatingLog event_log;
+
+  explicit Rig(const char* state_name, bool with_udp = false, double start_distance = 1.2, bool record = false) {
     state_file = std::string("/tmp/dockd_test_") + std::to_string(::getpid()) + "_" + state_name;
     std::remove(state_file.c_str());
     std::remove((state_file + ".bak").c_str());
     cfg.state_file = state_file;
+    if (record) {
+      record_dir = state_file + "_record";
+      remove_record();
+      ::mkdir(record_dir.c_str(), 0700);
+      std::string err;
+      CHECK_TRUE_TEXT(event_log.open(record_dir, "events.jsonl", 1 << 20, 2, err), err.c_str());
+    }
     cfg.teach_scans = 10;
     dockd::DockEntry d3 = cfg.docks[0];
     d3.id = 3;
@@ -66,6 +78,7 @@ struct Rig {
     io.can_host = &host;
     io.clock = &clock;
     io.stderr_level = std::getenv("DOCKD_TEST_LOG") ? dockd::LogLevel::kDebug : dockd::LogLevel::kError;
+    if (record) io.event_log = &event_log;
     if (with_udp) {
       dockcore::drivers::UdpHostLinkOptions o;
       o.port = 0;
@@ -78,8 +91,29 @@ struct Rig {
     CHECK_TRUE(daemon->start(err));
   }
   ~Rig() {
+    daemon.reset();  // its shutdown event goes to event_log, declared (so destroyed) after it
     std::remove(state_file.c_str());
     std::remove((state_file + ".bak").c_str());
+    if (!record_dir.empty()) remove_record();
+  }
+  void remove_record() const {
+    for (const char* f : {"/events.jsonl", "/events.jsonl.1", "/can.log", "/can.log.1"})
+      std::remove((record_dir + f).c_str());
+    ::rmdir(record_dir.c_str());
+  }
+  /// The event log's lines with "event":"NAME".
+  std::string events(const char* name) const {
+    std::string out, line;
+    FILE* f = std::fopen((record_dir + "/events.jsonl").c_str(), "r");
+    if (f == nullptr) return out;
+    const std::string key = std::string("\"event\":\"") + name + "\"";
+    char buf[1024];
+    while (std::fgets(buf, sizeof buf, f) != nullptr) {
+      line = buf;
+      if (line.find(key) != std::string::npos) out += line;
+    }
+    std::fclose(f);
+    return out;
   }
 
   /// One 20 ms tick of the world: 4 chassis steps of 5 ms, a 10 Hz scan, then the daemon's tick.
@@ -148,6 +182,31 @@ TEST(DockdDaemon, DocksChargesAndUndocksInSimulation) {
   CHECK_EQUAL(static_cast<int>(dockcore::TaskResult::kUndocked), static_cast<int>(r.daemon->last_status().last_result));
   CHECK_FALSE(r.chassis->state().contact);
   CHECK(r.daemon->tick_stats().ticks > 100);
+}
+
+// A failed attempt says why in the event log (issue #6: CI saw a retry and nothing told its cause): the charger's
+// relay stays open for the first attempt, so WAIT_FOR_CHARGE times out into RETRY with charge_not_confirmed; the
+// second attempt charges.
+TEST(DockdDaemon, RetryEventSaysWhyTheAttemptEnded) {
+  Rig r("retry", false, 1.2, true);
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
+  r.link.relay_broken = true;
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kRetry; }, 60.0));
+  CHECK_EQUAL(182, static_cast<int>(r.daemon->last_status().retry_reason));
+  CHECK_EQUAL(0, static_cast<int>(r.daemon->last_status().fault));
+  r.link.relay_broken = false;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
+  CHECK_EQUAL(1, r.daemon->last_status().retries);
+  const std::string ev = r.events("state");
+  CHECK_TEXT(ev.find("\"from\":\"WAIT_FOR_CHARGE\",\"to\":\"RETRY\",\"dock_id\":0,\"result\":\"none\","
+                     "\"reason\":\"charge_not_confirmed\",\"code\":182,\"phase\":\"WAIT_FOR_CHARGE\"}") !=
+                 std::string::npos,
+             ev.c_str());
+  // Only the RETRY entry carries a reason.
+  int reasons = 0;
+  for (std::size_t p = ev.find("\"reason\""); p != std::string::npos; p = ev.find("\"reason\"", p + 1)) ++reasons;
+  CHECK_EQUAL(1, reasons);
 }
 
 TEST(DockdDaemon, ChassisStaleStopsWithinOneTickFaultsAndResumes) {

@@ -570,7 +570,10 @@ TEST(TaskManager, ChargingRetryThenSuccess) {
   s->command(HostCommandType::kDock);
   CHECK(s->run_until(TaskState::kRetry, 30));
   CHECK(!s->out.status.charge_enable);
+  LONGS_EQUAL(182, static_cast<int>(s->out.status.retry_reason));  // the attempt ended: no charging current
+  LONGS_EQUAL(0, static_cast<int>(s->out.status.fault));
   CHECK(s->run_until(TaskState::kReachTaskingPoint, 20));
+  LONGS_EQUAL(0, static_cast<int>(s->out.status.retry_reason));
   // Backed off on odometry until the centre is at the staging distance.
   REAL_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.1 * 0.02 + 0.002);
   LONGS_EQUAL(1, s->out.status.retries);
@@ -600,7 +603,10 @@ TEST(TaskManager, ControllerFailureRetriesThenFault188) {
   auto s = std::make_unique<Sim>();
   s->ctrl.fail = true;
   s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kRetry, 30));
+  LONGS_EQUAL(188, static_cast<int>(s->out.status.retry_reason));
   CHECK(s->run_until(TaskState::kFault, 60));
+  LONGS_EQUAL(0, static_cast<int>(s->out.status.retry_reason));
   LONGS_EQUAL(188, static_cast<int>(s->out.status.fault));
   LONGS_EQUAL(s->params.max_retries, s->out.status.retries);
 }

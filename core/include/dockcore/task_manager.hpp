@@ -171,6 +171,9 @@ struct TaskStatus {
   std::uint8_t phase = 0;          ///< Controller phase in ALIGN, else 0.
   FaultCode fault = FaultCode::kNone;
   std::uint8_t retries = 0;        ///< Retries used in the current/last task.
+  /// In RETRY: why the attempt ended (kAlignFailed: the controller gave up, e.g. pressed without contact;
+  /// kChargeNotConfirmed: no charging current), the fault raised when no retry is left. kNone in every other state.
+  FaultCode retry_reason = FaultCode::kNone;
   bool dock_valid = false;         ///< dock_pose is a current estimate (not older than target_lost_after_s).
   Pose2 dock_pose{};               ///< Dock in the robot frame.
   bool charge_enable = false;      ///< Charging requested.
