@@ -33,6 +33,7 @@ candump log's stamps, chassis-sim's truth "wall" field and the case's inject log
   matrix.py delta ROW_DIR EV1 EV2     -> ms from the first EV1 to the first EV2 at or after it (truth/inject events)
   matrix.py last-signal ROW_DIR FRAME SIGNAL -> that signal in the last frame of that name (dock-decode names)
   matrix.py faults-split ROW_DIR      -> "UNEXCUSED;EXCUSED" fault codes since the task started (VM-starvation split)
+  matrix.py retries-split ROW_DIR     -> "UNEXCUSED;EXCUSED" attempts that ended in RETRY, with reason (same split)
   matrix.py table CASE_DIR...         -> the measured table of docs/reliability.md (markdown)
   matrix.py states ROW_DIR            -> deduplicated DockStatus state sequence
 """
@@ -217,6 +218,69 @@ def watchdog_onsets(r):
                 why = "simulated lidar skipped a turn or sent late"
             out.append((t, c, why))
         prev = c
+    return out
+
+
+# A docking attempt that ends in RETRY because the controller gave up (pressed without contact) after dockd's loop
+# stalled: the robot drove blind on its last command (up to the chassis' 500 ms command timeout) and lined up short.
+# In dock-sim (host_stall events every second through the approach, 400 starts, [robot.motor] command_timeout_s 0.5)
+# stalls up to 300 ms never made a retry; 0.5 s stalls did in 7 of 400 runs (docs/reliability.md).
+RETRY_STALL_MS = 300
+
+
+def truth_at(d, t):
+    """chassis-sim's last truth line at or before wall time t (None when there is none)."""
+    best = None
+    tp = os.path.join(d, "truth.jsonl")
+    if not os.path.exists(tp):
+        return None
+    with open(tp) as f:
+        for line in f:
+            try:
+                j = json.loads(line)
+            except ValueError:
+                continue
+            if float(j.get("wall", 0)) > t:
+                break
+            best = j
+    return best
+
+
+def retry_onsets(r):
+    """[(wall, what, excuse)] for every attempt that ended in RETRY (DockStatus state 6); `what` = dockd's reason and
+    phase (its state event) and the true pads then; excuse says why the retry was the test machine's ("" when
+    nothing excuses it): the attempt ended in ALIGN with align_failed, the true contacts were open (dockd did not miss
+    a contact), and dockd's own 20 ms wheel frames stalled longer than RETRY_STALL_MS during that attempt."""
+    wheels = [e["wall"] for e in r.wheels()]
+    reasons = [e for e in r.dockd_events if e.get("event") == "state" and e.get("to") == "RETRY"]
+    out = []
+    prev = None
+    attempt_t0 = None
+    n = 0
+    for e in r.status():
+        s = int(e["signals"]["state"])
+        if s == prev:
+            continue
+        if s == STATE["ALIGN"]:
+            attempt_t0 = e["wall"]
+        if s == STATE["RETRY"]:
+            t = e["wall"]
+            ev = reasons[n] if n < len(reasons) else {}
+            n += 1
+            reason = ev.get("reason", "?")
+            tr = truth_at(r.dir, t)
+            pads = "pads unknown"
+            if tr is not None:
+                pads = (f"pads {float(tr['pad_lateral_m']) * 1000:+.0f} mm, "
+                        f"{float(tr['pad_yaw_rad']) * 57.29578:+.1f} deg, contact {tr['contact']}")
+            what = f"{reason} in {ev.get('phase', '?')}, {pads}"
+            stall = stall_ms(wheels, attempt_t0, t) if attempt_t0 is not None else 0.0
+            why = ""
+            if (prev == STATE["ALIGN"] and reason == "align_failed" and tr is not None and not tr["contact"]
+                    and stall > RETRY_STALL_MS):
+                why = f"dockd stalled {stall:.0f} ms in the attempt"
+            out.append((t, what, why))
+        prev = s
     return out
 
 
@@ -569,6 +633,16 @@ def main(argv):
                 excused.append(f"{c}({why})")
             else:
                 unexcused.append(str(c))
+        print(" ".join(unexcused) + ";" + " ".join(excused))
+        return 0
+    if cmd == "retries-split":
+        # "UNEXCUSED;EXCUSED": the attempts that ended in RETRY, split by cause (retry_onsets), each with its reason.
+        unexcused, excused = [], []
+        for _, what, why in retry_onsets(Row(argv[2])):
+            if why:
+                excused.append(f"({what}; {why})")
+            else:
+                unexcused.append(f"({what})")
         print(" ".join(unexcused) + ";" + " ".join(excused))
         return 0
     if cmd == "last-signal":

@@ -13,10 +13,19 @@ post_flood() {
   echo "FIGURE ${ROW}_wheel_frames_during_flood $n"
   check_no_fault "$ROW"
   states=$($MATRIX_PY states "$RD"); echo "INFO $ROW states: $states"
-  # The docking ran once through to charging (4), never cancelled back to NOT_TASKING (0) on the way; a watchdog
-  # FAULT (8) with its resume (1 2 3 ...) is allowed only when check_no_fault excused it as starvation above.
-  if [ "$FAULTS_SPLIT" = ";" ] || [ "${HIL_STRICT_TIMING:-0}" = 1 ]; then
+  local retries unexc_r exc_r
+  retries=$($MATRIX_PY retries-split "$RD"); unexc_r=${retries%%;*}; exc_r=${retries#*;}
+  echo "INFO $ROW retries: '$unexc_r' starvation-excused: '$exc_r'"
+  # The docking ran once through to charging (4), never cancelled back to NOT_TASKING (0) on the way. A watchdog
+  # FAULT (8) with its resume (1 2 3 ...) is allowed only when check_no_fault excused it as starvation above; a
+  # RETRY (6) and the attempt after it only when retry_onsets excused it (dockd stalled in that attempt and the robot
+  # pressed off the contacts): then STARVED.
+  if { [ "$FAULTS_SPLIT" = ";" ] && [ "$retries" = ";" ]; } || [ "${HIL_STRICT_TIMING:-0}" = 1 ]; then
     check "${ROW}_state_sequence" grep -qE '^0 1 (2 )?3 5 4$' <<< "$states"
+  elif [ -n "$unexc_r" ]; then
+    check "${ROW}_state_sequence" false
+  elif [ -n "$exc_r" ] && grep -qE '^0 1 (2 )?3 ([0-9 ]* )?5 4$' <<< "${states// 0 / X }"; then
+    echo "STARVED ${ROW}_state_sequence  (retried: $exc_r: VM starvation)"
   else
     check "${ROW}_state_sequence" grep -qE '^0 1 (2 )?3 ([0-9 ]* )?5 4$' <<< "${states// 0 / X }"
   fi
