@@ -23,7 +23,10 @@ post_request_off() {
 # consecutive agreeing detection after the push. The first turn rendered after the push starts <= 100 ms after it,
 # the second 100 ms later, and a turn is published when its last packet has left (paced over the turn, as the sensor
 # sends) and the next turn's first one shows the wrap: the second post-push turn is parsed <= 300 ms after the push,
-# plus one 20 ms tick: limit 320 ms. If dockd's own loop stalled over 500 ms (target_lost_after) around the push, the
+# plus one 20 ms tick: 320 ms when the first two post-push detections both count. They do not always: in dock-sim
+# (these scenarios, seeds 1-200) the fault came on the 2nd post-push turn in 154/176 runs (angle/distance), the 3rd in
+# 39/21 and the 4th in 7/3 (docs/reliability.md), and CI saw 372 ms with dockd's loop on time. The limit allows
+# those two more turns: 520 ms. If dockd's own loop stalled over 500 ms (target_lost_after) around the push, the
 # VM decided the row (the target is lost and reacquired at the pushed pose): its failed checks count as STARVED
 # (docs/reliability.md). Not a watchdog fault: no resume; the
 # robot holds until a new dock command (sent 1.5 s later, sequence 2), then moves again.
@@ -37,7 +40,7 @@ push_row() {
   cansend vcan0 "$("$BUILD/tests/hil/hil_frames" dock 0 2)"
   sleep 1.5
   row_stop
-  judge --fault push --limit-ms 320 --code "$code" --clear redock --recover moving --starved-if-stall-ms 500
+  judge --fault push --limit-ms 520 --code "$code" --clear redock --recover moving --starved-if-stall-ms 500
 }
 push_row motion_push_distance push_distance.toml 178
 push_row motion_push_angle push_angle.toml 179
