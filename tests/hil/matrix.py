@@ -96,6 +96,7 @@ class Row:
                 self.timeline.append(e)
         self.decode = doc
         self.events = {}  # name -> [wall...]
+        self.truth = []  # chassis-sim's truth lines (dicts with "wall"), in file order
         tp = os.path.join(d, "truth.jsonl")
         if os.path.exists(tp):
             with open(tp) as f:
@@ -104,7 +105,10 @@ class Row:
                         j = json.loads(line)
                     except ValueError:
                         continue
-                    if "event" in j and "wall" in j:
+                    if "wall" not in j:
+                        continue
+                    self.truth.append(j)
+                    if "event" in j:
                         self.events.setdefault(j["event"], []).append(float(j["wall"]))
         ip = os.path.join(d, "inject.log")
         if os.path.exists(ip):
@@ -122,6 +126,15 @@ class Row:
                         self.dockd_events.append(json.loads(line))
                     except ValueError:
                         pass
+
+    def truth_at(self, t):
+        """chassis-sim's last truth line at or before wall time t (None when there is none)."""
+        best = None
+        for j in self.truth:
+            if float(j["wall"]) > t:
+                break
+            best = j
+        return best
 
     def wheels(self):
         return [e for e in self.timeline if e["name"] == "WheelCmdA"]
@@ -228,24 +241,6 @@ def watchdog_onsets(r):
 RETRY_STALL_MS = 300
 
 
-def truth_at(d, t):
-    """chassis-sim's last truth line at or before wall time t (None when there is none)."""
-    best = None
-    tp = os.path.join(d, "truth.jsonl")
-    if not os.path.exists(tp):
-        return None
-    with open(tp) as f:
-        for line in f:
-            try:
-                j = json.loads(line)
-            except ValueError:
-                continue
-            if float(j.get("wall", 0)) > t:
-                break
-            best = j
-    return best
-
-
 def retry_onsets(r):
     """[(wall, what, excuse)] for every attempt that ended in RETRY (DockStatus state 6); `what` = dockd's reason and
     phase (its state event) and the true pads then; excuse says why the retry was the test machine's ("" when
@@ -268,7 +263,7 @@ def retry_onsets(r):
             ev = reasons[n] if n < len(reasons) else {}
             n += 1
             reason = ev.get("reason", "?")
-            tr = truth_at(r.dir, t)
+            tr = r.truth_at(t)
             pads = "pads unknown"
             if tr is not None:
                 pads = (f"pads {float(tr['pad_lateral_m']) * 1000:+.0f} mm, "
@@ -473,6 +468,15 @@ def judge_row(argv):
     return fails
 
 
+def print_split(items):
+    """Prints "UNEXCUSED;EXCUSED" from (unexcused text, excused text, excuse) triples: the excused text when there
+    is an excuse."""
+    unexcused, excused = [], []
+    for plain, with_excuse, why in items:
+        (excused if why else unexcused).append(with_excuse if why else plain)
+    print(" ".join(unexcused) + ";" + " ".join(excused))
+
+
 def main(argv):
     if len(argv) < 2:
         print(__doc__)
@@ -627,23 +631,11 @@ def main(argv):
     if cmd == "faults-split":
         # "UNEXCUSED;EXCUSED": fault codes of the status frames, split by cause (watchdog_onsets): a watchdog fault
         # that the test machine's starvation explains is listed as excused, with that cause.
-        unexcused, excused = [], []
-        for _, c, why in watchdog_onsets(Row(argv[2])):
-            if why:
-                excused.append(f"{c}({why})")
-            else:
-                unexcused.append(str(c))
-        print(" ".join(unexcused) + ";" + " ".join(excused))
+        print_split((str(c), f"{c}({why})", why) for _, c, why in watchdog_onsets(Row(argv[2])))
         return 0
     if cmd == "retries-split":
         # "UNEXCUSED;EXCUSED": the attempts that ended in RETRY, split by cause (retry_onsets), each with its reason.
-        unexcused, excused = [], []
-        for _, what, why in retry_onsets(Row(argv[2])):
-            if why:
-                excused.append(f"({what}; {why})")
-            else:
-                unexcused.append(f"({what})")
-        print(" ".join(unexcused) + ";" + " ".join(excused))
+        print_split((f"({what})", f"({what}; {why})", why) for _, what, why in retry_onsets(Row(argv[2])))
         return 0
     if cmd == "last-signal":
         r = Row(argv[2])

@@ -25,6 +25,18 @@ docksim::Scenario default_scenario() {
   return docksim::load_scenario_file(f + "/tools/scenarios/default.toml");
 }
 
+// The default scenario with a base command timeout and one host_stall event.
+docksim::Scenario host_stall_scenario(double command_timeout_s, double t_s, double duration_s) {
+  docksim::Scenario sc = default_scenario();
+  sc.chassis.motor.command_timeout_s = command_timeout_s;
+  docksim::ScenarioEvent ev;
+  ev.t_s = t_s;
+  ev.kind = docksim::EventKind::kHostStall;
+  ev.duration_s = duration_s;
+  sc.events.push_back(ev);
+  return sc;
+}
+
 bool has_fault(const docksim::SimRun& r, int code, double after_s, double before_s) {
   for (const auto& e : r.timeline) {
     if (e.kind == docksim::TimelineKind::kFault && e.code == code && e.t_s >= after_s && e.t_s <= before_s) return true;
@@ -152,13 +164,7 @@ TEST(SimRun, OneSecondOcclusionIsRecovered) {
 // dockd stalled (a starved machine): no scan read, no tick, the motors keep the last command until the chassis'
 // command timeout. The robot travels blind for exactly the timeout, then stands; the run resumes afterwards.
 TEST(SimRun, HostStallHoldsTheLastCommandUntilTheChassisTimeout) {
-  docksim::Scenario sc = default_scenario();
-  sc.chassis.motor.command_timeout_s = 0.2;
-  docksim::ScenarioEvent ev;
-  ev.t_s = 1.5;
-  ev.kind = docksim::EventKind::kHostStall;
-  ev.duration_s = 1.0;
-  sc.events.push_back(ev);
+  docksim::Scenario sc = host_stall_scenario(0.2, 1.5, 1.0);
   const docksim::StartPose start = docksim::start_from(sc, 1.5, 0, 0);
   docksim::SimOptions opt;
   opt.start = &start;
@@ -193,13 +199,7 @@ TEST(SimRun, HostStallHoldsTheLastCommandUntilTheChassisTimeout) {
 // dock face off the contacts; the controller's stall timeout ends the attempt and one retry docks (the recovery the
 // HIL flood rows see on a starved machine; tests/hil/matrix.py retry_onsets).
 TEST(SimRun, HostStallNearTheDockIsRecoveredByARetry) {
-  docksim::Scenario sc = default_scenario();
-  sc.chassis.motor.command_timeout_s = 0.5;
-  docksim::ScenarioEvent ev;
-  ev.t_s = 1.5;
-  ev.kind = docksim::EventKind::kHostStall;
-  ev.duration_s = 0.5;
-  sc.events.push_back(ev);
+  docksim::Scenario sc = host_stall_scenario(0.5, 1.5, 0.5);
   const docksim::StartPose start = docksim::start_from(sc, 0.516784, 13.077118 * kDeg, 20.577731 * kDeg);
   docksim::SimOptions opt;
   opt.start = &start;

@@ -295,9 +295,10 @@ void print_table(const std::vector<Summary>& sums) {
   for (const auto& s : sums) {
     const std::string rate = fmt("%.1f%%", 100.0 * s.successes / std::max(1, s.trials));
     const std::string t = s.time_s.empty() ? "-" : fmt("%.1f", pct(s.time_s, 50)) + "/" + fmt("%.1f", pct(s.time_s, 95));
-    const std::string rev = std::to_string(s.reversals) + " (" + std::to_string(s.runs_with_reversals) + ")";
-    const std::string inp = std::to_string(s.inplace) + " (" + std::to_string(s.runs_with_inplace) + ")";
-    const std::string ret = std::to_string(s.retries) + " (" + std::to_string(s.runs_with_retries) + ")";
+    auto total_runs = [](long total, long runs) { return std::to_string(total) + " (" + std::to_string(runs) + ")"; };
+    const std::string rev = total_runs(s.reversals, s.runs_with_reversals);
+    const std::string inp = total_runs(s.inplace, s.runs_with_inplace);
+    const std::string ret = total_runs(s.retries, s.runs_with_retries);
     const std::string clr = std::isfinite(s.min_clearance_m) ? fmt("%.3f", s.min_clearance_m) : "-";
     std::printf("%-8s %8s %16s %16s %16s %12s %8s %10s %12s %10s %10s  %s\n", s.name.c_str(), rate.c_str(),
                 triple(s.lat_mm, "%.1f").c_str(), triple(s.lon_mm, "%.1f").c_str(), triple(s.yaw_deg, "%.2f").c_str(),
