@@ -327,7 +327,8 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
   for (int i = 0; i < 4 && io_.lidar->poll_scan(*scan_); ++i) {
     ++counters_.scans;
     const std::uint64_t stamp = scan_->stamp_us != 0 && scan_->stamp_us <= now_us ? scan_->stamp_us : now_us;
-    if (prev_scan_stamp_us_ != 0 && stamp > prev_scan_stamp_us_ && stamp - prev_scan_stamp_us_ <= 500000u)
+    const std::uint64_t max_period_us = std::max<std::uint64_t>(500000u, std::uint64_t{cfg_.lidar_stale_ms} * 1000u);
+    if (prev_scan_stamp_us_ != 0 && stamp > prev_scan_stamp_us_ && stamp - prev_scan_stamp_us_ <= max_period_us)
       scan_period_us_ = stamp - prev_scan_stamp_us_;
     prev_scan_stamp_us_ = stamp;
     const std::uint64_t turn_end_us = std::min(now_us, stamp + scan_period_us_);
@@ -340,7 +341,12 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
     }
     have_scan_ = true;
     last_scan_late_ = false;
-    if (turn_end_us > last_scan_rx_us_) last_scan_rx_us_ = turn_end_us;
+    last_scan_parsed_us_ = now_us;
+    // A scan is stamped with its first sample: one scan alone cannot say when its turn ended. Taking its start for
+    // its end made the first scan after start-up look one turn old, so the watchdog tripped just before the second
+    // one arrived — a 185 flap that a host docking right away saw in the status (CI, motion_obstacle). The lidar
+    // counts as fresh from the second scan on, when the turn's length is known; the first one still feeds the core.
+    if (scan_period_us_ != 0 && turn_end_us > last_scan_rx_us_) last_scan_rx_us_ = turn_end_us;
     const dockcore::DockEstimate& e = core_->on_scan(scan_->view(), stamp, odom_at(stamp));
     if (e.found) {
       ++counters_.detections;
@@ -477,9 +483,17 @@ void Daemon::watchdogs(std::uint64_t now_us) {
   const bool chassis = !have_wheels_ || (now_us > last_wheels_stamp_us_ && now_us - last_wheels_stamp_us_ > chassis_lim);
   if (lidar != lidar_stale_) {
     if (lidar) ++counters_.lidar_stale_trips;
-    char f[96];
-    std::snprintf(f, sizeof f, "\"which\":\"lidar\",\"stale\":%s,\"fault\":%u", lidar ? "true" : "false",
-                  static_cast<unsigned>(FaultCode::kLidarStale));
+    // Why it went stale, for a log read after the fact: how old the newest turn's end and the newest parse are
+    // (-1: none yet). A turn that ended long ago but was parsed just now is a backlog; both old is a silent lidar.
+    char f[192];
+    const auto age_ms = [now_us](std::uint64_t t) {
+      return t == 0 || t > now_us ? -1LL : static_cast<long long>((now_us - t) / 1000u);
+    };
+    std::snprintf(f, sizeof f,
+                  "\"which\":\"lidar\",\"stale\":%s,\"fault\":%u,\"turn_end_age_ms\":%lld,\"parsed_age_ms\":%lld,"
+                  "\"late_scans\":%u",
+                  lidar ? "true" : "false", static_cast<unsigned>(FaultCode::kLidarStale), age_ms(last_scan_rx_us_),
+                  age_ms(last_scan_parsed_us_), counters_.late_scans);
     log_event(now_us, "watchdog", f, lidar ? LogLevel::kWarn : LogLevel::kInfo);
   }
   if (chassis != chassis_stale_) {

@@ -220,11 +220,13 @@ class Daemon {
   // Lidar and camera.
   bool have_scan_ = false;
   /// When the newest scan's turn ended (its stamp plus one turn), clamped to its receive time: what the stale-lidar
-  /// watchdog measures from. Parse time would let a backlog of old bytes pass for a live sensor.
+  /// watchdog measures from. Parse time would let a backlog of old bytes pass for a live sensor. 0 until the turn's
+  /// length is known (the second scan).
   std::uint64_t last_scan_rx_us_ = 0;
+  std::uint64_t last_scan_parsed_us_ = 0;  ///< When dockd last parsed a usable (not late) scan.
   std::uint64_t prev_scan_stamp_us_ = 0;
   bool last_scan_late_ = false;       ///< scan_ holds a late scan (not given to the core).
-  std::uint64_t scan_period_us_ = 0;  ///< Spacing of the last two scan stamps, if plausible (≤ 0.5 s); 0 = unknown.
+  std::uint64_t scan_period_us_ = 0;  ///< Spacing of the last two scan stamps, if plausible (≤ 0.5 s or lidar_stale_ms); 0 = unknown.
   dockcore::CameraTarget camera_{};
 
   // Commands.

@@ -287,6 +287,30 @@ TEST(DockdDaemon, LidarStaleStopsWithinOneTickAndFaults) {
   CHECK_TRUE(r.wheels_zero());
 }
 
+TEST(DockdDaemon, LidarWatchdogDoesNotFlapAtStartUp) {
+  // A real sensor's turn reaches dockd a turn and a bit after its first sample (the parser closes it on the next
+  // turn's first point): here 130 ms. The first scan alone does not say when its turn ended; taken for ending at
+  // its first sample, it made the lidar fresh and then stale again just before the second scan (CI saw that 185 in
+  // the status of a docking commanded right after start-up). Once fresh, it must stay fresh.
+  Rig r("startup", false, 1.2, true);
+  r.scan_lag_us = 130000;
+  bool was_fresh = false;
+  int flaps = 0;
+  for (int i = 0; i < 100; ++i) {  // 2 s
+    r.tick();
+    if (!r.daemon->lidar_stale()) was_fresh = true;
+    else if (was_fresh) ++flaps;
+  }
+  CHECK_TRUE(was_fresh);
+  CHECK_EQUAL(0, flaps);
+  CHECK_EQUAL(0u, r.daemon->counters().lidar_stale_trips);
+  CHECK_EQUAL(0u, r.daemon->counters().late_scans);
+  // The watchdog's events say how old the data was: the one that went fresh carries the ages.
+  const std::string ev = r.events("watchdog");
+  CHECK_TRUE(ev.find("\"which\":\"lidar\",\"stale\":false") != std::string::npos);
+  CHECK_TRUE(ev.find("\"turn_end_age_ms\":") != std::string::npos);
+}
+
 TEST(DockdDaemon, ScansDeliveredLateDoNotKeepTheLidarFresh) {
   // A reader behind a backlog keeps parsing turns, but their stamps (sensor clock) are old: the stale watchdog must
   // go by when the turn was measured, not when dockd parsed it.
