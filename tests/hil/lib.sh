@@ -77,6 +77,12 @@ DOCKCTL() { "$BUILD/app/dockctl" --port 7300 --timeout 2 "$@"; }
 # Current task state name from dockd over UDP ("" when dockd does not answer).
 dock_state() { DOCKCTL status 2>/dev/null | sed -n 's/.*"state":"\([A-Z_]*\)".*/\1/p'; }
 state_is() { [ "$(dock_state)" = "$1" ]; }
+# dockd idle with fresh lidar and chassis data: a docking commanded now starts without a watchdog hold. (A host that
+# docks before that sees the 184/185 watchdog code in the status until the data comes, which a no-fault check counts.)
+dockd_ready() {
+  local s; s=$(DOCKCTL status 2>/dev/null)
+  [[ $s == *'"state":"NOT_TASKING"'* && $s == *'"lidar_stale":false'* && $s == *'"chassis_stale":false'* ]]
+}
 
 # chassis-sim from this build.
 chassis-sim-run() { "$BUILD/tools/chassis-sim/chassis-sim" "$@"; }

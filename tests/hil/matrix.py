@@ -33,6 +33,7 @@ candump log's stamps, chassis-sim's truth "wall" field and the case's inject log
   matrix.py delta ROW_DIR EV1 EV2     -> ms from the first EV1 to the first EV2 at or after it (truth/inject events)
   matrix.py last-signal ROW_DIR FRAME SIGNAL -> that signal in the last frame of that name (dock-decode names)
   matrix.py faults-split ROW_DIR      -> "UNEXCUSED;EXCUSED" fault codes since the task started (VM-starvation split)
+  matrix.py faults-explain ROW_DIR    -> one line per unexcused watchdog fault: time, state, stalls, dockd's reason
   matrix.py retries-split ROW_DIR     -> "UNEXCUSED;EXCUSED" attempts that ended in RETRY, with reason (same split)
   matrix.py table CASE_DIR...         -> the measured table of docs/reliability.md (markdown)
   matrix.py states ROW_DIR            -> deduplicated DockStatus state sequence
@@ -196,6 +197,10 @@ def stall_ms(times, t0, t1):
 # trips it; the chassis watchdog (chassis_stale_ms 200) sees feedback 20 ms old at best.
 LIDAR_WATCHDOG_MARGIN_MS = 100
 CHASSIS_WATCHDOG_MARGIN_MS = 180
+# chassis-sim writes sim_lidar_late / sim_scan_skipped when it runs again after a stall: in a loaded HIL run
+# (2026-11-22, /tmp/obs2) a 240 ms stall of the VM left dockd without scans and the event was stamped 36 ms after
+# the 185 it caused. A starved simulator's next loop runs within a tick or two once it is scheduled again.
+SIM_LATE_LOGGED_AFTER_S = 0.3
 
 
 def watchdog_onsets(r):
@@ -205,7 +210,8 @@ def watchdog_onsets(r):
       dockd: it could not read the data in time);
     - 184: chassis-sim's 20 ms feedback frames stalled longer than the margin (the simulated chassis starved);
     - 185: chassis-sim logged "sim_scan_skipped" (its loop fell a turn behind) or "sim_lidar_late" (a turn or its
-      paced packets left late) in the 0.5 s before."""
+      paced packets left late) in the 0.5 s before, or up to 0.3 s after: chassis-sim notices its lateness only when
+      it runs again, so a stall of the simulator that starved dockd of scans is logged after the 185 it caused."""
     wheels = [e["wall"] for e in r.wheels()]
     feedback = [e["wall"] for e in r.timeline if e["name"] == "WheelFbA"]
     skipped = r.events.get("sim_scan_skipped", []) + r.events.get("sim_lidar_late", [])
@@ -227,11 +233,54 @@ def watchdog_onsets(r):
                 why = f"stall {stall:.0f} ms"
             elif c == 184 and fb > CHASSIS_WATCHDOG_MARGIN_MS:
                 why = f"simulated chassis silent {fb:.0f} ms"
-            elif c == 185 and any(t - 0.5 <= k <= t for k in skipped):
+            elif c == 185 and any(t - 0.5 <= k <= t + SIM_LATE_LOGGED_AFTER_S for k in skipped):
                 why = "simulated lidar skipped a turn or sent late"
             out.append((t, c, why))
         prev = c
     return out
+
+
+def dockd_wall_offset(r):
+    """Seconds to add to dockd's event clock (t_us / 1e6, monotonic) to get wall time: the first DockStatus frame
+    with state GET_TASKING_CMD against dockd's state event into it (both in the same tick; None when absent)."""
+    ev = next((e for e in r.dockd_events if e.get("event") == "state" and e.get("to") == "GET_TASKING_CMD"), None)
+    st = next((e for e in r.status() if int(e["signals"]["state"]) == STATE["GET_TASKING_CMD"]), None)
+    if ev is None or st is None:
+        return None
+    return st["wall"] - ev["t_us"] / 1e6
+
+
+def explain_onsets(r):
+    """One line per unexcused watchdog fault onset (watchdog_onsets): when it came, the stalls around it and what
+    dockd's watchdog event said — so a check that failed on a machine that keeps no row logs still says why."""
+    wheels = [e["wall"] for e in r.wheels()]
+    feedback = [e["wall"] for e in r.timeline if e["name"] == "WheelFbA"]
+    late = sorted(r.events.get("sim_scan_skipped", []) + r.events.get("sim_lidar_late", []))
+    dock = r.event("dock")
+    off = dockd_wall_offset(r)
+    lines = []
+    for t, c, why in watchdog_onsets(r):
+        if why:
+            continue
+        state = next((int(e["signals"]["state"]) for e in reversed(r.status()) if e["wall"] <= t), -1)
+        name = next((k for k, v in STATE.items() if v == state), "?")
+        parts = [f"fault {c} at {t - dock:+.3f} s from the dock command" if dock is not None else f"fault {c}",
+                 f"state {name}",
+                 f"dockd wheel stall {stall_ms(wheels, t - 1.5, t):.0f} ms",
+                 f"chassis feedback stall {stall_ms(feedback, t - 1.5, t):.0f} ms"]
+        before = [k for k in late if k <= t]
+        parts.append(f"last simulated-lidar late/skip {t - before[-1]:.2f} s before" if before
+                     else "no simulated-lidar late/skip before")
+        if off is not None:
+            which = "lidar" if c == 185 else "chassis"
+            wd = [e for e in r.dockd_events if e.get("event") == "watchdog" and e.get("which") == which
+                  and e.get("stale") is True and abs(e["t_us"] / 1e6 + off - t) < 0.1]
+            said = [f"{k} {v}" for k, v in (wd[0].items() if wd else [])
+                    if k not in ("t_us", "event", "which", "stale", "fault")]
+            if said:
+                parts.append("dockd: " + ", ".join(said))
+        lines.append("; ".join(parts))
+    return lines
 
 
 # A docking attempt that ends in RETRY because the controller gave up (pressed without contact) after dockd's loop
@@ -632,6 +681,10 @@ def main(argv):
         # "UNEXCUSED;EXCUSED": fault codes of the status frames, split by cause (watchdog_onsets): a watchdog fault
         # that the test machine's starvation explains is listed as excused, with that cause.
         print_split((str(c), f"{c}({why})", why) for _, c, why in watchdog_onsets(Row(argv[2])))
+        return 0
+    if cmd == "faults-explain":
+        for line in explain_onsets(Row(argv[2])):
+            print(line)
         return 0
     if cmd == "retries-split":
         # "UNEXCUSED;EXCUSED": the attempts that ended in RETRY, split by cause (retry_onsets), each with its reason.

@@ -39,6 +39,9 @@ check_no_fault() {
     echo "STARVED ${1}_no_fault  (watchdog faults $exc right after dockd's loop stalled: VM starvation)"
     return 0
   fi
+  if [ -n "$unexc" ]; then
+    $MATRIX_PY faults-explain "$RD" | sed "s/^/INFO $1 unexcused: /"
+  fi
   check "${1}_no_fault" test -z "$unexc$exc"
 }
 
@@ -73,8 +76,9 @@ rbg() {
 inject() { echo "$1 $EPOCHREALTIME" >> "$RD/inject.log"; }
 
 # row_start NAME [chassis-sim options...]: $ROW_SCENARIO (default scenario), $ROW_SED (sed expressions applied to
-# dockd-hil.toml, e.g. to change a key of a table it already has) and $ROW_TOML (extra dockd config text appended,
-# e.g. a [task] table) apply. Starts candump (dockcore ids 0x100-0x1FF only), chassis-sim, dockd.
+# dockd-hil.toml, e.g. to change a key of a table it already has), $ROW_TOML (extra dockd config text appended,
+# e.g. a [task] table) and $ROW_READY (what "dockd up" waits for; default dockd_ready: idle, data fresh) apply.
+# Starts candump (dockcore ids 0x100-0x1FF only), chassis-sim, dockd.
 row_start() {
   ROW="$1"; shift
   RD="$OUT/$ROW"
@@ -90,7 +94,8 @@ row_start() {
      --seed 3 --truth "$RD/truth.jsonl" "$@" "${ROW_SCENARIO:-$DEFAULT_SCENARIO}"
   wait_for 10 test -e /tmp/dockcore-lidar
   row_dockd
-  check "${ROW}_dockd_up" wait_for 30 state_is NOT_TASKING
+  # shellcheck disable=SC2086  # ROW_READY is a command with its arguments
+  check "${ROW}_dockd_up" wait_for 30 ${ROW_READY:-dockd_ready}
 }
 
 # row_dockd: (re)starts dockd with the row's config and record directory (appending to the record).

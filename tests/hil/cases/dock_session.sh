@@ -8,7 +8,7 @@ bg chassis chassis-sim-run --can vcan0 --lidar-pty /tmp/dockcore-lidar --start 1
    --seed 3 "$SRC/tools/scenarios/default.toml"
 wait_for 10 test -e /tmp/dockcore-lidar
 bg dockd "$BUILD/app/dockd" --config "$OUT/dockd.toml"
-check dockd_up wait_for 20 state_is NOT_TASKING
+check dockd_up wait_for 20 dockd_ready
 
 # Run 1: CAN host command (dock at dock 0, sequence 1).
 t0=$(hil_now)

@@ -6,7 +6,7 @@ bg chassis chassis-sim-run --can vcan0 --lidar-pty /tmp/dockcore-lidar --start 1
    --seed 9 --lidar-corrupt-packets 0.05 "$SRC/tools/scenarios/default.toml"
 wait_for 10 test -e /tmp/dockcore-lidar
 bg dockd "$BUILD/app/dockd" --config "$OUT/dockd.toml"
-check dockd_up wait_for 20 state_is NOT_TASKING
+check dockd_up wait_for 20 dockd_ready
 check dock_accepted DOCKCTL dock --dock 0
 check charging_with_corrupt_lidar wait_for 180 state_is FINISH_TASKING
 DOCKCTL status > "$OUT/status.json"

@@ -41,7 +41,8 @@ lidar_row lidar_wrong_baud lidar_wrong_baud lidar_right_baud --lidar-wrong-baud 
 # faults 185 at once (the lidar was never fresh). Fault time = the HostCommand frame in the candump log; limit for the
 # FAULT/185 status (idle, the status already shows 185 as the watchdog condition): the command is taken on the next
 # tick and faults on the one after (GET_TASKING_CMD sees lidar_ok false), status on change: 3 ticks = 60 ms. The robot never moves; the parser counts the garbage.
-row_start lidar_protocol --lidar-protocol rplidar --lidar-rplidar-autostart
+# The lidar never becomes fresh here: "dockd up" is idle alone.
+ROW_READY="state_is NOT_TASKING" row_start lidar_protocol --lidar-protocol rplidar --lidar-rplidar-autostart
 sleep 2
 row_dock
 sleep 3

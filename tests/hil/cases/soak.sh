@@ -53,7 +53,7 @@ bg chassis chassis-sim-run --can vcan0 --lidar-pty /tmp/dockcore-lidar --start 1
    --seed 3 "$SRC/tools/scenarios/default.toml"
 wait_for 10 test -e /tmp/dockcore-lidar
 bg dockd "$BUILD/app/dockd" --config "$OUT/dockd.toml"
-check dockd_up wait_for 20 state_is NOT_TASKING
+check dockd_up wait_for 20 dockd_ready
 
 dockd_rss_kib() { awk '/^VmRSS:/ {print $2}' "/proc/$PID_dockd/status" 2>/dev/null; }
 # The task state, asking again while dockd does not answer within dockctl's 2 s (the starved TCG VM: ticks of seconds).
