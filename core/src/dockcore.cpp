@@ -12,6 +12,7 @@ bool Dockcore::configure(const DockProfile& profile, const DockcoreConfig& confi
   filter_confirmed_ = false;
   restart_ref_set_ = false;
   push_ref_set_ = false;
+  confirmed_ref_set_ = false;
   last_estimate_ = DockEstimate{};
   prev_state_ = TaskState::kNotTasking;
   return estimator_.configure(profile, config.estimator);
@@ -45,7 +46,18 @@ const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_
     d.expectation_set = true;
     const bool was_confirmed = filter_.initialised() && filter_confirmed_;
     d.expectation_confirmed = was_confirmed;
-    if (was_confirmed) d.expected_in_odom = filter_.dock_in_odom();
+    if (was_confirmed) {
+      d.expected_in_odom = filter_.dock_in_odom();
+    } else if (confirmed_ref_set_ && stamp_us >= confirmed_ref_us_ &&
+               static_cast<Real>(stamp_us - confirmed_ref_us_) * static_cast<Real>(1e-6) <= config_.push_check_max_gap_s) {
+      // The filter restarted in this task and rests on one detection. A restart needs reinit_after gated detections
+      // in a row, and those may come before a push: detections matched to odometry read late (a loaded host), then
+      // the push. The restart then left the push test one look, against the old estimate, and the second post-push
+      // detection met the unconfirmed filter and passed untested (HIL, motion_push_angle on a loaded machine).
+      // The last confirmed estimate, carried by odometry, stays the expectation until the filter is confirmed again.
+      d.expectation_confirmed = true;
+      d.expected_in_odom = confirmed_ref_in_odom_;
+    }
     if (push_ref_set_) {  // a resumed task: the pre-outage estimate, not the filter restarted since
       d.expectation_confirmed = true;
       d.expected_in_odom = push_ref_in_odom_;
@@ -66,7 +78,12 @@ const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_
       restart_ref_in_odom_ = before;
       restart_ref_us_ = before_us;
     }
-    if (u == FilterUpdate::kFused) filter_confirmed_ = true;
+    if (u == FilterUpdate::kFused) {
+      filter_confirmed_ = true;
+      confirmed_ref_set_ = true;
+      confirmed_ref_in_odom_ = filter_.dock_in_odom();
+      confirmed_ref_us_ = stamp_us;
+    }
   }
   return last_estimate_;
 }
@@ -116,6 +133,7 @@ TickOutput Dockcore::tick(const TickInput& in) {
       }
     }
     restart_ref_set_ = false;
+    confirmed_ref_set_ = false;
     filter_.reset();
     filter_confirmed_ = false;
   }
