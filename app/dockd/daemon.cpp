@@ -324,10 +324,10 @@ Pose2 Daemon::odom_at(std::uint64_t stamp_us) const {
 
 void Daemon::poll_lidar(std::uint64_t now_us) {
   // Only the newest scan matters (poll_scan keeps the newest); bounded to a few per call.
+  const std::uint64_t max_period_us = std::max<std::uint64_t>(500000u, std::uint64_t{cfg_.lidar_stale_ms} * 1000u);
   for (int i = 0; i < 4 && io_.lidar->poll_scan(*scan_); ++i) {
     ++counters_.scans;
     const std::uint64_t stamp = scan_->stamp_us != 0 && scan_->stamp_us <= now_us ? scan_->stamp_us : now_us;
-    const std::uint64_t max_period_us = std::max<std::uint64_t>(500000u, std::uint64_t{cfg_.lidar_stale_ms} * 1000u);
     if (prev_scan_stamp_us_ != 0 && stamp > prev_scan_stamp_us_ && stamp - prev_scan_stamp_us_ <= max_period_us)
       scan_period_us_ = stamp - prev_scan_stamp_us_;
     prev_scan_stamp_us_ = stamp;

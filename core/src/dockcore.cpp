@@ -45,19 +45,18 @@ const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_
     d.stamp_us = stamp_us;
     d.expectation_set = true;
     const bool was_confirmed = filter_.initialised() && filter_confirmed_;
-    d.expectation_confirmed = was_confirmed;
-    if (was_confirmed) {
-      d.expected_in_odom = filter_.dock_in_odom();
-    } else if (confirmed_ref_set_ && stamp_us >= confirmed_ref_us_ &&
-               static_cast<Real>(stamp_us - confirmed_ref_us_) * static_cast<Real>(1e-6) <= config_.push_check_max_gap_s) {
-      // The filter restarted in this task and rests on one detection. A restart needs reinit_after gated detections
-      // in a row, and those may come before a push: detections matched to odometry read late (a loaded host), then
-      // the push. The restart then left the push test one look, against the old estimate, and the second post-push
-      // detection met the unconfirmed filter and passed untested (HIL, motion_push_angle on a loaded machine).
-      // The last confirmed estimate, carried by odometry, stays the expectation until the filter is confirmed again.
-      d.expectation_confirmed = true;
-      d.expected_in_odom = confirmed_ref_in_odom_;
-    }
+    // The expectation is the task's last confirmed estimate: while the filter is confirmed that is the filter itself
+    // (gated detections leave it alone). After a restart it rests on one detection, and the last confirmed estimate,
+    // carried by odometry, stays the expectation until the filter is confirmed again, if it is recent enough. A
+    // restart needs reinit_after gated detections in a row, and those may come before a push (detections matched to
+    // odometry read late on a loaded host): without this, the restart left the push test one look at the push and the
+    // next post-push detection met the unconfirmed filter untested (HIL, motion_push_angle on a loaded machine).
+    d.expectation_confirmed =
+        confirmed_ref_set_ &&
+        (was_confirmed ||
+         (stamp_us >= confirmed_ref_us_ && static_cast<Real>(stamp_us - confirmed_ref_us_) * static_cast<Real>(1e-6) <=
+                                               config_.push_check_max_gap_s));
+    if (d.expectation_confirmed) d.expected_in_odom = confirmed_ref_in_odom_;
     if (push_ref_set_) {  // a resumed task: the pre-outage estimate, not the filter restarted since
       d.expectation_confirmed = true;
       d.expected_in_odom = push_ref_in_odom_;

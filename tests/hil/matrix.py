@@ -49,6 +49,7 @@ ROW_NAMES = ["lidar_unplug", "lidar_stall", "lidar_corrupt50", "lidar_corrupt5",
              "host_flood_udp", "host_flood_can", "host_bad_commands", "process_sigkill", "process_restart"]
 STATE = {"NOT_TASKING": 0, "GET_TASKING_CMD": 1, "REACH_TASKING_POINT": 2, "ALIGN": 3, "FINISH_TASKING": 4,
          "WAIT_FOR_CHARGE": 5, "RETRY": 6, "UNDOCKING": 7, "FAULT": 8, "TEST_MODE": 9}
+STATE_NAME = {v: k for k, v in STATE.items()}
 
 
 def crc8_h2f(data):
@@ -143,6 +144,14 @@ class Row:
     def status(self):
         return [e for e in self.timeline if e["name"] == "DockStatus"]
 
+    def feedback_times(self):
+        """Wall times of chassis-sim's 20 ms wheel feedback frames."""
+        return [e["wall"] for e in self.timeline if e["name"] == "WheelFbA"]
+
+    def sim_lidar_late_times(self):
+        """Wall times (ascending) at which chassis-sim logged that its simulated lidar skipped a turn or sent late."""
+        return sorted(self.events.get("sim_scan_skipped", []) + self.events.get("sim_lidar_late", []))
+
     def event(self, name):
         """Wall time of a reference: a truth/inject event NAME; "status:C" the first DockStatus with fault C;
         "last:FRAME:REF" the last FRAME frame before REF; "first:FRAME:REF" the first FRAME frame at or after REF;
@@ -198,7 +207,7 @@ def stall_ms(times, t0, t1):
 LIDAR_WATCHDOG_MARGIN_MS = 100
 CHASSIS_WATCHDOG_MARGIN_MS = 180
 # chassis-sim writes sim_lidar_late / sim_scan_skipped when it runs again after a stall: in a loaded HIL run
-# (2026-11-22, /tmp/obs2) a 240 ms stall of the VM left dockd without scans and the event was stamped 36 ms after
+# (2026-11-22, obstacle row) a 240 ms stall of the VM left dockd without scans and the event was stamped 36 ms after
 # the 185 it caused. A starved simulator's next loop runs within a tick or two once it is scheduled again.
 SIM_LATE_LOGGED_AFTER_S = 0.3
 
@@ -213,8 +222,8 @@ def watchdog_onsets(r):
       paced packets left late) in the 0.5 s before, or up to 0.3 s after: chassis-sim notices its lateness only when
       it runs again, so a stall of the simulator that starved dockd of scans is logged after the 185 it caused."""
     wheels = [e["wall"] for e in r.wheels()]
-    feedback = [e["wall"] for e in r.timeline if e["name"] == "WheelFbA"]
-    skipped = r.events.get("sim_scan_skipped", []) + r.events.get("sim_lidar_late", [])
+    feedback = r.feedback_times()
+    skipped = r.sim_lidar_late_times()
     out = []
     prev = 0
     started = False
@@ -254,18 +263,18 @@ def explain_onsets(r):
     """One line per unexcused watchdog fault onset (watchdog_onsets): when it came, the stalls around it and what
     dockd's watchdog event said — so a check that failed on a machine that keeps no row logs still says why."""
     wheels = [e["wall"] for e in r.wheels()]
-    feedback = [e["wall"] for e in r.timeline if e["name"] == "WheelFbA"]
-    late = sorted(r.events.get("sim_scan_skipped", []) + r.events.get("sim_lidar_late", []))
+    feedback = r.feedback_times()
+    late = r.sim_lidar_late_times()
+    status = r.status()
     dock = r.event("dock")
     off = dockd_wall_offset(r)
     lines = []
     for t, c, why in watchdog_onsets(r):
         if why:
             continue
-        state = next((int(e["signals"]["state"]) for e in reversed(r.status()) if e["wall"] <= t), -1)
-        name = next((k for k, v in STATE.items() if v == state), "?")
+        state = next((int(e["signals"]["state"]) for e in reversed(status) if e["wall"] <= t), -1)
         parts = [f"fault {c} at {t - dock:+.3f} s from the dock command" if dock is not None else f"fault {c}",
-                 f"state {name}",
+                 f"state {STATE_NAME.get(state, '?')}",
                  f"dockd wheel stall {stall_ms(wheels, t - 1.5, t):.0f} ms",
                  f"chassis feedback stall {stall_ms(feedback, t - 1.5, t):.0f} ms"]
         before = [k for k in late if k <= t]
@@ -659,7 +668,6 @@ def main(argv):
         # showed on the bus (candump) — what dockd had done, it had written.
         r = Row(argv[2])
         t_kill = r.event(argv[4])
-        names = {v: k for k, v in STATE.items()}
         with open(argv[3]) as f:
             text = f.read()
         if not text.endswith("\n"):
@@ -668,7 +676,7 @@ def main(argv):
         ev = [json.loads(line) for line in text.splitlines()]
         states = [e["to"] for e in ev if e.get("event") == "state"]
         st = [e for e in r.status() if e["wall"] <= t_kill]
-        bus = names.get(int(st[-1]["signals"]["state"])) if st else None
+        bus = STATE_NAME.get(int(st[-1]["signals"]["state"])) if st else None
         print(f"record {len(ev)} events, last state {states[-1] if states else None}; bus before the kill: {bus}")
         return 0 if states and bus == states[-1] else 1
     if cmd == "first-wheels":

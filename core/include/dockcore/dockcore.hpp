@@ -113,8 +113,9 @@ class Dockcore {
   /// The push test's reference after a resume (see TickInput::resume), replacing the restarted filter.
   bool push_ref_set_ = false;
   Pose2 push_ref_in_odom_{};
-  /// This task's newest confirmed estimate (dock in odom) and the stamp of the detection that made it: the push
-  /// test's reference while the filter rests on one detection after a restart.
+  /// This task's newest confirmed estimate (dock in odom; equal to the filter's while filter_confirmed_) and the
+  /// stamp of the detection that made it: the push test's reference, also while the filter rests on one detection
+  /// after a restart.
   bool confirmed_ref_set_ = false;
   Pose2 confirmed_ref_in_odom_{};
   std::uint64_t confirmed_ref_us_ = 0;
