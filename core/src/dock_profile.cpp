@@ -33,6 +33,34 @@ const char* to_string(ProfileError e) {
   return "unknown profile error";
 }
 
+const char* to_string(DockMountKind k) {
+  switch (k) {
+    case DockMountKind::kUnknown: return "unknown";
+    case DockMountKind::kWall: return "wall";
+    case DockMountKind::kFreeStanding: return "free_standing";
+  }
+  return "unknown";
+}
+
+bool parse_mount_kind(const char* name, DockMountKind* out) {
+  if (name == nullptr || out == nullptr) return false;
+  const DockMountKind kinds[] = {DockMountKind::kUnknown, DockMountKind::kWall, DockMountKind::kFreeStanding};
+  for (const DockMountKind k : kinds) {
+    if (same_name(name, to_string(k))) {
+      *out = k;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool mounting_valid(const DockMounting& m) {
+  const bool kind_ok = m.kind == DockMountKind::kUnknown || m.kind == DockMountKind::kWall ||
+                       m.kind == DockMountKind::kFreeStanding;
+  return kind_ok && std::isfinite(m.wall_gap_min_m) && std::isfinite(m.wall_gap_max_m) && m.wall_gap_min_m >= 0 &&
+         m.wall_gap_max_m >= m.wall_gap_min_m && m.wall_gap_max_m <= kMaxWallGapM;
+}
+
 Real DockProfile::length_m() const {
   Real len = 0;
   for (std::size_t i = 0; i + 1 < vertex_count; ++i) len += (vertices_m[i + 1] - vertices_m[i]).norm();

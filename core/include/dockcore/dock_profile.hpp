@@ -28,11 +28,39 @@ enum class ProfileError : std::uint8_t {
 /// Human-readable name of a ProfileError, for messages. Never null.
 const char* to_string(ProfileError e);
 
+/// How a dock is installed: what lies behind it, as far as the lidar can tell.
+enum class DockMountKind : std::uint8_t {
+  kUnknown = 0,      ///< Nothing assumed: a wall behind the dock is evidence for it when seen, never a requirement.
+  kWall = 1,         ///< Against a wall the lidar sees, its face wall_gap_min_m..wall_gap_max_m behind the dock's back.
+  kFreeStanding = 2, ///< Open space (or glass, which the lidar sees through) behind the dock.
+};
+
+/// Human-readable name of a DockMountKind ("unknown", "wall", "free_standing"), as in profile and config files.
+const char* to_string(DockMountKind k);
+
+/// Parses a DockMountKind name as written by to_string(); false (out untouched) for anything else. O(1).
+bool parse_mount_kind(const char* name, DockMountKind* out);
+
+/// A dock's mounting. The gap is measured along the dock's x axis from its back plane (the profile's smallest x)
+/// to the wall's face, metres; only used with kWall.
+struct DockMounting {
+  DockMountKind kind = DockMountKind::kUnknown;
+  Real wall_gap_min_m = 0;                         ///< >= 0.
+  Real wall_gap_max_m = static_cast<Real>(0.10);   ///< >= wall_gap_min_m, <= kMaxWallGapM.
+};
+
+/// Largest wall gap a mounting may state: beyond it the wall is just part of the room.
+constexpr Real kMaxWallGapM = static_cast<Real>(0.5);
+
+/// Checks a mounting's bounds (gap range ordered, within [0, kMaxWallGapM], finite). O(1).
+bool mounting_valid(const DockMounting& m);
+
 /// A dock outline. Trivially copyable, fixed size.
 struct DockProfile {
   Vec2 vertices_m[kMaxProfileVertices] = {};
   std::size_t vertex_count = 0;
   char name[24] = {};
+  DockMounting mounting{};  ///< How this dock is installed; the built-ins are kUnknown.
 
   std::size_t segment_count() const { return vertex_count > 0 ? vertex_count - 1 : 0; }
   /// Length of the polyline in metres. O(vertices).
