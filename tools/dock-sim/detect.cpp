@@ -103,6 +103,23 @@ DetectorResult DetectorSet::run_estimator(const dockcore::ScanView& scan, const 
   q["expected"] = e.expected;
   q["violations"] = e.violations;
   q["occluded"] = e.occluded;
+  q["wall_seen"] = e.wall_seen;
+  q["wall_looked"] = e.wall_looked;
+  // The decision: each cue's log-likelihood ratio (nats) and their sum; for a miss, the best refused candidate's.
+  q["evidence_nats"] = round6(e.evidence.total_nats);
+  nlohmann::ordered_json cues = nlohmann::ordered_json::object();
+  for (std::size_t c = 0; c < dockcore::kEvidenceCueCount; ++c) {
+    cues[dockcore::to_string(static_cast<dockcore::EvidenceCue>(c))] = round6(e.evidence.cue_nats[c]);
+  }
+  q["cues"] = cues;
+  const dockcore::DecisionFeatures& f = e.evidence.features;
+  q["features"] = {{"hit", round6(f.hit)},         {"hit_sq", round6(f.hit_sq)},
+                   {"dropped", round6(f.dropped)}, {"beyond", round6(f.beyond)},
+                   {"front", round6(f.front)},     {"missing", round6(f.missing)},
+                   {"continues", round6(f.continues)}, {"stops", round6(f.stops)},
+                   {"wall_seen", round6(f.wall_seen)}, {"wall_missed", round6(f.wall_missed)},
+                   {"constraint", round6(f.constraint)}};
+  if (!e.found && e.reject != dockcore::RejectReason::kNone) q["reject"] = dockcore::to_string(e.reject);
   if (e.found) {
     q["sigma_x_m"] = round6(std::sqrt(std::max<double>(0, e.covariance(0, 0))));
     q["sigma_y_m"] = round6(std::sqrt(std::max<double>(0, e.covariance(1, 1))));

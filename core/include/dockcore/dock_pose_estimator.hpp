@@ -9,11 +9,14 @@
 ///     hypotheses (centres aligned, or either end aligned for a partly hidden segment).
 ///  2. Registration. Point-to-segment Gauss-Newton on (x, y, yaw) with Huber then Tukey weights, over the beams inside the dock's
 ///     angular span (plus a margin), associating each point with the nearest visible profile segment.
-///  3. Verification. The expected scan of the profile at the refined pose is compared beam by beam with the measured
-///     one: inliers (within the gate), occluded (measured well in front — allowed, that is partial occlusion) and
-///     violations (measured farther, no return where the dock should be, or a surface just in front of where the
-///     dock should be — evidence that the dock is not there; this is what rejects look-alike clutter such as a flat
-///     board or wall for a winged dock).
+///  3. Decision. The expected scan of the profile at the refined pose is compared beam by beam with the measured one,
+///     and each candidate gets a log-likelihood ratio (nats): how much better "this dock at this pose" explains the
+///     beams than "no dock here". It is a sum of cues (EvidenceCue), each reported: the fit of the beams that land on
+///     the dock, beams that see through it, surfaces in the free space in front of it, the support of each feature,
+///     surfaces that carry on past the dock's edges (a real dock stops where its outline stops), the wall behind it
+///     (as the dock's mounting says: required, evidence when seen, or not looked for) and the pose prior (hint). A
+///     candidate is accepted when the sum reaches min_evidence_nats. A few structural checks stay hard (too few
+///     beams, out of range, seen edge-on, pose too uncertain, outside the hint radius).
 ///  4. Selection among verified candidates: nearest to the lidar, or nearest to the hint.
 ///
 /// Cost: O(B) to read the scan (B beams, no trig per beam), O(B) segmentation, then per candidate
@@ -52,19 +55,61 @@ enum class EstimateStatus : std::uint8_t {
 enum class RejectReason : std::uint8_t {
   kNone = 0,
   kNoConvergence,      ///< Registration found too few points or diverged.
-  kSegmentUnsupported, ///< A long dock surface expected on >= 3 beams has too few inliers.
   kTooFewInliers,      ///< Fewer than min_inliers.
-  kLowInlierFraction,  ///< Inliers / unoccluded expected beams below min_inlier_fraction.
   kMostlyHidden,       ///< Inliers / expected beams below min_visible_fraction.
-  kSeeThrough,         ///< Violations above max_violation_fraction.
-  kHighRms,            ///< Inlier RMS above max_rms_m.
-  kSurfaceContinues,   ///< More than max_extension_points returns continue a dock surface past its end.
   kOblique,            ///< Face seen beyond max_view_angle_rad.
   kOutOfRange,         ///< Farther than max_range_m.
   kUncertain,          ///< Position 1-σ from the covariance above max_sigma_m.
   kFarFromHint,        ///< Farther than hint_radius_m from the hint.
-  kNoWallBehind,       ///< require_wall_behind is set and the beams past the dock's ends see beyond its back plane.
+  kWeakEvidence,       ///< The cues' log-likelihood ratio is below min_evidence_nats (see the cues for why).
   kCount,
+};
+
+/// The terms of the accept decision, each a log-likelihood ratio in nats (positive: evidence for the dock).
+enum class EvidenceCue : std::uint8_t {
+  kFit = 0,      ///< Beams landing on the dock, by how closely (Gaussian of range_sigma_m against a look-alike's).
+  kSeeThrough,   ///< Beams that pass where the dock should stop them, or return nothing there.
+  kFreeSpace,    ///< Surfaces just in front of the dock (free_space_m), where an approaching robot would be.
+  kSupport,      ///< Long dock surfaces with too few of their beams (a surface of the dock that is not there).
+  kEdges,        ///< Beams just past the dock's ends: a surface carrying on in line (against) or stopping (for).
+  kWall,         ///< Beams past the ends meeting the wall where the mounting puts it (for), or not (against).
+  kGeometry,     ///< How well the visible part of the dock fixes all three pose components (a flat face alone cannot).
+  kPrior,        ///< Closeness to the pose hint when hint_radius_m is set (dock database, staging pose).
+  kCount,
+};
+
+/// Number of evidence cues.
+constexpr std::size_t kEvidenceCueCount = static_cast<std::size_t>(EvidenceCue::kCount);
+
+/// Short name of a cue ("fit", "see_through", "free_space", "support", "edges", "wall", "geometry", "prior").
+/// Never null.
+const char* to_string(EvidenceCue c);
+
+/// What the cues are computed from, per candidate. Beam counts are weighted by min(1, beam spacing at the dock /
+/// 5 cm): beams closer than that on one surface are not independent evidence.
+struct DecisionFeatures {
+  Real hit = 0;          ///< Weighted beams within the inlier gate of the dock's surface.
+  Real hit_sq = 0;       ///< Weighted sum of (residual / range_sigma_m)² over those beams.
+  Real dropped = 0;      ///< Weighted dock beams with no return (not scored: dropouts say little).
+  Real beyond = 0;       ///< Weighted dock beams returning from behind the dock's surface.
+  Real front = 0;        ///< Weighted dock beams returning within free_space_m in front of it.
+  Real missing = 0;      ///< Long dock surfaces (>= 3 expected beams) with fewer than half their beams on them.
+  Real continues = 0;    ///< Weighted returns 4-12 cm past a long surface's end, on its line.
+  Real stops = 0;        ///< Weighted returns there off its line (not scored: free-standing clutter stops too).
+  Real wall_seen = 0;    ///< Weighted beams past the dock's ends meeting the mounting's wall.
+  Real wall_missed = 0;  ///< Weighted beams past the ends that could have, and did not.
+  /// Smallest eigenvalue of the fit's information matrix (yaw scaled by the dock's radius), weighted: the number of
+  /// independent beams that fix the least constrained pose component.
+  Real constraint = 0;
+};
+
+/// A candidate's evidence: each cue's log-likelihood ratio and their sum, nats, and the features behind them.
+struct DockEvidence {
+  Real cue_nats[kEvidenceCueCount] = {};
+  Real total_nats = 0;
+  DecisionFeatures features{};
+  /// The cue with the most negative contribution (kCount when none is negative): the main reason against.
+  EvidenceCue weakest() const;
 };
 
 /// Human-readable name of a RejectReason. Never null.
@@ -86,48 +131,33 @@ struct EstimatorParams {
   std::uint8_t max_iterations = 10;               ///< Gauss-Newton cap per candidate.
   std::uint8_t max_candidates = 12;               ///< Hypotheses refined per scan at most (best prescore first).
   Real min_feature_length_m = static_cast<Real>(0.08);  ///< Profile segments shorter than this seed no hypotheses.
-  Real min_inlier_fraction = static_cast<Real>(0.6);    ///< Inliers / unoccluded beams expected on the dock, at least.
-  Real max_violation_fraction = static_cast<Real>(0.1); ///< See-through beams / expected beams, at most.
-  /// Returns this close in front of the expected surface count as violations, not occlusion: the space just in front
-  /// of a dock is empty (a robot docks there), so a surface there means the hypothesis is wrong — e.g. a flat wall
-  /// "explaining" a winged dock's face while hiding its wings.
+  /// Returns this close in front of the expected surface count against the dock (free-space cue), not as
+  /// occlusion: the space just in front of a dock is empty (a robot docks there), so a surface there means the
+  /// hypothesis is wrong — e.g. a flat wall "explaining" a winged dock's face while hiding its wings.
   Real free_space_m = static_cast<Real>(0.15);
   std::uint16_t min_inliers = 10;  ///< Absolute floor on inliers (a 0.3 m dock 2 m away gives ~13 with LD06).
   /// Inliers / all beams expected on the dock (occluded included), at least: how much of the dock may be hidden.
   Real min_visible_fraction = static_cast<Real>(0.5);
-  /// Returns allowed on the line of a long profile segment 4-12 cm past its end (more are allowed while they stay
-  /// under 30 % of the returns there). A real dock's surfaces stop at its edges; a wall or box face matched as the
-  /// dock's face carries on.
-  std::uint16_t max_extension_points = 2;
-  /// Distance from a segment's line within which a return past its end counts as an extension. Narrower than the
-  /// inlier gate: a wall meeting a 45° wing at its tip stays ~overhang away from the wing's line.
+  /// Distance from a segment's line within which a return 4-12 cm past its end counts as the surface carrying on.
+  /// Narrower than the inlier gate: a wall meeting a 45° wing at its tip stays ~overhang away from the wing's line.
   Real extension_band_m = static_cast<Real>(0.02);
-  /// Each long profile segment expected on >= 3 unoccluded beams needs this fraction of them as inliers (one
-  /// missing beam is always allowed).
-  Real min_segment_support = static_cast<Real>(0.7);                  ///< Absolute floor on inliers.
-  /// Shape RMS (every unoccluded beam on the dock, residuals clamped at inlier_gate_m), at most. The dock's whole
-  /// outline must match to about the noise level, which is what separates it from look-alikes.
-  Real max_shape_rms_m = static_cast<Real>(0.015);
-  Real max_rms_m = static_cast<Real>(0.015);      ///< Inlier fit RMS, at most (1.5 range_sigma: a wrong pose that
-                                                  ///< still lands most beams inside the gate shows up here).
+  /// Accept a candidate when its evidence (sum of the cues' log-likelihood ratios) reaches this, nats. Higher: fewer
+  /// false detections, more misses of partly seen docks. docs/performance.md gives the rates per setting.
+  Real min_evidence_nats = static_cast<Real>(2);
   Real max_sigma_m = static_cast<Real>(0.05);     ///< Reject when the position 1-σ (covariance) exceeds this.
   Real max_view_angle_rad = static_cast<Real>(1.2);     ///< Dock face seen more obliquely than this is rejected.
   Real hint_gate_m = static_cast<Real>(0.3);      ///< A verified pose farther than this from the hint ignores it.
   /// With a hint, only docks within this distance of it are accepted (0: anywhere). Set it when the dock's pose is
   /// known roughly (a dock database, a staging pose): clutter elsewhere can then never be taken for the dock.
   Real hint_radius_m = 0;
-  /// The dock is mounted against a wall flush with its back (the profile's smallest x), as charging docks are: beams
-  /// just past the dock's ends must meet that wall (or an occluder well in front of it). This is what separates a dock from
-  /// free-standing look-alikes (boxes, boards, table legs). Turn it off for a free-standing dock.
-  bool require_wall_behind = true;
-  Real wall_tolerance_m = static_cast<Real>(0.04);  ///< How far the wall may lie from the back plane (either way).
+  /// How far the wall may lie outside the mounting's gap range (either way), on top of the noise gate, metres.
+  Real wall_tolerance_m = static_cast<Real>(0.02);
   DockSelect select = DockSelect::kNearest;
   SegmentParams segments{};                       ///< Line extraction used for candidate generation.
 };
 
 /// Parameters for a lidar whose 1-σ range noise is `range_sigma_m`: the noise-dependent gates (inlier gate 3σ,
-/// inlier and shape RMS 1.5σ, extension band 2σ, association gate 6σ, each with a floor for very
-/// clean lidars) scaled from
+/// extension band 2σ, association gate 6σ, each with a floor for very clean lidars) scaled from
 /// the defaults, which are this function's result for 10 mm. O(1).
 EstimatorParams estimator_params_for_noise(Real range_sigma_m);
 
@@ -144,6 +174,15 @@ struct DockEstimate {
   std::uint16_t violations = 0; ///< Beams that see through where the dock should be.
   std::uint16_t occluded = 0;   ///< Beams blocked by something in front of the dock.
   std::uint16_t extensions = 0; ///< Returns continuing a long dock surface past its end (evidence against).
+  std::uint16_t wall_seen = 0;  ///< Beams past the dock's ends that met the wall where the mounting puts it.
+  std::uint16_t wall_looked = 0;///< Beams past the dock's ends that could have met such a wall.
+  /// The decision's cues. When found: the accepted candidate's. When not: the best refused candidate's (the one
+  /// with the highest total), so a caller can see why nothing was accepted; all zero when no candidate was refined.
+  DockEvidence evidence{};
+  RejectReason reject = RejectReason::kNone;  ///< When not found: why the best refused candidate was refused.
+  /// When not found: the best refused candidate's pose (robot frame), for diagnostics; the counts above are then
+  /// that candidate's too. Never use it to dock.
+  Pose2 refused_pose{};
   std::uint8_t iterations = 0;  ///< Gauss-Newton iterations of the winning candidate.
   std::uint16_t candidates = 0; ///< Hypotheses refined this scan.
   std::uint16_t verified = 0;   ///< Of which passed verification.
@@ -182,8 +221,9 @@ class DockPoseEstimator {
     Mat3 h;          // Gauss-Newton normal matrix at the solution
     Real rms_m;
     Real shape_rms_m;
-    std::uint16_t inliers, expected, violations, occluded, extensions;
+    std::uint16_t inliers, expected, violations, occluded, extensions, wall_seen, wall_looked;
     std::uint8_t iterations;
+    DockEvidence evidence;
     bool ok;
     RejectReason reject;
   };
@@ -191,7 +231,8 @@ class DockPoseEstimator {
   /// Fills points_ from the loaded beams (global search only).
   void build_points();
   Refined refine(const Pose2& initial);
-  void verify(Refined& r);
+  /// Scores a refined candidate (its evidence and counts) and decides. `hint` is the hint in the lidar frame or null.
+  void verify(Refined& r, const Pose2* hint);
   /// Signed index of the beam nearest angle_rad (may lie outside [0, beams) for a partial scan).
   long first_beam(Real angle_rad) const;
   /// Index of beam first+k, wrapped on full-turn scans; false when outside a partial scan.
@@ -209,10 +250,10 @@ class DockPoseEstimator {
   void add_window_hypotheses(std::size_t* n);
   /// Rough support of a hypothesis: +1 per matching beam, -2 per beam seeing through the dock (every other beam).
   Real prescore(const Pose2& pose);
-  /// The wall-behind test of verify(): beams just outside [k_first_hit, k_last_hit] (offsets from `first`).
-  bool wall_behind(const Pose2& pose, long first, std::size_t k_first_hit, std::size_t k_last_hit) const;
-  /// Score to choose between poses of one object: inliers discounted by fit, minus see-through beams.
-  Real quality(const Refined& r) const;
+  /// The wall cue's counts: of the beams just outside [k_first_hit, k_last_hit] (offsets from `first`, up to 3 per
+  /// side) that could meet a wall behind the dock, how many do where the mounting's gap range puts it.
+  void wall_behind(const Pose2& pose, long first, std::size_t k_first_hit, std::size_t k_last_hit,
+                   std::uint16_t* seen, std::uint16_t* looked) const;
   /// For a return p: 0 when it is not 4-12 cm past the end of a long visible segment of placed_ (or lies on the
   /// dock), 1 when it is but off that segment's line, 2 when it continues the segment's line.
   int continues_past_end(const Vec2& p) const;
