@@ -495,7 +495,7 @@ TEST(Rplidar, RealCapturesPublishEveryCompleteRotation) {
       if (want.count(st) == 0) ++extra;
     const RplidarByteAccount a = rplidar_byte_account(c, p->buffered());
     std::printf(
-        "%s: %zu B, rotations %zu (complete %zu), scans %u (extra %zu), lost %zu, stray S %u; bytes: "
+        "%s: %zu B, S-to-S runs %zu, complete rotations %zu, scans %u (extra %zu), lost %zu, stray S %u; bytes: "
         "nodes %llu, descriptors %llu, responses %llu, resync %llu, idle %llu, pending %llu\n",
         std::filesystem::path(f).filename().c_str(), bytes.size(), ref.boundaries, ref.complete.size(), c.scans, extra,
         lost, c.stray_start, static_cast<unsigned long long>(a.node_bytes),
