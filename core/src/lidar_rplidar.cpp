@@ -15,6 +15,33 @@ bool same7(const std::uint8_t* a, const std::uint8_t* b) {
 // A 15-bit angle_q6 can say up to 512 deg; a real node never exceeds 360. Rejecting those tightens framing.
 constexpr std::uint16_t kFullTurnQ6 = 360u * 64u;
 
+const std::uint8_t* const kDescriptors[] = {kRplidarScanDescriptor, kRplidarHealthDescriptor, kRplidarInfoDescriptor};
+
+enum class Overlap { kNo, kMaybe, kYes };
+
+// Whether a known descriptor starts at b (avail bytes present): kMaybe while the bytes present match a prefix.
+Overlap descriptor_at(const std::uint8_t* b, std::size_t avail) {
+  Overlap r = Overlap::kNo;
+  for (const std::uint8_t* d : kDescriptors) {
+    const std::size_t n = avail < kRplidarDescriptorBytes ? avail : kRplidarDescriptorBytes;
+    std::size_t i = 0;
+    while (i < n && b[i] == d[i]) ++i;
+    if (i < n) continue;
+    if (n == kRplidarDescriptorBytes) return Overlap::kYes;
+    r = Overlap::kMaybe;
+  }
+  return r;
+}
+
+// b - a wrapped to [-180, 180) deg, in 1/64 deg.
+std::int32_t signed_step_q6(std::uint16_t a, std::uint16_t b) {
+  std::int32_t d = static_cast<std::int32_t>(b) - static_cast<std::int32_t>(a);
+  constexpr std::int32_t kTurn = kFullTurnQ6;
+  if (d >= kTurn / 2) d -= kTurn;
+  if (d < -kTurn / 2) d += kTurn;
+  return d;
+}
+
 }  // namespace
 
 std::size_t rplidar_encode_request(std::uint8_t cmd, std::uint8_t out[2]) {
@@ -50,7 +77,7 @@ bool RplidarParser::configure(const RplidarConfig& cfg) {
   if (!out_.configure(cfg.bins_per_turn, cfg.angle_min_rad)) return false;
   cfg_ = cfg;
   len_ = 0;
-  synced_ = scanning_ = turn_open_ = false;
+  synced_ = scanning_ = turn_open_ = have_last_ = false;
   return true;
 }
 
@@ -58,11 +85,12 @@ void RplidarParser::reset() {
   counters_.dropped_bytes += static_cast<std::uint32_t>(len_);
   len_ = 0;
   if (turn_open_) counters_.samples_discarded += out_.building().samples();
-  synced_ = scanning_ = turn_open_ = false;
+  synced_ = scanning_ = turn_open_ = have_last_ = false;
 }
 
 void RplidarParser::drop_first() {
   ++counters_.dropped_bytes;
+  if (!scanning_ && cfg_.require_descriptor) ++counters_.idle_bytes;
   if (synced_) {
     ++counters_.resyncs;
     synced_ = false;
@@ -111,7 +139,7 @@ void RplidarParser::process() {
           ++counters_.descriptors;
           // A new scan session: a turn in progress belongs to the old one.
           if (turn_open_) counters_.samples_discarded += out_.building().samples();
-          turn_open_ = false;
+          turn_open_ = have_last_ = false;
           scanning_ = true;
           consume(kRplidarDescriptorBytes);
           continue;
@@ -136,6 +164,17 @@ void RplidarParser::process() {
     }
     if (scanning_ || !cfg_.require_descriptor) {
       if (len_ < kRplidarNodeBytes) return;
+      // A descriptor starting inside the candidate node wins; undecided until its bytes are in.
+      Overlap overlap = Overlap::kNo;
+      for (std::size_t k = 1; k < kRplidarNodeBytes && overlap != Overlap::kYes; ++k) {
+        const Overlap o = descriptor_at(buf_ + k, len_ - k);
+        if (o != Overlap::kNo) overlap = o;
+      }
+      if (overlap == Overlap::kMaybe) return;
+      if (overlap == Overlap::kYes) {
+        drop_first();
+        continue;
+      }
       RplidarNode n;
       if (rplidar_decode_node(buf_, n)) {
         const std::uint64_t stamp = stamp_[0];
@@ -150,25 +189,43 @@ void RplidarParser::process() {
 
 void RplidarParser::on_node(const RplidarNode& n, std::uint64_t stamp_us) {
   ++counters_.packets;
-  // Turn boundary: the S bit, but only once the turn has reached angles more than 180 deg above this node's.
-  // Without a checksum a misaligned node after corruption can carry a stray S=1 mid-turn; it would split the turn.
-  const bool wrapped = turn_open_ && n.angle_q6 + kFullTurnQ6 / 2 < prev_q6_;
-  if (n.start && turn_open_ && !wrapped) ++counters_.stray_start;
-  if (n.start && (!turn_open_ || wrapped)) {
-    prev_q6_ = 0;
+  const std::int32_t step = have_last_ ? signed_step_q6(last_q6_, n.angle_q6) : 0;
+  const bool in_sequence = have_last_ && step <= kRplidarMaxNodeStepQ6 && -step <= kRplidarMaxNodeStepQ6;
+  if (n.start) {
+    if (turn_open_ && !(in_sequence && sweep_q6_ >= kRplidarMinTurnSweepQ6)) {
+      // Not a turn start: most likely a misaligned node, so neither its angle nor its range is used.
+      ++counters_.stray_start;
+      return;
+    }
     if (turn_open_) out_.publish(counters_);
     out_.building().begin(stamp_us);
     turn_open_ = true;
+    sweep_q6_ = 0;
+  } else if (in_sequence) {
+    sweep_q6_ += step;  // jumps (a misaligned node and the step back from it) are left out
   }
+  last_q6_ = n.angle_q6;
+  have_last_ = true;
   if (!turn_open_) {
     ++counters_.samples_discarded;
     return;
   }
-  if (n.angle_q6 > prev_q6_) prev_q6_ = n.angle_q6;  // the turn's largest angle so far
   const Real deg = static_cast<Real>(n.angle_q6) / static_cast<Real>(64);
   const Real range_m = static_cast<Real>(n.distance_q2) / static_cast<Real>(4000);
   out_.building().add(cfg_.convention.to_core(deg_to_rad(deg)), range_m, static_cast<Real>(n.quality));
   ++counters_.samples;
+}
+
+RplidarByteAccount rplidar_byte_account(const LidarParserCounters& c, std::size_t pending_bytes) {
+  RplidarByteAccount a;
+  a.node_bytes = static_cast<std::uint64_t>(c.packets) * kRplidarNodeBytes;
+  a.descriptor_bytes = static_cast<std::uint64_t>(c.descriptors) * kRplidarDescriptorBytes;
+  a.response_bytes = static_cast<std::uint64_t>(c.health_packets) * (kRplidarDescriptorBytes + kRplidarHealthBytes) +
+                     static_cast<std::uint64_t>(c.info_packets) * (kRplidarDescriptorBytes + kRplidarInfoBytes);
+  a.idle_bytes = c.idle_bytes;
+  a.resync_bytes = c.dropped_bytes - c.idle_bytes;
+  a.pending_bytes = pending_bytes;
+  return a;
 }
 
 std::size_t RplidarEncoder::write_descriptor(std::uint8_t out[kRplidarDescriptorBytes]) {

@@ -1,9 +1,16 @@
 // RPLIDAR legacy standard scan: requests, node layout and validity bits, descriptor detection, resync, health,
-// the clockwise-from-the-back convention, round trip, splits at every byte, the recorded capture.
+// the clockwise-from-the-back convention, round trip, splits at every byte, turn starts near 360 deg and stray S
+// nodes, byte accounting, the recorded capture, and the real RPLIDAR A1 captures of the realdata folder (every
+// complete rotation published, corrupted variants).
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
+#include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -19,6 +26,7 @@ using lidar_test::capture_dist_mm;
 using lidar_test::check_accounting;
 using lidar_test::read_capture;
 using lidar_test::replay_bytes;
+using lidar_test::replay_scan_stamps;
 
 namespace {
 
@@ -44,6 +52,133 @@ std::vector<std::uint8_t> stream(int n_nodes) {
     s.insert(s.end(), b, b + 5);
   }
   return s;
+}
+
+// One node's bytes.
+void put_node(std::vector<std::uint8_t>& s, bool start, double deg, int dist_mm, int quality = 15) {
+  RplidarNode n;
+  n.start = start;
+  n.quality = static_cast<std::uint8_t>(quality);
+  n.angle_q6 = static_cast<std::uint16_t>(std::lround(deg * 64.0));
+  n.distance_q2 = static_cast<std::uint16_t>(dist_mm * 4);
+  std::uint8_t b[5];
+  rplidar_encode_node(n, b);
+  s.insert(s.end(), b, b + 5);
+}
+
+// Every byte is in exactly one category, and the accepted ones are the nodes, descriptors and responses.
+void check_byte_account(const RplidarParser& p) {
+  const auto& c = p.counters();
+  const RplidarByteAccount a = rplidar_byte_account(c, p.buffered());
+  CHECK_EQUAL(c.bytes, a.total());
+  CHECK_EQUAL(c.bytes_accepted, a.node_bytes + a.descriptor_bytes + a.response_bytes);
+  CHECK_EQUAL(static_cast<std::uint64_t>(c.dropped_bytes), a.resync_bytes + a.idle_bytes);
+  check_accounting(p);
+}
+
+// ---- Independent reference for the real captures (shares no code with the parser) ----
+// Segments as the realdata README describes them: each scan descriptor A5 5A 05 00 00 40 81 up to the next one or
+// the relay's FF FF FF FF frame-end marker. Nodes by the bit rule (S != !S, check bit 1, angle < 360 deg; else move
+// on one byte). A rotation runs from an S=1 node to the next S=1 node of the same segment. An S=1 node whose first
+// byte is A5 is the relay's echo of a request (A5 25, STOP, at the end of each turret segment), not a node: the A1 of
+// these captures reports quality <= 15, and A5 would say 41. A rotation is complete when its node angles leave no
+// gap wider than 12 deg (complete A1 rotations leave at most ~9 deg; turns cut by the STOP miss 17 deg or more).
+struct RefCapture {
+  std::vector<std::size_t> complete;  // stream offset of each complete rotation's S=1 node
+  std::size_t boundaries = 0;         // S=1 to S=1 pairs, complete or not
+  std::size_t descriptors = 0;
+  std::size_t health = 0;            // A5 5A 03 00 00 00 06 + 3 bytes
+  std::size_t first_descriptor = 0;  // offset (size of the stream when there is none)
+  std::size_t health_before_first = 0;
+};
+
+bool match_at(const std::vector<std::uint8_t>& d, std::size_t i, const std::uint8_t* pat, std::size_t n) {
+  return i + n <= d.size() && std::memcmp(d.data() + i, pat, n) == 0;
+}
+
+RefCapture reference_rotations(const std::vector<std::uint8_t>& d) {
+  static const std::uint8_t kDesc[7] = {0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81};
+  static const std::uint8_t kHealth[7] = {0xA5, 0x5A, 0x03, 0x00, 0x00, 0x00, 0x06};
+  static const std::uint8_t kEnd[4] = {0xFF, 0xFF, 0xFF, 0xFF};
+  RefCapture r;
+  std::vector<std::size_t> starts;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    if (match_at(d, i, kDesc, 7)) starts.push_back(i);
+    if (match_at(d, i, kHealth, 7) && i + 10 <= d.size()) {
+      ++r.health;
+      if (starts.empty()) ++r.health_before_first;
+    }
+  }
+  r.descriptors = starts.size();
+  r.first_descriptor = starts.empty() ? d.size() : starts[0];
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    std::size_t end = k + 1 < starts.size() ? starts[k + 1] : d.size();
+    for (std::size_t i = starts[k] + 7; i + 4 <= end; ++i)
+      if (match_at(d, i, kEnd, 4)) {
+        end = i;
+        break;
+      }
+    struct Node {
+      std::size_t off;
+      bool start;
+      double deg;
+    };
+    std::vector<Node> nodes;
+    for (std::size_t p = starts[k] + 7; p + 5 <= end;) {
+      const std::uint8_t* b = d.data() + p;
+      const int s = b[0] & 1, ns = (b[0] >> 1) & 1;
+      const int q6 = (b[1] | (b[2] << 8)) >> 1;
+      if (s == ns || (b[1] & 1) == 0 || q6 >= 360 * 64) {
+        ++p;
+        continue;
+      }
+      nodes.push_back(Node{p, s == 1 && b[0] != 0xA5, q6 / 64.0});
+      p += 5;
+    }
+    std::size_t open = nodes.size();  // index of the S=1 node opening the rotation in progress
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      if (!nodes[i].start) continue;
+      if (open < nodes.size()) {
+        ++r.boundaries;
+        std::vector<double> a;
+        for (std::size_t j = open; j < i; ++j) a.push_back(nodes[j].deg);
+        std::sort(a.begin(), a.end());
+        double gap = a.front() + 360.0 - a.back();
+        for (std::size_t j = 1; j < a.size(); ++j) gap = std::max(gap, a[j] - a[j - 1]);
+        if (gap <= 12.0) r.complete.push_back(nodes[open].off);
+      }
+      open = i;
+    }
+  }
+  return r;
+}
+
+std::vector<std::string> real_captures(const std::string& dir) {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir + "/raw-rplidar", ec))
+    if (e.path().extension() == ".bin") out.push_back(e.path().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::uint64_t> offsets(std::size_t n) {
+  std::vector<std::uint64_t> v(n);
+  for (std::size_t i = 0; i < n; ++i) v[i] = i;
+  return v;
+}
+
+// Complete reference rotations that no published scan starts (scan stamp = offset of its S node's first byte).
+std::vector<std::size_t> lost_rotations(const std::vector<std::size_t>& complete,
+                                        const std::vector<std::uint64_t>& stamps) {
+  const std::set<std::uint64_t> got(stamps.begin(), stamps.end());
+  std::vector<std::size_t> lost;
+  for (std::size_t off : complete)
+    if (got.count(off) == 0) lost.push_back(off);
+  return lost;
+}
+std::size_t count_lost(const std::vector<std::size_t>& complete, const std::vector<std::uint64_t>& stamps) {
+  return lost_rotations(complete, stamps).size();
 }
 
 }  // namespace
@@ -238,5 +373,215 @@ TEST(Rplidar, RecordedCaptureGivesExactCounters) {
     Real r = -1, i = -1;
     CHECK(scan_lookup(scans[1].view(), kPi - deg_to_rad(j), &r, &i));
     REAL_EQUAL(capture_dist_mm(j) / 1000.0, r, 1e-9);
+  }
+}
+
+TEST(Rplidar, TurnStartsAnywhereNear360AndTheSNodeOpensTheNewTurn) {
+  // A real A1 reports its S node at 350..359 deg (or ~0): the boundary must not depend on that angle. Turn t has
+  // range 1000 + 100 t mm, so a bin tells which turn filled it.
+  for (double first : {358.0, 351.0, 0.5, 0.0}) {
+    std::vector<std::uint8_t> s(kRplidarScanDescriptor, kRplidarScanDescriptor + 7);
+    for (int t = 0; t < 4; ++t)
+      for (int j = 0; j < 300; ++j) put_node(s, j == 0, std::fmod(first + 1.2 * j, 360.0), 1000 + 100 * t);
+    auto p = make_parser();
+    std::vector<LaserScan> scans = replay_bytes(*p, s);
+    CHECK_EQUAL(3u, scans.size());
+    CHECK_EQUAL(0u, p->counters().stray_start);
+    CHECK_EQUAL(1200u, p->counters().samples);
+    for (std::size_t t = 0; t < scans.size(); ++t) {
+      // The S node's own bin (its angle) and the last node before the next S both belong to turn t.
+      Real r = 0, i = 0;
+      CHECK(scan_lookup(scans[t].view(), kPi - deg_to_rad(first), &r, &i));
+      REAL_EQUAL((1000 + 100 * static_cast<int>(t)) / 1000.0, r, 1e-9);
+      CHECK(scan_lookup(scans[t].view(), kPi - deg_to_rad(std::fmod(first + 1.2 * 299, 360.0)), &r, &i));
+      REAL_EQUAL((1000 + 100 * static_cast<int>(t)) / 1000.0, r, 1e-9);
+    }
+    check_byte_account(*p);
+  }
+}
+
+TEST(Rplidar, StraySNodesNeitherSplitATurnNorAddASample) {
+  std::vector<std::uint8_t> s(kRplidarScanDescriptor, kRplidarScanDescriptor + 7);
+  for (int t = 0; t < 3; ++t) {
+    for (int j = 0; j < 360; ++j) {
+      put_node(s, j == 0, j, 1000 + j);
+      if (t == 1 && j == 90) put_node(s, true, 200, 300);   // out of sequence (a misaligned node)
+      if (t == 1 && j == 120) put_node(s, true, 121, 300);  // in sequence, but the turn has swept only 120 deg
+    }
+  }
+  put_node(s, true, 0, 1000);
+  auto p = make_parser();
+  std::vector<LaserScan> scans = replay_bytes(*p, s);
+  CHECK_EQUAL(3u, scans.size());
+  CHECK_EQUAL(2u, p->counters().stray_start);
+  CHECK_EQUAL(3u * 360u + 1u, p->counters().samples);
+  Real r = 0, i = 0;
+  CHECK(scan_lookup(scans[1].view(), kPi - deg_to_rad(200), &r, &i));
+  REAL_EQUAL(1.2, r, 1e-9);  // the stray node's 0.3 m did not win the bin
+  CHECK(scan_lookup(scans[1].view(), kPi - deg_to_rad(121), &r, &i));
+  REAL_EQUAL(1.121, r, 1e-9);
+  check_byte_account(*p);
+}
+
+TEST(Rplidar, TurnWhoseSNodeIsLostMergesIntoOneScanThenResumes) {
+  std::vector<std::uint8_t> s(kRplidarScanDescriptor, kRplidarScanDescriptor + 7);
+  for (int t = 0; t < 5; ++t)
+    for (int j = 0; j < 360; ++j)
+      if (!(t == 2 && j == 0)) put_node(s, j == 0, j, 1000 + j);
+  put_node(s, true, 0, 1000);
+  auto p = make_parser();
+  const std::vector<LaserScan> scans = replay_bytes(*p, s);
+  CHECK_EQUAL(4u, scans.size());                    // turns 1 and 2 come out as one scan
+  CHECK_EQUAL(359u, p->counters().bin_collisions);  // turn 2's nodes on turn 1's bins, but for the lost 0 deg one
+  check_byte_account(*p);
+}
+
+TEST(Rplidar, ADescriptorInsideACandidateNodeWins) {
+  // A relay echoes the host's requests into the stream: after the last node come A5 52 A5 20, then the health
+  // response and the scan descriptor. "52 A5 20 A5 5A" passes a node's bit tests; the health descriptor must win.
+  std::vector<std::uint8_t> s(kRplidarScanDescriptor, kRplidarScanDescriptor + 7);
+  for (int j = 0; j < 400; ++j) put_node(s, j % 360 == 0, j % 360, 1000);
+  const std::uint8_t echo[] = {0xA5, 0x52, 0xA5, 0x20};
+  s.insert(s.end(), echo, echo + 4);
+  std::uint8_t health[10];
+  RplidarEncoder::write_health(RplidarHealth{0, 0}, health);
+  s.insert(s.end(), health, health + 10);
+  s.insert(s.end(), kRplidarScanDescriptor, kRplidarScanDescriptor + 7);
+  for (int j = 0; j < 361; ++j) put_node(s, j % 360 == 0, j % 360, 1000);
+  auto p = make_parser();
+  p->feed(s.data(), s.size(), 0);
+  const auto& c = p->counters();
+  CHECK_EQUAL(1u, c.health_packets);
+  CHECK_EQUAL(2u, c.descriptors);
+  CHECK_EQUAL(4u, c.dropped_bytes);
+  CHECK_EQUAL(761u, c.packets);
+  CHECK_EQUAL(2u, c.scans);
+  check_byte_account(*p);
+}
+
+TEST(Rplidar, BytesBeforeTheFirstDescriptorAreIdle) {
+  auto s = stream(400);
+  std::vector<std::uint8_t> pre(s.begin() + 7, s.begin() + 7 + 5 * 50);  // a stream joined mid-scan
+  const std::uint8_t echo[] = {0xA5, 0x25, 0xA5, 0x20};
+  pre.insert(pre.end(), echo, echo + 4);
+  s.insert(s.begin(), pre.begin(), pre.end());
+  auto p = make_parser();
+  p->feed(s.data(), s.size(), 0);
+  const RplidarByteAccount a = rplidar_byte_account(p->counters(), p->buffered());
+  CHECK_EQUAL(pre.size(), a.idle_bytes);
+  CHECK_EQUAL(0u, a.resync_bytes);
+  CHECK_EQUAL(400u * 5u, a.node_bytes);
+  CHECK_EQUAL(7u, a.descriptor_bytes);
+  check_byte_account(*p);
+}
+
+TEST(Rplidar, RealCapturesPublishEveryCompleteRotation) {
+  const std::string dir = lidar_test::realdata_dir("Rplidar.RealCapturesPublishEveryCompleteRotation");
+  if (dir.empty()) return;
+  const auto files = real_captures(dir);
+  CHECK(!files.empty());
+  std::size_t total_complete = 0, total_scans = 0;
+  for (const auto& f : files) {
+    const auto bytes = lidar_test::read_file_bytes(f);
+    CHECK(!bytes.empty());
+    const RefCapture ref = reference_rotations(bytes);
+    auto p = make_parser();
+    const std::vector<std::uint64_t> stamps = replay_scan_stamps(*p, bytes, offsets(bytes.size()));
+    const auto& c = p->counters();
+    const std::size_t lost = count_lost(ref.complete, stamps);
+    const std::set<std::uint64_t> want(ref.complete.begin(), ref.complete.end());
+    std::size_t extra = 0;
+    for (std::uint64_t st : stamps)
+      if (want.count(st) == 0) ++extra;
+    const RplidarByteAccount a = rplidar_byte_account(c, p->buffered());
+    std::printf(
+        "%s: %zu B, S-to-S runs %zu, complete rotations %zu, scans %u (extra %zu), lost %zu, stray S %u; bytes: "
+        "nodes %llu, descriptors %llu, responses %llu, resync %llu, idle %llu, pending %llu\n",
+        std::filesystem::path(f).filename().c_str(), bytes.size(), ref.boundaries, ref.complete.size(), c.scans, extra,
+        lost, c.stray_start, static_cast<unsigned long long>(a.node_bytes),
+        static_cast<unsigned long long>(a.descriptor_bytes), static_cast<unsigned long long>(a.response_bytes),
+        static_cast<unsigned long long>(a.resync_bytes), static_cast<unsigned long long>(a.idle_bytes),
+        static_cast<unsigned long long>(a.pending_bytes));
+    CHECK_EQUAL(0u, lost);  // 100 %: every complete rotation is published, stamped at its S node
+    CHECK_EQUAL(stamps.size(), static_cast<std::size_t>(c.scans));
+    // A scan that starts no complete rotation is a turn cut short where the STOP echo reads as an S node in
+    // sequence: at most one per segment end.
+    CHECK(extra <= ref.descriptors);
+    CHECK(extra * 100 <= ref.complete.size() + 99);
+    CHECK_EQUAL(ref.descriptors, static_cast<std::size_t>(c.descriptors));
+    CHECK_EQUAL(ref.health, static_cast<std::size_t>(c.health_packets));
+    CHECK_EQUAL(ref.first_descriptor - 10 * ref.health_before_first, static_cast<std::size_t>(a.idle_bytes));
+    check_byte_account(*p);
+    total_complete += ref.complete.size();
+    total_scans += c.scans;
+  }
+  std::printf("all: complete rotations %zu, scans %zu\n", total_complete, total_scans);
+}
+
+TEST(Rplidar, CorruptedRealCaptureLosesRotationsOnlyNearTheDamage) {
+  const std::string dir = lidar_test::realdata_dir("Rplidar.CorruptedRealCaptureLosesRotationsOnlyNearTheDamage");
+  if (dir.empty()) return;
+  const auto bytes = lidar_test::read_file_bytes(dir + "/raw-rplidar/turret-living_room_90_steps.bin");
+  if (bytes.empty()) {
+    std::printf("skipped: %s/raw-rplidar/turret-living_room_90_steps.bin not readable\n", dir.c_str());
+    return;
+  }
+  const RefCapture ref = reference_rotations(bytes);
+  std::mt19937 rng(20240611u);
+  // Feeds a damaged stream whose byte i came from original offset st[i] (the parser's stamps, so a published scan
+  // names the original rotation it starts) and checks what it lost among the complete rotations closed before `cut`.
+  // hit: the damaged original offsets. Every lost rotation must have damage within kNear bytes of its S node
+  // (~2.5 rotations of ~1.5 kB): the loss stays next to the damage.
+  constexpr std::size_t kNear = 4000;
+  auto run = [&](const char* what, int events, const std::vector<std::uint8_t>& v, const std::vector<std::uint64_t>& st,
+                 std::size_t cut, const std::vector<std::size_t>& hit) {
+    auto p = make_parser();
+    const std::vector<std::uint64_t> stamps = replay_scan_stamps(*p, v, st);
+    std::vector<std::size_t> reachable;
+    for (std::size_t off : ref.complete)
+      if (off + 5 * 400 < cut) reachable.push_back(off);
+    const std::vector<std::size_t> lost = lost_rotations(reachable, stamps);
+    std::size_t far = 0, worst = 0;
+    for (std::size_t off : lost) {
+      std::size_t d = SIZE_MAX;
+      for (std::size_t h : hit) d = std::min(d, h > off ? h - off : off - h);
+      worst = std::max(worst, d);
+      if (d > kNear) ++far;
+    }
+    std::printf(
+        "variant %s x%d: %zu B fed, scans %u, lost %zu of %zu (farthest from damage: %zu B), stray S %u, "
+        "resync bytes %llu\n",
+        what, events, v.size(), p->counters().scans, lost.size(), reachable.size(), worst, p->counters().stray_start,
+        static_cast<unsigned long long>(rplidar_byte_account(p->counters(), p->buffered()).resync_bytes));
+    CHECK(lost.size() <= 2u * static_cast<std::size_t>(events));
+    CHECK_EQUAL(0u, far);
+    check_byte_account(*p);
+  };
+  for (bool drop : {false, true}) {
+    for (int events : {1, 10, 100, 1000}) {
+      std::vector<bool> damaged(bytes.size(), false);
+      std::vector<std::size_t> hit;
+      for (int e = 0; e < events; ++e) {
+        const std::size_t at = std::uniform_int_distribution<std::size_t>(0, bytes.size() - 41)(rng);
+        const std::size_t len = drop ? std::uniform_int_distribution<std::size_t>(1, 40)(rng) : 1;
+        for (std::size_t k = 0; k < len; ++k) damaged[at + k] = true;
+        hit.push_back(at);
+      }
+      std::vector<std::uint8_t> v;
+      std::vector<std::uint64_t> st;
+      for (std::size_t i = 0; i < bytes.size(); ++i) {
+        if (damaged[i] && drop) continue;
+        v.push_back(damaged[i] ? static_cast<std::uint8_t>(bytes[i] ^ (1u << (i % 8))) : bytes[i]);
+        st.push_back(i);
+      }
+      // Each damaged spot costs at most the rotation it hits and the next one (whose S then closes a merged or
+      // shortened turn), and only rotations next to it.
+      run(drop ? "drop 1..40 B" : "flip 1 bit", events, v, st, bytes.size(), hit);
+    }
+  }
+  for (int k = 0; k < 10; ++k) {
+    const std::size_t cut = std::uniform_int_distribution<std::size_t>(1, bytes.size() - 1)(rng);
+    const std::vector<std::uint8_t> v(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(cut));
+    run("truncate", 1, v, offsets(cut), cut, std::vector<std::size_t>{cut});
   }
 }

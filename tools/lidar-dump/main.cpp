@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dockcore/drivers/lidar_driver.hpp"
+#include "dockcore/lidar_rplidar.hpp"
 #include "docksim/scan_io.hpp"
 
 using dockcore::drivers::LidarProtocol;
@@ -27,7 +28,8 @@ nlohmann::json counters_json(const dockcore::LidarParserCounters& c, std::uint32
                         {"health_packets", c.health_packets}, {"info_packets", c.info_packets},
                         {"descriptors", c.descriptors}, {"bad_packets", c.bad_packets}, {"samples", c.samples},
                         {"samples_discarded", c.samples_discarded}, {"bin_collisions", c.bin_collisions},
-                        {"scans_overwritten", c.scans_overwritten}, {"clock_resyncs", c.clock_resyncs}};
+                        {"scans_overwritten", c.scans_overwritten}, {"clock_resyncs", c.clock_resyncs},
+                        {"stray_start", c.stray_start}, {"idle_bytes", c.idle_bytes}};
 }
 
 struct Printer {
@@ -199,6 +201,18 @@ int main(int argc, char** argv) {
                counters.packets, counters.bad_span, counters.health_packets, counters.info_packets,
                counters.descriptors, counters.bad_packets, counters.samples_discarded, counters.bin_collisions,
                counters.scans_overwritten, counters.clock_resyncs);
+  if (*proto == LidarProtocol::kRplidar) {
+    // Where every byte went; pending = bytes still buffered in the parser (the byte-accounting identity).
+    const auto a = dockcore::rplidar_byte_account(
+        counters, static_cast<std::size_t>(counters.bytes - counters.bytes_accepted - counters.dropped_bytes));
+    std::fprintf(stderr,
+                 "rplidar: stray_start=%u bytes=%llu = nodes %llu + descriptors %llu + responses %llu + resync %llu + "
+                 "idle %llu + pending %llu\n",
+                 counters.stray_start, static_cast<unsigned long long>(counters.bytes),
+                 static_cast<unsigned long long>(a.node_bytes), static_cast<unsigned long long>(a.descriptor_bytes),
+                 static_cast<unsigned long long>(a.response_bytes), static_cast<unsigned long long>(a.resync_bytes),
+                 static_cast<unsigned long long>(a.idle_bytes), static_cast<unsigned long long>(a.pending_bytes));
+  }
   if (!json_counters.empty()) {
     const std::string j = counters_json(counters, reconnects).dump();
     if (json_counters == "-") {

@@ -56,15 +56,35 @@ struct RplidarConfig {
   bool require_descriptor = true;
 };
 
+/// A node is "in sequence" when its angle is within this many 1/64 deg of the previous node's (either way, wrapped
+/// at 360 deg). A real A1/A2 steps ~1 deg per node; a misaligned node decoded after corruption lands anywhere. 20 deg:
+/// streams need >= 18 nodes per turn.
+constexpr std::uint16_t kRplidarMaxNodeStepQ6 = 20u * 64u;
+/// An S=1 node ends the turn in progress only once that turn has swept at least this angle (1/64 deg; the sum of its
+/// in-sequence node steps). 270 deg: a complete turn sweeps ~358 deg, so up to 88 deg lost to corruption still count.
+constexpr std::int32_t kRplidarMinTurnSweepQ6 = 270 * 64;
+
 /// Byte-at-a-time RPLIDAR parser. At every position it tries, in order: a known 7-byte response descriptor (scan,
 /// health, info; health and info are followed by their payload), then — once a scan descriptor was seen — a 5-byte
-/// node passing the S/!S and check-bit tests. When neither fits, the first byte is dropped and the rest rescanned
-/// (counted: dropped_bytes, and resyncs when the stream had been in sync). A new turn starts at an S=1 node once the turn
-/// in progress has reached angles more than 180 deg above it; a stray S=1 mid-turn (a misaligned node after
-/// corruption) is ignored and counted (stray_start). Nodes before the first turn start are discarded
-/// (samples_discarded). Storage ~130 KiB; O(1) amortised per byte, worst case
-/// O(27) per byte on garbage, plus O(bins) per published scan. No checksum exists in this mode, so corrupted node
-/// bytes that still pass the bit tests are decoded: the grid keeps the nearest return per bin.
+/// node passing the S/!S and check-bit tests, unless a known descriptor starts inside those 5 bytes (its 7 exact
+/// bytes outweigh a node's 3 check bits: a relay's echoed requests misalign nodes right before a response; the node
+/// waits until the overlap is decided, at most 6 bytes). When neither fits, the first byte is dropped and the rest
+/// rescanned (counted: dropped_bytes, idle_bytes outside scan mode, and resyncs when the stream had been in sync).
+///
+/// Turns (what Slamtec's SDK does, plus a guard for a stray S): the S=1 node starts a turn. It ends the turn in
+/// progress when it is in sequence with the previous node (kRplidarMaxNodeStepQ6) and that turn has swept at least
+/// kRplidarMinTurnSweepQ6; the S node's own angle does not matter (real A1 captures report 350..359 deg; encoder: 0).
+/// Any other S=1 node while a turn is open is stray — a misaligned node after corruption, or the echo of a STOP
+/// request (A5 25) read as a node — and is counted (stray_start) and not used: no split, no sample. Every node
+/// belongs to the turn open when it arrives: the S node and the nodes after it go into the new turn, each in the bin
+/// of its own angle (so a node at 358 deg before an S at 359 deg stays in the old turn's bin for 358 deg, and the
+/// S node at 359 deg fills the new turn's bin for 359 deg). Nodes before the first turn start after configure(),
+/// reset() or a scan descriptor are discarded (samples_discarded), as is a turn open when a scan descriptor arrives.
+/// Counters: packets = nodes decoded = samples + stray_start + nodes discarded before a turn start.
+///
+/// Storage ~130 KiB; O(1) amortised per byte, worst case O(27) per byte on garbage, plus O(bins) per published scan.
+/// No checksum exists in this mode, so corrupted node bytes that still pass the bit tests are decoded: the grid keeps
+/// the nearest return per bin.
 class RplidarParser {
  public:
   /// False (nothing changed) for bins outside [1, kMaxScanPoints] or a non-finite angle_min.
@@ -100,8 +120,26 @@ class RplidarParser {
   bool synced_ = false;
   bool scanning_ = false;
   bool turn_open_ = false;
-  std::uint16_t prev_q6_ = 0;  ///< Largest angle of the turn in progress.
+  bool have_last_ = false;     ///< last_q6_ holds a node of this scan session.
+  std::uint16_t last_q6_ = 0;  ///< Angle of the previous node (stray S nodes excluded).
+  std::int32_t sweep_q6_ = 0;  ///< Sum of the in-sequence node steps of the turn in progress.
 };
+
+/// Where the bytes fed to an RplidarParser went, from its counters: every byte is in exactly one field.
+struct RplidarByteAccount {
+  std::uint64_t node_bytes = 0;        ///< 5 per decoded node (packets).
+  std::uint64_t descriptor_bytes = 0;  ///< 7 per scan descriptor.
+  std::uint64_t response_bytes = 0;    ///< Health (10) and device-info (27) responses, their descriptors included.
+  std::uint64_t resync_bytes = 0;      ///< Dropped in scan mode to regain framing, or flushed by reset().
+  std::uint64_t idle_bytes = 0;        ///< Dropped outside scan mode (before a scan descriptor).
+  std::uint64_t pending_bytes = 0;     ///< Buffered, not decided yet (RplidarParser::buffered()).
+  /// Sum of all fields; equals LidarParserCounters::bytes.
+  std::uint64_t total() const {
+    return node_bytes + descriptor_bytes + response_bytes + resync_bytes + idle_bytes + pending_bytes;
+  }
+};
+/// Splits an RplidarParser's bytes by category (counters(), buffered()). O(1).
+RplidarByteAccount rplidar_byte_account(const LidarParserCounters& c, std::size_t pending_bytes);
 
 /// Encodes scans as the sensor streams them: M = round(2 pi / |increment|) nodes per turn clockwise from sensor
 /// 0 deg, the first with S=1. quality = clamp(round(intensity), 0, 63); distance in 1/4 mm (0 when invalid or

@@ -32,9 +32,12 @@ struct LidarParserCounters {
   std::uint32_t samples = 0;        ///< Samples put into scans.
   std::uint32_t samples_discarded = 0; ///< Samples of a partial first turn, or before the first RPLIDAR S=1 node.
   std::uint32_t bin_collisions = 0; ///< Samples that fell into an already filled grid bin (see LidarScanAssembler).
-  std::uint32_t stray_start = 0;    ///< RPLIDAR: S=1 nodes ignored because the turn had not wrapped yet.
+  std::uint32_t stray_start = 0;    ///< RPLIDAR: S=1 nodes ignored (out of sequence, or the turn not swept yet).
   std::uint32_t scans_overwritten = 0; ///< A ready scan was replaced by a newer one before take_scan() read it.
   std::uint32_t clock_resyncs = 0;  ///< LD06: sensor-clock mapping restarted (step over the limit) or found frozen.
+  /// RPLIDAR: the part of dropped_bytes dropped outside scan mode (no scan descriptor yet with require_descriptor):
+  /// a stream joined mid-scan, echoed requests before SCAN. dropped_bytes - idle_bytes were skipped to resync.
+  std::uint32_t idle_bytes = 0;
 };
 
 /// How a sensor's own angle maps to core's angle: core = zero_offset + sign * sensor, sign = -1 for clockwise
