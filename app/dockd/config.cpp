@@ -13,6 +13,7 @@
 
 #include <toml++/toml.h>
 
+#include "dockcore/drivers/estimator_toml.hpp"
 #include "dockcore/drivers/profile_toml.hpp"
 #include "dockcore/drivers/toml_reader.hpp"
 
@@ -456,6 +457,12 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
          docks_node = &n;
          for (const toml::node& e : *a) dock_entry(e);
        }},
+      {"estimator", p.sub("estimator.", [&]() {
+         // The estimator's tuning, the same keys and bounds as dock-sim's scenarios; the range keys are in [lidar].
+         Handlers h;
+         dockcore::drivers::estimator_toml::add_keys(p, h, c.estimator, "estimator.");
+         return h;
+       })},
       {"controller", p.sub("controller.", controller)},
       {"task", p.sub("task.", task)},
       {"host", p.sub("host.", host)},

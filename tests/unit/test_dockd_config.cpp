@@ -296,3 +296,27 @@ TEST(DockdConfig, BadDockMountingIsPositioned) {
   STRCMP_CONTAINS("t.toml:4:1: unknown key 'docks.mounting.gap_m'",
                   error_of("[[docks]]\nid = 1\n[docks.mounting]\ngap_m = 0.1\n").c_str());
 }
+
+TEST(DockdConfig, EstimatorTuningKeys) {
+  const dockd::DockdConfig c = dockd::parse_config_toml(
+      "[estimator]\ninlier_gate_m = 0.02\nmax_view_angle_deg = 60\nselect = \"hint\"\nmin_inliers = 14\n"
+      "[estimator.segments]\nmin_points = 4\n",
+      "t.toml");
+  REAL_EQUAL(0.02, c.estimator.inlier_gate_m, 1e-12);
+  REAL_EQUAL(60 * 3.14159265358979323846 / 180, c.estimator.max_view_angle_rad, 1e-9);
+  CHECK(c.estimator.select == dockcore::DockSelect::kHint);
+  CHECK_EQUAL(14u, c.estimator.min_inliers);
+  CHECK_EQUAL(4u, c.estimator.segments.min_points);
+  // Untouched keys keep the estimator's defaults.
+  const dockcore::EstimatorParams d{};
+  REAL_EQUAL(d.max_rms_m, c.estimator.max_rms_m, 0);
+  // Out of range, wrong type, unknown: at the value / key.
+  STRCMP_CONTAINS("t.toml:2:17: estimator.inlier_gate_m = 0.6 is out of range [0.001, 0.5]",
+                  error_of("[estimator]\ninlier_gate_m = 0.6\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:15: estimator.min_inliers must be an integer, not a float",
+                  error_of("[estimator]\nmin_inliers = 2.5\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:1: unknown key 'estimator.require_wall_behind'",
+                  error_of("[estimator]\nrequire_wall_behind = false\n").c_str());
+  STRCMP_CONTAINS("t.toml:3:14: estimator.segments.min_points = 1 is out of range [2, 100]",
+                  error_of("[estimator.segments]\n\nmin_points = 1\n").c_str());
+}

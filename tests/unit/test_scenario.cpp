@@ -379,3 +379,22 @@ TEST(Scenario, ShippedWallScenariosHaveTheirWorlds) {
     STRCMP_EQUAL(d.controller.c_str(), x->controller.c_str());
   }
 }
+
+TEST(Scenario, EstimatorTuningKeys) {
+  // The same text as dockd's EstimatorTuningKeys test: both parsers share one key list.
+  const docksim::Scenario sc = docksim::parse_scenario_toml(
+      "[estimator]\ninlier_gate_m = 0.02\nmax_view_angle_deg = 60\nselect = \"hint\"\nmin_inliers = 14\n"
+      "[estimator.segments]\nmin_points = 4\n",
+      "s.toml");
+  REAL_EQUAL(0.02, sc.estimator.inlier_gate_m, 1e-12);
+  REAL_EQUAL(60 * kDeg, sc.estimator.max_view_angle_rad, 1e-9);
+  CHECK(sc.estimator.select == dockcore::DockSelect::kHint);
+  CHECK_EQUAL(14u, sc.estimator.min_inliers);
+  CHECK_EQUAL(4u, sc.estimator.segments.min_points);
+  const dockcore::EstimatorParams d{};
+  REAL_EQUAL(d.max_rms_m, sc.estimator.max_rms_m, 0);
+  refused_at("[estimator]\ninlier_gate_m = 0.6\n", 2, 17, "estimator.inlier_gate_m = 0.6 is out of range [0.001, 0.5]");
+  refused_at("[estimator]\nmax_view_angle_deg = 95\n", 2, 22, "estimator.max_view_angle_deg = 95 is out of range [1, 90]");
+  refused_at("[estimator]\nselect = \"first\"\n", 2, 10, "estimator.select = \"first\" is not one of nearest, hint");
+  refused_at("[estimator]\nwall_tolerance_m = 0.1\n", 2, 1, "unknown key 'estimator.wall_tolerance_m'");
+}

@@ -10,6 +10,7 @@
 
 #include <toml++/toml.h>
 
+#include "dockcore/drivers/estimator_toml.hpp"
 #include "dockcore/drivers/profile_toml.hpp"
 #include "dockcore/drivers/toml_reader.hpp"
 
@@ -495,9 +496,12 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
 
   auto estimator_handlers = [&]() {
     dockcore::EstimatorParams& e = sc.estimator;
-    return Handlers{{"max_range_m", p.real(&e.max_range_m, 0.1, 100)},
-                    {"min_range_m", p.real(&e.min_range_m, 0, 10)},
-                    {"range_sigma_m", p.real(&e.range_sigma_m, 0.0001, 1)}};
+    Handlers h{{"max_range_m", p.real(&e.max_range_m, 0.1, 100)},
+               {"min_range_m", p.real(&e.min_range_m, 0, 10)},
+               {"range_sigma_m", p.real(&e.range_sigma_m, 0.0001, 1)}};
+    // The tuning keys dockd's [estimator] takes, with the same bounds.
+    dockcore::drivers::estimator_toml::add_keys(p, h, e, "estimator.");
+    return h;
   };
 
   auto host_handlers = [&]() {
