@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "real_tolerance.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
@@ -125,7 +127,7 @@ TEST(ProfileCheck, FiveCentimetreDockAt2500mmWithLd06IsTooSmall) {
   const ProfileCheck c = check_ld06(p);
   STRCMP_EQUAL("too small", to_string(c.reason));
   STRCMP_EQUAL("none", to_string(c.component));
-  DOUBLES_EQUAL(0.05, static_cast<double>(c.width_m), 1e-9);
+  REAL_EQUAL(0.05, c.width_m, 1e-9);
   DOUBLES_EQUAL(2 * 2.5 * 0.8 * 3.14159265358979 / 180, static_cast<double>(c.min_width_m), 1e-6);
   // The same dock passes at 1 m, where 3 beams need 27.9 mm.
   const ProfileCheck near = check_profile(p, kProfileCheckDefaultBeamSpacingRad, 1);
@@ -140,7 +142,7 @@ TEST(ProfileCheck, WideDockWhoseOnlyYFeaturesAreTinyIsTooSmallInY) {
   const ProfileCheck c = check_ld06(p);
   STRCMP_EQUAL("too small", to_string(c.reason));
   STRCMP_EQUAL("y", to_string(c.component));
-  DOUBLES_EQUAL(0.04, static_cast<double>(c.width_m), 1e-6);
+  REAL_EQUAL(0.04, c.width_m, 1e-6);
   // At 1.2 m the wings hold 3 beams (33.5 mm needed).
   STRCMP_EQUAL("ok", to_string(check_profile(p, kProfileCheckDefaultBeamSpacingRad, r(1.2)).reason));
 }

@@ -1,5 +1,6 @@
 // Scenario TOML parsing: a complete good file, defaults, positioned errors for unknown keys, bad types and bad values,
 // and the shipped scenario files.
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -257,6 +258,8 @@ void refused_at(const std::string& text, int line, int column, const char* needl
 
 constexpr double kPlateVBackM = -0.1 * 0.70710678118654752;  // plate-v's smallest x (its wing tips)
 constexpr double kPlateVHalfWidthM = 0.15 - kPlateVBackM;      // its largest |y|
+/// World geometry is in core's Real (float in the float build): ranges of ~1 m hold a few float ulps.
+const double kHitTol = dockcore_test::real_tol(1.0, 1e-9, 16);
 
 }  // namespace
 
@@ -264,10 +267,10 @@ TEST(Scenario, WallGapGlassAndFreeStandingShapeTheLidarsWorld) {
   // A beam from 1 m out, 0.4 m to the dock's left (clear of the dock), straight back at the wall.
   const dockcore::Vec2 from(1.0, 0.4), back(-1.0, 0.0);
   const docksim::Scenario flush = docksim::parse_scenario_toml("[dock]\nwall = true\n", "s.toml");
-  DOUBLES_EQUAL(1.0 - kPlateVBackM, first_hit(docksim::scenario_world(flush), from, back), 1e-9);
+  DOUBLES_EQUAL(1.0 - kPlateVBackM, first_hit(docksim::scenario_world(flush), from, back), kHitTol);
   const docksim::Scenario gap = docksim::parse_scenario_toml("[dock]\nwall_gap_m = 0.05\n", "s.toml");
   REAL_EQUAL(0.05, gap.wall_gap_m, 1e-12);
-  DOUBLES_EQUAL(1.0 - kPlateVBackM + 0.05, first_hit(docksim::scenario_world(gap), from, back), 1e-9);
+  DOUBLES_EQUAL(1.0 - kPlateVBackM + 0.05, first_hit(docksim::scenario_world(gap), from, back), kHitTol);
   // Glass: the wall is there (dock_wall) but the lidar sees through it.
   const docksim::Scenario glass = docksim::parse_scenario_toml("[dock]\nwall_glass = true\n", "s.toml");
   CHECK(glass.wall && glass.wall_glass);
@@ -279,7 +282,7 @@ TEST(Scenario, WallGapGlassAndFreeStandingShapeTheLidarsWorld) {
   const docksim::Scenario free = docksim::parse_scenario_toml("[dock]\nwall = false\n", "s.toml");
   CHECK_FALSE(docksim::dock_wall(free, &a, &b));
   DOUBLES_EQUAL(-1, first_hit(docksim::scenario_world(free), from, back), 0);
-  DOUBLES_EQUAL(1.0, first_hit(docksim::scenario_world(free), dockcore::Vec2(1.0, 0.0), back), 1e-9);
+  DOUBLES_EQUAL(1.0, first_hit(docksim::scenario_world(free), dockcore::Vec2(1.0, 0.0), back), kHitTol);
   // The gap follows the dock's pose: a dock at (2, 1) turned 90° has its wall along y = 1 + back - gap.
   const docksim::Scenario turned =
       docksim::parse_scenario_toml("[dock]\nx_m = 2\ny_m = 1\nyaw_deg = 90\nwall_gap_m = 0.1\n", "s.toml");
@@ -331,7 +334,7 @@ TEST(Scenario, FurnitureStandsBesideTheDock) {
   // The lidar sees the box: a beam parallel to the dock's x at the box's centre line hits its front face.
   const docksim::World w = docksim::scenario_world(sc);
   DOUBLES_EQUAL(1.0 - (back + 0.4), first_hit(w, dockcore::Vec2(1.0, sc.boxes[0].centre.y()), dockcore::Vec2(-1, 0)),
-                1e-6);
+                std::max(1e-6, kHitTol));
   // Furniture follows a turned dock: a dock facing +y has its left at -x.
   const docksim::Scenario t =
       docksim::parse_scenario_toml("[dock]\nyaw_deg = 90\nwall = false\n[[dock.furniture]]\nkind = \"bin\"\n", "s.toml");
