@@ -13,6 +13,8 @@
 
 #include <toml++/toml.h>
 
+#include "dockcore/drivers/estimator_toml.hpp"
+#include "dockcore/drivers/profile_toml.hpp"
 #include "dockcore/drivers/toml_reader.hpp"
 
 namespace dockd {
@@ -103,55 +105,21 @@ void self_sectors(const Parser& p, const toml::node& n, dockcore::FootprintParam
   f.self_sector_count = static_cast<std::uint8_t>(a->size());
 }
 
-/// A profile file: name (optional), contact_offset_m (optional), points = [[x, y], ...] (docs/docks.md).
+/// A profile file (docs/docks.md), parsed by the parser dock-sim uses. An error inside the file is reported at the
+/// profile file's line and column, naming the config key that refers to it; a file that cannot be read is reported
+/// at that key.
 dockcore::DockProfile load_profile(const Parser& p, const toml::node& at, const std::string& path) {
-  toml::table t;
   std::string text, why;
   if (!read_bounded(path, kMaxProfileFileBytes, text, why)) p.fail(at.source(), "profile file " + path + ": " + why);
   try {
-    t = toml::parse(text, path);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream s;
-    s << "profile file " << path << ":" << e.source().begin.line << ":" << e.source().begin.column << ": "
-      << e.description();
-    p.fail(at.source(), s.str());
+    return dockcore::drivers::profile_toml::parse<ConfigError>(text, path,
+                                                               dockcore::drivers::profile_toml::name_from_path(path));
+  } catch (const ConfigError& e) {
+    const toml::source_position& w = at.source().begin;
+    throw ConfigError(std::string(e.what()) + " (dock profile named at " + p.src() + ":" + std::to_string(w.line) +
+                          ":" + std::to_string(w.column) + ")",
+                      e.line(), e.column());
   }
-  std::vector<Vec2> pts;
-  double offset = 0;
-  std::string name = "custom";
-  for (auto&& [k, v] : t) {
-    const std::string key(k.str());
-    if (key == "name" && v.is_string()) {
-      name = v.as_string()->get();
-    } else if (key == "contact_offset_m" && (v.is_floating_point() || v.is_integer())) {
-      offset = v.is_integer() ? static_cast<double>(v.as_integer()->get()) : v.as_floating_point()->get();
-    } else if (key == "points" && v.is_array()) {
-      for (const toml::node& e : *v.as_array()) {
-        const toml::array* a = e.as_array();
-        if (a == nullptr || a->size() != 2) p.fail(at.source(), "profile file " + path + ": points must be [x, y] pairs");
-        double xy[2];
-        for (int i = 0; i < 2; ++i) {
-          const toml::node& c = (*a)[static_cast<std::size_t>(i)];
-          if (c.is_floating_point()) {
-            xy[i] = c.as_floating_point()->get();
-          } else if (c.is_integer()) {
-            xy[i] = static_cast<double>(c.as_integer()->get());
-          } else {
-            p.fail(at.source(), "profile file " + path + ": points must be numbers");
-          }
-        }
-        pts.emplace_back(static_cast<Real>(xy[0]), static_cast<Real>(xy[1]));
-      }
-    } else {
-      p.fail(at.source(), "profile file " + path + ": unknown or mistyped key '" + key + "'");
-    }
-  }
-  if (name.size() > 23) name.resize(23);
-  dockcore::DockProfile prof;
-  const dockcore::ProfileError e =
-      dockcore::make_profile(pts.data(), pts.size(), static_cast<Real>(offset), name.c_str(), prof);
-  if (e != dockcore::ProfileError::kOk) p.fail(at.source(), "profile file " + path + ": " + dockcore::to_string(e));
-  return prof;
 }
 
 }  // namespace
@@ -203,6 +171,14 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   const toml::node* lidar_protocol_node = nullptr;
   bool pad_reach_set = false, max_range_set = false;
   std::vector<const toml::node*> dock_profile_nodes;
+  // Per dock: the [mounting] given in its entry, which replaces the profile's own (the same dock shape may stand
+  // against a wall in one place and free in another).
+  std::vector<std::pair<bool, dockcore::DockMounting>> dock_mountings;
+  auto mounting_handler = [&](std::pair<bool, dockcore::DockMounting>* out, const std::string& path) {
+    return [&p, out, path](const toml::node& v) {
+      *out = {true, dockcore::drivers::profile_toml::read_mounting(p, v, path)};
+    };
+  };
 
   auto lidar = [&]() {
     auto& l = c.lidar;
@@ -296,6 +272,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
     const toml::node* profile_node = &n;
     double tx = 0, ty = 0, tyaw = 0;
     bool tx_set = false, ty_set = false, tyaw_set = false;
+    std::pair<bool, dockcore::DockMounting> mounting{false, {}};
     const std::string base = p.key() + ".";
     p.each(t, base,
            Handlers{{"id", p.integ(&d.id, 0, 31)},
@@ -305,7 +282,8 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
                      }},
                     {"target_x_m", [&](const toml::node& v) { tx = p.number(v, -3, 3); tx_set = true; }},
                     {"target_y_m", [&](const toml::node& v) { ty = p.number(v, -3, 3); ty_set = true; }},
-                    {"target_yaw_deg", [&](const toml::node& v) { tyaw = p.number(v, -180, 180); tyaw_set = true; }}});
+                    {"target_yaw_deg", [&](const toml::node& v) { tyaw = p.number(v, -180, 180); tyaw_set = true; }},
+                    {"mounting", mounting_handler(&mounting, base + "mounting.")}});
     if (tx_set || ty_set || tyaw_set) {
       if (!(tx_set && ty_set && tyaw_set)) p.fail(n.source(), "dock target needs all of target_x_m, target_y_m, target_yaw_deg");
       d.has_target = true;
@@ -316,6 +294,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
     }
     c.docks.push_back(d);
     dock_profile_nodes.push_back(profile_node);
+    dock_mountings.push_back(mounting);
   };
 
   auto controller = [&]() {
@@ -453,17 +432,23 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
          const toml::table& t = p.table(n);
          DockEntry d;
          const toml::node* profile_node = &n;
+         std::pair<bool, dockcore::DockMounting> mounting{false, {}};
          bool entry = false;
          p.each(t, "dock.",
                 Handlers{{"default_id", p.integ(&c.default_dock_id, 0, 31)},
                          {"id", [&](const toml::node& v) { d.id = static_cast<std::uint16_t>(p.integer(v, 0, 31)); entry = true; }},
-                         {"profile", [&](const toml::node& v) { d.profile_ref = p.string(v); profile_node = &v; entry = true; }}});
+                         {"profile", [&](const toml::node& v) { d.profile_ref = p.string(v); profile_node = &v; entry = true; }},
+                         {"mounting", [&](const toml::node& v) {
+                            mounting_handler(&mounting, "dock.mounting.")(v);
+                            entry = true;
+                          }}});
          if (entry) {
            for (const DockEntry& o : c.docks) {
              if (o.id == d.id) p.fail(n.source(), "dock id " + std::to_string(d.id) + " appears twice");
            }
            c.docks.push_back(d);
            dock_profile_nodes.push_back(profile_node);
+           dock_mountings.push_back(mounting);
          }
        }},
       {"docks", [&](const toml::node& n) {
@@ -472,6 +457,12 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
          docks_node = &n;
          for (const toml::node& e : *a) dock_entry(e);
        }},
+      {"estimator", p.sub("estimator.", [&]() {
+         // The estimator's tuning, the same keys and bounds as dock-sim's scenarios; the range keys are in [lidar].
+         Handlers h;
+         dockcore::drivers::estimator_toml::add_keys(p, h, c.estimator, "estimator.");
+         return h;
+       })},
       {"controller", p.sub("controller.", controller)},
       {"task", p.sub("task.", task)},
       {"host", p.sub("host.", host)},
@@ -523,6 +514,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
     DockEntry d;
     c.docks.push_back(d);
     dock_profile_nodes.push_back(&root);
+    dock_mountings.push_back({false, {}});
   }
   std::uint32_t mask = 0;
   for (std::size_t i = 0; i < c.docks.size(); ++i) {
@@ -538,6 +530,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
       p.fail(dock_profile_nodes[i]->source(), "dock profile \"" + ref + "\" is neither a built-in (" + names +
                                                   ") nor a .toml file");
     }
+    if (dock_mountings[i].first) d.profile.mounting = dock_mountings[i].second;
     mask |= 1u << d.id;
   }
   c.task.accepted_dock_ids = mask;

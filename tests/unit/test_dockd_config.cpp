@@ -209,3 +209,114 @@ TEST(DockdConfig, BadSelfSectorsAreRejectedWithPositions) {
   STRCMP_CONTAINS("t.toml:2:21: robot.footprint.self_sectors_deg sector 1 [-180, 180] has from and to on the same bearing",
                   error_of("[robot.footprint]\nself_sectors_deg = [[-180, 180]]\n").c_str());
 }
+
+namespace {
+/// Writes `text` to a fresh file under /tmp and returns its path.
+std::string write_temp(const std::string& stem, const std::string& text) {
+  const std::string path = "/tmp/dockd_cfg_" + stem + "_" + std::to_string(::getpid()) + ".toml";
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  CHECK_TRUE(f != nullptr);
+  std::fputs(text.c_str(), f);
+  std::fclose(f);
+  return path;
+}
+}  // namespace
+
+TEST(DockdConfig, ProfileFilesAreReadByTheSharedParserWithTheirMounting) {
+  const std::string path = write_temp("wall_dock", "points = [[-0.07, -0.22], [0, -0.15], [0, 0.15], [-0.07, 0.22]]\n"
+                                                   "[mounting]\nkind = \"wall\"\nwall_gap_m = [0.01, 0.06]\n");
+  const dockd::DockdConfig c = dockd::parse_config_toml("[dock]\ndefault_id = 2\n[[docks]]\nid = 2\nprofile = \"" + path + "\"\n", "t.toml");
+  CHECK_EQUAL(1u, c.docks.size());
+  const dockcore::DockProfile& p = c.docks[0].profile;
+  CHECK_EQUAL(4u, p.vertex_count);
+  // The default name is the file name without .toml, as in dock-sim.
+  STRCMP_EQUAL(("dockd_cfg_wall_dock_" + std::to_string(::getpid())).substr(0, 23).c_str(), p.name);
+  CHECK(p.mounting.kind == dockcore::DockMountKind::kWall);
+  REAL_EQUAL(0.01, p.mounting.wall_gap_min_m, 1e-12);
+  REAL_EQUAL(0.06, p.mounting.wall_gap_max_m, 1e-12);
+  std::remove(path.c_str());
+}
+
+TEST(DockdConfig, BadProfileFileIsReportedAtTheProfileFilesLine) {
+  // A flat plate (cannot fix y) on line 2, and a bad mounting kind on line 4 of another file.
+  const std::string plate = write_temp("plate", "name = \"plate\"\npoints = [[0, -0.2], [0, 0.2]]\n");
+  const std::string kind = write_temp("kind", "points = [[-0.07, -0.22], [0, -0.15], [0, 0.15], [-0.07, 0.22]]\n\n"
+                                              "[mounting]\nkind = \"shelf\"\n");
+  const std::string cfg = "[[docks]]\nid = 1\nprofile = \"";
+  STRCMP_CONTAINS((plate + ":2:10: points: the outline cannot fix the dock's y").c_str(),
+                  error_of(cfg + plate + "\"\n").c_str());
+  // ... naming the config key that refers to it.
+  STRCMP_CONTAINS("(dock profile named at t.toml:3:11)", error_of(cfg + plate + "\"\n").c_str());
+  STRCMP_CONTAINS((kind + ":4:8: mounting.kind = \"shelf\" is not one of").c_str(), error_of(cfg + kind + "\"\n").c_str());
+  try {
+    dockd::parse_config_toml(cfg + kind + "\"\n", "t.toml");
+    FAIL("bad profile accepted");
+  } catch (const dockd::ConfigError& e) {
+    CHECK_EQUAL(4, e.line());
+    CHECK_EQUAL(8, e.column());
+  }
+  std::remove(plate.c_str());
+  std::remove(kind.c_str());
+}
+
+TEST(DockdConfig, DockEntriesTakeAMountingThatReplacesTheProfiles) {
+  const dockd::DockdConfig c = dockd::parse_config_toml(
+      "[dock]\ndefault_id = 1\n[[docks]]\nid = 1\nprofile = \"plate-v\"\nmounting = { kind = \"wall\", wall_gap_m = [0.02, 0.05] }\n"
+      "[[docks]]\nid = 2\nprofile = \"v-marker\"\n[docks.mounting]\nkind = \"free_standing\"\n"
+      "[[docks]]\nid = 3\n",
+      "t.toml");
+  CHECK_EQUAL(3u, c.docks.size());
+  CHECK(c.docks[0].profile.mounting.kind == dockcore::DockMountKind::kWall);
+  REAL_EQUAL(0.02, c.docks[0].profile.mounting.wall_gap_min_m, 1e-12);
+  REAL_EQUAL(0.05, c.docks[0].profile.mounting.wall_gap_max_m, 1e-12);
+  CHECK(c.docks[1].profile.mounting.kind == dockcore::DockMountKind::kFreeStanding);
+  CHECK(c.docks[2].profile.mounting.kind == dockcore::DockMountKind::kUnknown);
+  // The [dock] shorthand too.
+  const dockd::DockdConfig s = dockd::parse_config_toml("[dock]\ndefault_id = 4\nid = 4\n[dock.mounting]\nkind = \"wall\"\n", "t.toml");
+  CHECK(s.docks[0].profile.mounting.kind == dockcore::DockMountKind::kWall);
+  REAL_EQUAL(0.10, s.docks[0].profile.mounting.wall_gap_max_m, 1e-12);
+  // A dock's mounting replaces the one in its profile file.
+  const std::string path = write_temp("free_dock", "points = [[-0.07, -0.22], [0, -0.15], [0, 0.15], [-0.07, 0.22]]\n"
+                                                   "[mounting]\nkind = \"free_standing\"\n");
+  const dockd::DockdConfig f = dockd::parse_config_toml(
+      "[dock]\ndefault_id = 1\n[[docks]]\nid = 1\nprofile = \"" + path + "\"\n[docks.mounting]\nkind = \"wall\"\nwall_gap_m = [0, 0.2]\n",
+      "t.toml");
+  CHECK(f.docks[0].profile.mounting.kind == dockcore::DockMountKind::kWall);
+  REAL_EQUAL(0.2, f.docks[0].profile.mounting.wall_gap_max_m, 1e-12);
+  std::remove(path.c_str());
+}
+
+TEST(DockdConfig, BadDockMountingIsPositioned) {
+  STRCMP_CONTAINS("t.toml:5:18: docks.mounting.wall_gap_m = 0.7 is out of range [0, 0.5]",
+                  error_of("[[docks]]\nid = 1\n[docks.mounting]\nkind = \"wall\"\nwall_gap_m = [0, 0.7]\n").c_str());
+  STRCMP_CONTAINS("t.toml:4:14: docks.mounting.wall_gap_m is only meaningful with docks.mounting.kind = \"wall\"",
+                  error_of("[[docks]]\nid = 1\n[docks.mounting]\nwall_gap_m = [0, 0.1]\n").c_str());
+  STRCMP_CONTAINS("t.toml:4:8: dock.mounting.kind = \"floor\" is not one of unknown, wall, free_standing",
+                  error_of("[dock]\nid = 1\n[dock.mounting]\nkind = \"floor\"\n").c_str());
+  STRCMP_CONTAINS("t.toml:4:1: unknown key 'docks.mounting.gap_m'",
+                  error_of("[[docks]]\nid = 1\n[docks.mounting]\ngap_m = 0.1\n").c_str());
+}
+
+TEST(DockdConfig, EstimatorTuningKeys) {
+  const dockd::DockdConfig c = dockd::parse_config_toml(
+      "[estimator]\ninlier_gate_m = 0.02\nmax_view_angle_deg = 60\nselect = \"hint\"\nmin_inliers = 14\n"
+      "[estimator.segments]\nmin_points = 4\n",
+      "t.toml");
+  REAL_EQUAL(0.02, c.estimator.inlier_gate_m, 1e-12);
+  REAL_EQUAL(60 * 3.14159265358979323846 / 180, c.estimator.max_view_angle_rad, 1e-9);
+  CHECK(c.estimator.select == dockcore::DockSelect::kHint);
+  CHECK_EQUAL(14u, c.estimator.min_inliers);
+  CHECK_EQUAL(4u, c.estimator.segments.min_points);
+  // Untouched keys keep the estimator's defaults.
+  const dockcore::EstimatorParams d{};
+  REAL_EQUAL(d.max_rms_m, c.estimator.max_rms_m, 0);
+  // Out of range, wrong type, unknown: at the value / key.
+  STRCMP_CONTAINS("t.toml:2:17: estimator.inlier_gate_m = 0.6 is out of range [0.001, 0.5]",
+                  error_of("[estimator]\ninlier_gate_m = 0.6\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:15: estimator.min_inliers must be an integer, not a float",
+                  error_of("[estimator]\nmin_inliers = 2.5\n").c_str());
+  STRCMP_CONTAINS("t.toml:2:1: unknown key 'estimator.require_wall_behind'",
+                  error_of("[estimator]\nrequire_wall_behind = false\n").c_str());
+  STRCMP_CONTAINS("t.toml:3:14: estimator.segments.min_points = 1 is out of range [2, 100]",
+                  error_of("[estimator.segments]\n\nmin_points = 1\n").c_str());
+}

@@ -13,8 +13,8 @@
 #include <CppUTest/TestHarness.h>
 
 using dockcore::DockProfile;
-using docksim::ProfileFileError;
 using docksim::parse_profile_toml;
+using docksim::ProfileFileError;
 
 namespace {
 
@@ -63,10 +63,12 @@ TEST(ProfileFile, GoodFileWithOffsetAndName) {
 }
 
 TEST(ProfileFile, IntegersAcceptedAndDefaultName) {
-  const DockProfile p = parse_profile_toml("points = [[0, -1], [0, 1]]\n", "x.toml", "fallback");
+  const DockProfile p = parse_profile_toml("points = [[-1, -2], [0, -1], [0, 1], [-1, 2]]\n", "x.toml", "fallback");
   STRCMP_EQUAL("fallback", p.name);
-  LONGS_EQUAL(2, p.vertex_count);
-  REAL_EQUAL(2.0, p.length_m(), 1e-12);
+  LONGS_EQUAL(4, p.vertex_count);
+  REAL_EQUAL(2.0 + 2 * std::sqrt(2.0), p.length_m(), 1e-12);
+  // No [mounting]: nothing assumed about what is behind the dock.
+  CHECK(p.mounting.kind == dockcore::DockMountKind::kUnknown);
 }
 
 TEST(ProfileFile, RoundTripOfBuiltins) {
@@ -92,9 +94,13 @@ TEST(ProfileFile, UnknownKey) {
   check_position("points = [[0, -1], [0, 1]]\n  widht = 3\n", 2, 3, "unknown key 'widht'");
 }
 
-TEST(ProfileFile, MissingPoints) { check_position("name = \"x\"\n", 1, 1, "missing 'points'"); }
+TEST(ProfileFile, MissingPoints) {
+  check_position("name = \"x\"\n", 1, 1, "missing 'points'");
+}
 
-TEST(ProfileFile, PointsNotArray) { check_position("points = \"abc\"\n", 1, 10, "points must be an array"); }
+TEST(ProfileFile, PointsNotArray) {
+  check_position("points = \"abc\"\n", 1, 10, "points must be an array");
+}
 
 TEST(ProfileFile, CoordinateNotNumber) {
   //                 col: 1234567890123456789012
@@ -105,7 +111,9 @@ TEST(ProfileFile, PointWithThreeNumbers) {
   check_position("points = [[0, -1], [0, 1, 2]]\n", 1, 20, "must be [x_m, y_m]");
 }
 
-TEST(ProfileFile, TooFewPoints) { check_position("\npoints = [[0, -1]]\n", 2, 10, "at least 2"); }
+TEST(ProfileFile, TooFewPoints) {
+  check_position("\npoints = [[0, -1]]\n", 2, 10, "at least 2");
+}
 
 TEST(ProfileFile, TooManyPoints) {
   std::string text = "points = [\n";
@@ -120,12 +128,15 @@ TEST(ProfileFile, DegenerateSegment) {
 }
 
 TEST(ProfileFile, BadContactOffsetAndName) {
-  check_position("points = [[0, -1], [0, 1]]\ncontact_offset_m = \"2cm\"\n", 2, 20, "contact_offset_m must be a number");
+  check_position("points = [[0, -1], [0, 1]]\ncontact_offset_m = \"2cm\"\n", 2, 20,
+                 "contact_offset_m must be a number");
   check_position("name = 7\npoints = [[0, -1], [0, 1]]\n", 1, 8, "name must be a string");
   check_position("name = \"a-name-that-is-far-too-long\"\npoints = [[0, -1], [0, 1]]\n", 1, 8, "longer than 23");
 }
 
-TEST(ProfileFile, NonFinite) { check_position("points = [[0, -1], [nan, 1]]\n", 1, 21, "not finite"); }
+TEST(ProfileFile, NonFinite) {
+  check_position("points = [[0, -1], [nan, 1]]\n", 1, 21, "not finite");
+}
 
 TEST(ProfileFile, ResolveBuiltinFileAndUnknown) {
   const DockProfile b = docksim::resolve_profile("v-marker");
@@ -136,11 +147,11 @@ TEST(ProfileFile, ResolveBuiltinFileAndUnknown) {
   const std::string path = "test_profile_file_tmp.toml";
   {
     std::ofstream f(path);
-    f << "points = [[0, -0.1], [0, 0.1]]\n";
+    f << "points = [[-0.05, -0.15], [0, -0.1], [0, 0.1], [-0.05, 0.15]]\n";
   }
   const DockProfile p = docksim::resolve_profile(path);
   STRCMP_EQUAL("test_profile_file_tmp", p.name);
-  REAL_EQUAL(0.2, p.width_m(), 1e-12);
+  REAL_EQUAL(0.3, p.width_m(), 1e-12);
   std::remove(path.c_str());
 
   try {
@@ -156,4 +167,73 @@ TEST(ProfileFile, ResolveBuiltinFileAndUnknown) {
     CHECK(std::string(e.what()).find("cannot open") != std::string::npos);
     LONGS_EQUAL(0, e.line());
   }
+}
+
+namespace {
+/// A good outline (plate-v's shape) to which the mounting tests add tables; one line, so [mounting] starts on line 2.
+const std::string kWings = "points = [[-0.07, -0.22], [0, -0.15], [0, 0.15], [-0.07, 0.22]]\n";
+}  // namespace
+
+TEST(ProfileFile, MountingKinds) {
+  const DockProfile wall =
+      parse_profile_toml(kWings + "[mounting]\nkind = \"wall\"\nwall_gap_m = [0.02, 0.08]\n", "t.toml");
+  CHECK(wall.mounting.kind == dockcore::DockMountKind::kWall);
+  REAL_EQUAL(0.02, wall.mounting.wall_gap_min_m, 1e-12);
+  REAL_EQUAL(0.08, wall.mounting.wall_gap_max_m, 1e-12);
+  // kind wall without a gap: the default range [0, 0.10].
+  const DockProfile flush = parse_profile_toml(kWings + "[mounting]\nkind = \"wall\"\n", "t.toml");
+  REAL_EQUAL(0.0, flush.mounting.wall_gap_min_m, 1e-12);
+  REAL_EQUAL(0.10, flush.mounting.wall_gap_max_m, 1e-12);
+  const DockProfile free = parse_profile_toml(kWings + "[mounting]\nkind = \"free_standing\"\n", "t.toml");
+  CHECK(free.mounting.kind == dockcore::DockMountKind::kFreeStanding);
+  const DockProfile unknown = parse_profile_toml(kWings + "[mounting]\nkind = \"unknown\"\n", "t.toml");
+  CHECK(unknown.mounting.kind == dockcore::DockMountKind::kUnknown);
+  // An empty [mounting] is allowed and changes nothing.
+  CHECK(parse_profile_toml(kWings + "[mounting]\n", "t.toml").mounting.kind == dockcore::DockMountKind::kUnknown);
+}
+
+TEST(ProfileFile, MountingRoundTrips) {
+  for (const char* table :
+       {"[mounting]\nkind = \"wall\"\nwall_gap_m = [0.03, 0.25]\n", "[mounting]\nkind = \"free_standing\"\n", ""}) {
+    const DockProfile a = parse_profile_toml(kWings + table, "a.toml");
+    const DockProfile b = parse_profile_toml(docksim::profile_to_toml(a), "b.toml");
+    CHECK(a.mounting.kind == b.mounting.kind);
+    REAL_EQUAL(a.mounting.wall_gap_min_m, b.mounting.wall_gap_min_m, 1e-9);
+    REAL_EQUAL(a.mounting.wall_gap_max_m, b.mounting.wall_gap_max_m, 1e-9);
+  }
+}
+
+TEST(ProfileFile, BadMountingValuesArePositioned) {
+  check_position(kWings + "[mounting]\nkind = \"glued\"\n", 3, 8,
+                 "mounting.kind = \"glued\" is not one of unknown, wall, free_standing");
+  check_position(kWings + "[mounting]\nkind = 1\n", 3, 8, "mounting.kind must be a string");
+  check_position(kWings + "[mounting]\nkind = \"wall\"\n  gap = 0.1\n", 4, 3,
+                 "unknown key 'mounting.gap' (expected kind, wall_gap_m)");
+  //                                                     col: 12345678901234567890
+  check_position(kWings + "[mounting]\nkind = \"wall\"\nwall_gap_m = [0, 0.6]\n", 4, 18,
+                 "mounting.wall_gap_m = 0.6 is out of range [0, 0.5]");
+  check_position(kWings + "[mounting]\nkind = \"wall\"\nwall_gap_m = [-0.01, 0.1]\n", 4, 15, "out of range [0, 0.5]");
+  check_position(kWings + "[mounting]\nkind = \"wall\"\nwall_gap_m = [0.2, 0.1]\n", 4, 14,
+                 "minimum is larger than the maximum");
+  check_position(kWings + "[mounting]\nkind = \"wall\"\nwall_gap_m = 0.1\n", 4, 14, "must be [min_m, max_m]");
+  check_position(kWings + "[mounting]\nkind = \"wall\"\nwall_gap_m = [0, \"5cm\"]\n", 4, 18,
+                 "mounting.wall_gap_m must be a number");
+  check_position(kWings + "[mounting]\nkind = \"free_standing\"\nwall_gap_m = [0, 0.1]\n", 4, 14,
+                 "mounting.wall_gap_m is only meaningful with mounting.kind = \"wall\"");
+  // Without kind the kind is unknown, so a gap is refused as well.
+  check_position(kWings + "[mounting]\nwall_gap_m = [0, 0.1]\n", 3, 14, "only meaningful with");
+  check_position(kWings + "mounting = \"wall\"\n", 2, 12, "mounting must be a table");
+}
+
+TEST(ProfileFile, OutlinesCheckProfileRefusesArePositioned) {
+  // A flat plate cannot fix y.
+  check_position("name = \"plate\"\npoints = [[0, -0.2], [0, 0.2]]\n", 2, 10, "cannot fix the dock's y");
+  // A Z whose last segment crosses the first: pointed at the later segment's first point (point 2).
+  check_position("points = [[0, -0.15],\n  [0, 0.15],\n  [-0.1, 0.15], [0.05, 0]]\n", 3, 3,
+                 "segments 0 (points 0-1) and 2 (points 2-3) meet");
+  // 5 cm wide: fewer than 3 beams of an 0.8° lidar at 2.5 m.
+  check_position("points = [[0, -0.025], [-0.025, 0], [0, 0.025]]\n", 1, 10,
+                 "the dock is 0.050 m wide: at 2.50 m a 0.80° lidar puts fewer than 3 beams on it (it needs 0.070 m)");
+  // Every outward normal points away from the front.
+  check_position("points = [[0, 0.2], [0, -0.2]]\n", 1, 10, "no surface faces the front");
 }

@@ -1,9 +1,11 @@
 // Scenario TOML parsing: a complete good file, defaults, positioned errors for unknown keys, bad types and bad values,
 // and the shipped scenario files.
+#include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "docksim/scenario.hpp"
+#include "docksim/sim_run.hpp"
 
 #include "real_tolerance.hpp"
 
@@ -233,4 +235,169 @@ TEST(Scenario, SmoothLineupParametersAreSettable) {
       "lineup.toml");
   REAL_EQUAL(0.35, sc.smooth.lineup_distance_m, 1e-12);
   REAL_EQUAL(2.5, sc.smooth.lineup_max_curvature_inv_m, 1e-12);
+}
+
+namespace {
+
+/// Range of the first world hit from `from` along `dir` (unit), or -1 when nothing is hit within 10 m.
+double first_hit(const docksim::World& w, const dockcore::Vec2& from, const dockcore::Vec2& dir) {
+  double r = 0;
+  return w.raycast(from, dir, 10.0, &r) ? r : -1;
+}
+
+/// Checks that `text` is refused at line:column with `needle` in the message.
+void refused_at(const std::string& text, int line, int column, const char* needle) {
+  const docksim::ScenarioError e = expect_error(text);
+  const std::string msg = e.what();
+  CHECK_EQUAL_TEXT(line, e.line(), msg.c_str());
+  CHECK_EQUAL_TEXT(column, e.column(), msg.c_str());
+  const std::string prefix = "s.toml:" + std::to_string(line) + ":" + std::to_string(column) + ": ";
+  CHECK_TEXT(msg.rfind(prefix, 0) == 0, msg.c_str());
+  CHECK_TEXT(msg.find(needle) != std::string::npos, msg.c_str());
+}
+
+constexpr double kPlateVBackM = -0.1 * 0.70710678118654752;  // plate-v's smallest x (its wing tips)
+constexpr double kPlateVHalfWidthM = 0.15 - kPlateVBackM;      // its largest |y|
+/// World geometry is in core's Real (float in the float build): ranges of ~1 m hold a few float ulps.
+const double kHitTol = dockcore_test::real_tol(1.0, 1e-9, 16);
+
+}  // namespace
+
+TEST(Scenario, WallGapGlassAndFreeStandingShapeTheLidarsWorld) {
+  // A beam from 1 m out, 0.4 m to the dock's left (clear of the dock), straight back at the wall.
+  const dockcore::Vec2 from(1.0, 0.4), back(-1.0, 0.0);
+  const docksim::Scenario flush = docksim::parse_scenario_toml("[dock]\nwall = true\n", "s.toml");
+  DOUBLES_EQUAL(1.0 - kPlateVBackM, first_hit(docksim::scenario_world(flush), from, back), kHitTol);
+  const docksim::Scenario gap = docksim::parse_scenario_toml("[dock]\nwall_gap_m = 0.05\n", "s.toml");
+  REAL_EQUAL(0.05, gap.wall_gap_m, 1e-12);
+  DOUBLES_EQUAL(1.0 - kPlateVBackM + 0.05, first_hit(docksim::scenario_world(gap), from, back), kHitTol);
+  // Glass: the wall is there (dock_wall) but the lidar sees through it.
+  const docksim::Scenario glass = docksim::parse_scenario_toml("[dock]\nwall_glass = true\n", "s.toml");
+  CHECK(glass.wall && glass.wall_glass);
+  DOUBLES_EQUAL(-1, first_hit(docksim::scenario_world(glass), from, back), 0);
+  dockcore::Vec2 a, b;
+  CHECK(docksim::dock_wall(glass, &a, &b));
+  REAL_EQUAL(kPlateVBackM, a.x(), 1e-9);
+  // Free-standing: no wall at all; the dock itself is still hit.
+  const docksim::Scenario free = docksim::parse_scenario_toml("[dock]\nwall = false\n", "s.toml");
+  CHECK_FALSE(docksim::dock_wall(free, &a, &b));
+  DOUBLES_EQUAL(-1, first_hit(docksim::scenario_world(free), from, back), 0);
+  DOUBLES_EQUAL(1.0, first_hit(docksim::scenario_world(free), dockcore::Vec2(1.0, 0.0), back), kHitTol);
+  // The gap follows the dock's pose: a dock at (2, 1) turned 90° has its wall along y = 1 + back - gap.
+  const docksim::Scenario turned =
+      docksim::parse_scenario_toml("[dock]\nx_m = 2\ny_m = 1\nyaw_deg = 90\nwall_gap_m = 0.1\n", "s.toml");
+  CHECK(docksim::dock_wall(turned, &a, &b));
+  REAL_EQUAL(1.0 + kPlateVBackM - 0.1, a.y(), 1e-6);
+  REAL_EQUAL(1.0 + kPlateVBackM - 0.1, b.y(), 1e-6);
+}
+
+TEST(Scenario, WhatTheDetectorIsToldIsIndependentOfTheWorld) {
+  // Default: the profile's own mounting (built-ins: unknown).
+  CHECK(docksim::parse_scenario_toml("", "s.toml").profile.mounting.kind == dockcore::DockMountKind::kUnknown);
+  // Told unknown, the world has a wall 5 cm behind the dock.
+  const docksim::Scenario a =
+      docksim::parse_scenario_toml("[dock]\nwall_gap_m = 0.05\n[dock.mounting]\nkind = \"unknown\"\n", "s.toml");
+  CHECK(a.profile.mounting.kind == dockcore::DockMountKind::kUnknown);
+  REAL_EQUAL(0.05, a.wall_gap_m, 1e-12);
+  // Told "wall 0-50 mm", the world has none.
+  const docksim::Scenario b = docksim::parse_scenario_toml(
+      "[dock]\nwall = false\n[dock.mounting]\nkind = \"wall\"\nwall_gap_m = [0, 0.05]\n", "s.toml");
+  CHECK_FALSE(b.wall);
+  CHECK(b.profile.mounting.kind == dockcore::DockMountKind::kWall);
+  REAL_EQUAL(0.05, b.profile.mounting.wall_gap_max_m, 1e-12);
+}
+
+TEST(Scenario, FurnitureStandsBesideTheDock) {
+  const docksim::Scenario sc = docksim::parse_scenario_toml(
+      "[dock]\nwall_gap_m = 0.02\n"
+      "[[dock.furniture]]\nkind = \"box\"\nside = \"left\"\ngap_m = 0.3\ndepth_m = 0.4\nwidth_m = 0.2\n"
+      "[[dock.furniture]]\nkind = \"bin\"\nside = \"right\"\ngap_m = 0.25\nradius_m = 0.1\nx_m = 0.5\n"
+      "[[dock.furniture]]\nkind = \"chair\"\nside = \"right\"\ngap_m = 0.8\nseat_m = 0.4\nleg_radius_m = 0.02\n",
+      "s.toml");
+  CHECK_EQUAL(3u, sc.furniture.size());
+  CHECK_EQUAL(1u, sc.boxes.size());
+  CHECK_EQUAL(5u, sc.circles.size());  // the bin and four chair legs
+  // Box: near edge 0.3 m beyond the dock's outermost +y, back 1 cm in front of the wall (2 cm behind the dock).
+  const double back = kPlateVBackM - 0.02 + docksim::kFurnitureWallClearanceM;
+  REAL_EQUAL(back + 0.2, sc.boxes[0].centre.x(), 1e-9);
+  REAL_EQUAL(kPlateVHalfWidthM + 0.3 + 0.1, sc.boxes[0].centre.y(), 1e-9);
+  // Bin at the given x, on the right.
+  REAL_EQUAL(0.5, sc.circles[0].centre.x(), 1e-9);
+  REAL_EQUAL(-(kPlateVHalfWidthM + 0.25 + 0.1), sc.circles[0].centre.y(), 1e-9);
+  // Chair legs: outer edges on the 0.4 m seat square, whose near side is 0.8 m beyond the dock's -y edge.
+  double nearest = -1e9;
+  for (std::size_t i = 1; i < 5; ++i) {
+    REAL_EQUAL(0.02, sc.circles[i].r_m, 1e-12);
+    nearest = std::max(nearest, static_cast<double>(sc.circles[i].centre.y()) + 0.02);
+  }
+  REAL_EQUAL(-(kPlateVHalfWidthM + 0.8), nearest, 1e-9);
+  // The lidar sees the box: a beam parallel to the dock's x at the box's centre line hits its front face.
+  const docksim::World w = docksim::scenario_world(sc);
+  DOUBLES_EQUAL(1.0 - (back + 0.4), first_hit(w, dockcore::Vec2(1.0, sc.boxes[0].centre.y()), dockcore::Vec2(-1, 0)),
+                std::max(1e-6, kHitTol));
+  // Furniture follows a turned dock: a dock facing +y has its left at -x.
+  const docksim::Scenario t =
+      docksim::parse_scenario_toml("[dock]\nyaw_deg = 90\nwall = false\n[[dock.furniture]]\nkind = \"bin\"\n", "s.toml");
+  REAL_EQUAL(-(kPlateVHalfWidthM + 0.3 + 0.15), t.circles[0].centre.x(), 1e-6);
+  REAL_EQUAL(kPlateVBackM + 0.15, t.circles[0].centre.y(), 1e-6);
+}
+
+TEST(Scenario, BadWallMountingAndFurnitureValuesArePositioned) {
+  //                   col: 1234567890123
+  refused_at("[dock]\nwall_gap_m = 0.6\n", 2, 14, "dock.wall_gap_m = 0.6 is out of range [0, 0.5]");
+  refused_at("[dock]\nwall_glass = \"yes\"\n", 2, 14, "dock.wall_glass must be true or false");
+  refused_at("[dock]\nwall = false\nwall_gap_m = 0.05\n", 3, 14,
+             "dock.wall_gap_m is only meaningful with dock.wall = true");
+  refused_at("[dock]\nwall_glass = true\nwall = false\n", 2, 14, "dock.wall_glass is only meaningful with");
+  refused_at("[dock.mounting]\nkind = \"wall\"\nwall_gap_m = [0.1, 0.05]\n", 3, 14, "minimum is larger than the maximum");
+  refused_at("[dock.mounting]\nkind = \"glass\"\n", 2, 8, "dock.mounting.kind = \"glass\" is not one of");
+  refused_at("[[dock.furniture]]\nkind = \"sofa\"\n", 2, 8, "dock.furniture.kind = \"sofa\" is not one of box, bin, chair");
+  refused_at("[[dock.furniture]]\nside = \"left\"\n", 1, 1, "without 'kind'");
+  refused_at("[[dock.furniture]]\nkind = \"box\"\nradius_m = 0.2\n", 3, 1, "unknown key 'dock.furniture.box.radius_m'");
+  refused_at("[[dock.furniture]]\nkind = \"bin\"\nside = \"behind\"\n", 3, 8, "is not one of left, right");
+  refused_at("[[dock.furniture]]\nkind = \"bin\"\ngap_m = 4\n", 3, 9, "dock.furniture.bin.gap_m = 4 is out of range [0, 3]");
+  refused_at("[[dock.furniture]]\nkind = \"chair\"\nleg_radius_m = 0.1\n", 3, 16, "out of range [0.005, 0.05]");
+  refused_at("[[dock.furniture]]\nkind = \"box\"\nwidth_m = 0.01\n", 3, 11, "out of range [0.05, 2]");
+  refused_at("[dock]\nfurniture = 3\n", 2, 13, "dock.furniture must be an array of tables");
+}
+
+TEST(Scenario, ShippedWallScenariosHaveTheirWorlds) {
+  const docksim::Scenario f = docksim::load_scenario_file(scenario_dir() + "free-standing.toml");
+  CHECK_FALSE(f.wall);
+  CHECK(f.profile.mounting.kind == dockcore::DockMountKind::kFreeStanding);
+  const docksim::Scenario g = docksim::load_scenario_file(scenario_dir() + "wall-gap-5cm.toml");
+  CHECK(g.wall && !g.wall_glass);
+  REAL_EQUAL(0.05, g.wall_gap_m, 1e-12);
+  CHECK(g.profile.mounting.kind == dockcore::DockMountKind::kUnknown);
+  const docksim::Scenario s = docksim::load_scenario_file(scenario_dir() + "glass.toml");
+  CHECK(s.wall && s.wall_glass);
+  CHECK(s.profile.mounting.kind == dockcore::DockMountKind::kWall);
+  const docksim::Scenario u = docksim::load_scenario_file(scenario_dir() + "furniture.toml");
+  CHECK_EQUAL(3u, u.furniture.size());
+  // Apart from the dock's surroundings they are the default scenario.
+  const docksim::Scenario d = docksim::load_scenario_file(scenario_dir() + "default.toml");
+  for (const docksim::Scenario* x : {&f, &g, &s, &u}) {
+    REAL_EQUAL(d.start.distance_max_m, x->start.distance_max_m, 0);
+    REAL_EQUAL(d.estimator.max_range_m, x->estimator.max_range_m, 0);
+    STRCMP_EQUAL(d.controller.c_str(), x->controller.c_str());
+  }
+}
+
+TEST(Scenario, EstimatorTuningKeys) {
+  // The same text as dockd's EstimatorTuningKeys test: both parsers share one key list.
+  const docksim::Scenario sc = docksim::parse_scenario_toml(
+      "[estimator]\ninlier_gate_m = 0.02\nmax_view_angle_deg = 60\nselect = \"hint\"\nmin_inliers = 14\n"
+      "[estimator.segments]\nmin_points = 4\n",
+      "s.toml");
+  REAL_EQUAL(0.02, sc.estimator.inlier_gate_m, 1e-12);
+  REAL_EQUAL(60 * kDeg, sc.estimator.max_view_angle_rad, 1e-9);
+  CHECK(sc.estimator.select == dockcore::DockSelect::kHint);
+  CHECK_EQUAL(14u, sc.estimator.min_inliers);
+  CHECK_EQUAL(4u, sc.estimator.segments.min_points);
+  const dockcore::EstimatorParams d{};
+  REAL_EQUAL(d.max_rms_m, sc.estimator.max_rms_m, 0);
+  refused_at("[estimator]\ninlier_gate_m = 0.6\n", 2, 17, "estimator.inlier_gate_m = 0.6 is out of range [0.001, 0.5]");
+  refused_at("[estimator]\nmax_view_angle_deg = 95\n", 2, 22, "estimator.max_view_angle_deg = 95 is out of range [1, 90]");
+  refused_at("[estimator]\nselect = \"first\"\n", 2, 10, "estimator.select = \"first\" is not one of nearest, hint");
+  refused_at("[estimator]\nwall_tolerance_m = 0.1\n", 2, 1, "unknown key 'estimator.wall_tolerance_m'");
 }

@@ -49,6 +49,14 @@ docksim::SvgCanvas make_canvas(const docksim::Scenario& sc, const std::vector<Po
   docksim::SvgBounds b;
   for (const Vec2& p : profile_world(sc)) b.add(p);
   for (const Pose2& p : poses) b.add(p.x_m, p.y_m);
+  // Objects beside the dock (furniture) are part of its picture.
+  const Vec2 dock_at(sc.dock_pose.x_m, sc.dock_pose.y_m);
+  for (const auto& x : sc.boxes) {
+    if ((x.centre - dock_at).norm() < 1.5) b.add(x.centre);
+  }
+  for (const auto& x : sc.circles) {
+    if ((x.centre - dock_at).norm() < 1.5) b.add(x.centre);
+  }
   b.pad(0.5);
   const double span = std::max(b.x_max - b.x_min, b.y_max - b.y_min);
   docksim::SvgCanvas c(b, std::min(400.0, 800.0 / span), 20);
@@ -57,8 +65,18 @@ docksim::SvgCanvas make_canvas(const docksim::Scenario& sc, const std::vector<Po
   const docksim::World world = docksim::scenario_world(sc, false);
   const SvgStyle ws = SvgStyle::line("#9a9a9a", 1.5);
   for (const auto& s : world.segments) c.line(s.a, s.b, ws);
+  Vec2 glass_a, glass_b;
+  const bool glass = sc.wall_glass && docksim::dock_wall(sc, &glass_a, &glass_b);
+  const SvgStyle gs = SvgStyle::line("#7fc7e8", 2, "6,3");
+  if (glass) c.line(glass_a, glass_b, gs);
   c.polyline(profile_world(sc), SvgStyle::line("#2ca02c", 3));
   c.legend("world", ws);
+  if (glass) c.legend("glass wall (the lidar sees through)", gs);
+  c.legend_text(std::string("detector told: ") + dockcore::to_string(sc.profile.mounting.kind) +
+                (sc.profile.mounting.kind == dockcore::DockMountKind::kWall
+                     ? fmt(" %.0f-", static_cast<double>(sc.profile.mounting.wall_gap_min_m) * 1e3) +
+                           fmt("%.0f mm", static_cast<double>(sc.profile.mounting.wall_gap_max_m) * 1e3)
+                     : std::string()));
   c.legend("dock", SvgStyle::line("#2ca02c", 3));
   return c;
 }

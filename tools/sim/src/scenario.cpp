@@ -10,6 +10,8 @@
 
 #include <toml++/toml.h>
 
+#include "dockcore/drivers/estimator_toml.hpp"
+#include "dockcore/drivers/profile_toml.hpp"
 #include "dockcore/drivers/toml_reader.hpp"
 
 #include "docksim/profile_file.hpp"
@@ -25,6 +27,15 @@ const char* to_string(EventKind k) {
     case EventKind::kChargingNeverStarts: return "charging_never_starts";
     case EventKind::kChassisSilent: return "chassis_silent";
     case EventKind::kHostStall: return "host_stall";
+  }
+  return "?";
+}
+
+const char* to_string(FurnitureKind k) {
+  switch (k) {
+    case FurnitureKind::kBox: return "box";
+    case FurnitureKind::kBin: return "bin";
+    case FurnitureKind::kChair: return "chair";
   }
   return "?";
 }
@@ -109,7 +120,58 @@ struct ParseState {
   const toml::node* profile_node = nullptr;
   std::string footprint_shape = "square";
   double check_length_m = 0.3, check_width_m = 0.5;
+  bool mounting_set = false;
+  dockcore::DockMounting mounting{};
 };
+
+/// Adds the furniture beside the dock to the scenario's world boxes and circles (docs/scenarios.md, [dock]).
+void place_furniture(Scenario& sc) {
+  const dockcore::DockProfile& prof = sc.profile;
+  double min_x = 0, min_y = 0, max_y = 0;
+  for (std::size_t i = 0; i < prof.vertex_count; ++i) {
+    const Vec2& v = prof.vertices_m[i];
+    min_x = i == 0 ? static_cast<double>(v.x()) : std::min(min_x, static_cast<double>(v.x()));
+    min_y = i == 0 ? static_cast<double>(v.y()) : std::min(min_y, static_cast<double>(v.y()));
+    max_y = i == 0 ? static_cast<double>(v.y()) : std::max(max_y, static_cast<double>(v.y()));
+  }
+  const double back_x = sc.wall ? min_x - sc.wall_gap_m + kFurnitureWallClearanceM : min_x;
+  auto world = [&](double x, double y) { return sc.dock_pose.transform(Vec2(static_cast<Real>(x), static_cast<Real>(y))); };
+  for (const DockFurniture& f : sc.furniture) {
+    const double near = (f.side > 0 ? max_y : -min_y) + f.gap_m;  // nearest point's |y|, dock frame
+    const double sgn = f.side > 0 ? 1.0 : -1.0;
+    switch (f.kind) {
+      case FurnitureKind::kBox: {
+        WorldBox b;
+        b.centre = world(f.x_set ? f.x_m : back_x + f.depth_m / 2, sgn * (near + f.width_m / 2));
+        b.size_x_m = f.depth_m;
+        b.size_y_m = f.width_m;
+        b.yaw_rad = static_cast<double>(sc.dock_pose.yaw_rad);
+        sc.boxes.push_back(b);
+        break;
+      }
+      case FurnitureKind::kBin: {
+        WorldCircle c;
+        c.centre = world(f.x_set ? f.x_m : back_x + f.radius_m, sgn * (near + f.radius_m));
+        c.r_m = f.radius_m;
+        sc.circles.push_back(c);
+        break;
+      }
+      case FurnitureKind::kChair: {
+        const double half = f.seat_m / 2, in = half - f.leg_radius_m;
+        const double cx = f.x_set ? f.x_m : back_x + half, cy = sgn * (near + half);
+        for (const double dx : {-in, in}) {
+          for (const double dy : {-in, in}) {
+            WorldCircle c;
+            c.centre = world(cx + dx, cy + dy);
+            c.r_m = f.leg_radius_m;
+            sc.circles.push_back(c);
+          }
+        }
+        break;
+      }
+    }
+  }
+}
 
 }  // namespace
 
@@ -236,7 +298,53 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         {"yaw_deg", p.real_deg(&sc.dock_pose.yaw_rad, -180, 180)},
         {"face_half_width_m", p.num(&sc.dock_face_half_width_m, 0.005, 2)},
         {"wall", p.flag(&sc.wall)},
+        {"wall_gap_m", p.num(&sc.wall_gap_m, 0, static_cast<double>(dockcore::kMaxWallGapM))},
+        {"wall_glass", p.flag(&sc.wall_glass)},
         {"wall_half_length_m", p.num(&sc.wall_half_length_m, 0.1, 100)},
+        {"mounting", [&](const toml::node& n) {
+           st.mounting = dockcore::drivers::profile_toml::read_mounting(p, n, "dock.mounting.");
+           st.mounting_set = true;
+         }},
+        {"furniture", [&](const toml::node& n) {
+           const toml::array* a = n.as_array();
+           if (a == nullptr) p.fail(n.source(), "dock.furniture must be an array of tables ([[dock.furniture]])");
+           for (const toml::node& e : *a) {
+             const toml::table* t = e.as_table();
+             if (t == nullptr) p.fail(e.source(), "dock.furniture entries must be tables");
+             const toml::node* kind_node = t->get("kind");
+             if (kind_node == nullptr) p.fail(t->source(), "dock.furniture entry without 'kind' (box, bin, chair)");
+             DockFurniture f;
+             const toml::value<std::string>* kind_str = kind_node->as_string();
+             if (kind_str == nullptr) {
+               p.fail(kind_node->source(), std::string("dock.furniture.kind must be a string, not ") + type_name(*kind_node));
+             }
+             const std::string kind = kind_str->get();
+             if (kind != "box" && kind != "bin" && kind != "chair") {
+               p.fail(kind_node->source(), "dock.furniture.kind = \"" + kind + "\" is not one of box, bin, chair");
+             }
+             Handlers h{{"kind", [](const toml::node&) {}},
+                        {"side", [&](const toml::node& v) { f.side = p.choice(v, {"left", "right"}) == "left" ? 1 : -1; }},
+                        {"gap_m", p.num(&f.gap_m, 0, 3)},
+                        {"x_m", [&](const toml::node& v) {
+                           f.x_m = p.number(v, -3, 3);
+                           f.x_set = true;
+                         }}};
+             if (kind == "box") {
+               f.kind = FurnitureKind::kBox;
+               h.emplace_back("depth_m", p.num(&f.depth_m, 0.05, 2));
+               h.emplace_back("width_m", p.num(&f.width_m, 0.05, 2));
+             } else if (kind == "bin") {
+               f.kind = FurnitureKind::kBin;
+               h.emplace_back("radius_m", p.num(&f.radius_m, 0.05, 1));
+             } else {
+               f.kind = FurnitureKind::kChair;
+               h.emplace_back("seat_m", p.num(&f.seat_m, 0.2, 1));
+               h.emplace_back("leg_radius_m", p.num(&f.leg_radius_m, 0.005, 0.05));
+             }
+             p.each(*t, "dock.furniture." + kind + ".", h);
+             sc.furniture.push_back(f);
+           }
+         }},
         {"contacts", p.sub("dock.contacts.", [&]() {
            return Handlers{{"lateral_tolerance_m", p.num(&k.lateral_tolerance_m, 0, 0.5)},
                            {"yaw_tolerance_deg", p.deg(&k.yaw_tolerance_rad, 0, 45)},
@@ -388,9 +496,12 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
 
   auto estimator_handlers = [&]() {
     dockcore::EstimatorParams& e = sc.estimator;
-    return Handlers{{"max_range_m", p.real(&e.max_range_m, 0.1, 100)},
-                    {"min_range_m", p.real(&e.min_range_m, 0, 10)},
-                    {"range_sigma_m", p.real(&e.range_sigma_m, 0.0001, 1)}};
+    Handlers h{{"max_range_m", p.real(&e.max_range_m, 0.1, 100)},
+               {"min_range_m", p.real(&e.min_range_m, 0, 10)},
+               {"range_sigma_m", p.real(&e.range_sigma_m, 0.0001, 1)}};
+    // The tuning keys dockd's [estimator] takes, with the same bounds.
+    dockcore::drivers::estimator_toml::add_keys(p, h, e, "estimator.");
+    return h;
   };
 
   auto host_handlers = [&]() {
@@ -545,6 +656,16 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
       p.fail(st.profile_node != nullptr ? st.profile_node->source() : root.source(), std::string("dock.profile: ") + e.what());
     }
   }
+  // What the detector is told is independent of the world: [dock.mounting] replaces the profile file's.
+  if (st.mounting_set) sc.profile.mounting = st.mounting;
+  if (!sc.wall) {
+    for (const char* key : {"dock.wall_gap_m", "dock.wall_glass"}) {
+      const toml::source_region none{};
+      const toml::source_region at = p.where(key, none);
+      if (at.begin.line != 0) p.fail(at, std::string(key) + " is only meaningful with dock.wall = true");
+    }
+  }
+  place_furniture(sc);
 
   // Obstacle-check footprint from the chassis outline (centred on the footprint's extent about the rotation centre).
   dockcore::FootprintParams& f = sc.safety;

@@ -207,16 +207,22 @@ std::vector<Vec2> footprint_outline(const ChassisParams& c) {
   return pts;
 }
 
+bool dock_wall(const Scenario& sc, Vec2* a, Vec2* b) {
+  if (!sc.wall) return false;
+  double min_x = 0;
+  for (std::size_t i = 0; i < sc.profile.vertex_count; ++i) min_x = std::min(min_x, dd(sc.profile.vertices_m[i].x()));
+  const double x = min_x - sc.wall_gap_m;
+  *a = sc.dock_pose.transform(v2(x, -sc.wall_half_length_m));
+  *b = sc.dock_pose.transform(v2(x, sc.wall_half_length_m));
+  return true;
+}
+
 World scenario_world(const Scenario& sc, bool with_dock) {
   World w;
   if (with_dock) w.add_dock(sc.profile, sc.dock_pose);
-  if (sc.wall) {
-    double min_x = 0;
-    for (std::size_t i = 0; i < sc.profile.vertex_count; ++i) min_x = std::min(min_x, dd(sc.profile.vertices_m[i].x()));
-    w.add_polyline({sc.dock_pose.transform(v2(min_x, -sc.wall_half_length_m)),
-                    sc.dock_pose.transform(v2(min_x, sc.wall_half_length_m))},
-                   false, 0.5);
-  }
+  Vec2 wall_a, wall_b;
+  // Glass stands there but the lidar sees through it: it is not part of the lidar's world.
+  if (dock_wall(sc, &wall_a, &wall_b) && !sc.wall_glass) w.add_polyline({wall_a, wall_b}, false, 0.5);
   for (const auto& pl : sc.polylines) w.add_polyline(pl.points, pl.closed);
   for (const auto& b : sc.boxes) w.add_box(b.centre, b.size_x_m, b.size_y_m, b.yaw_rad);
   for (const auto& c : sc.circles) w.add_circle(c.centre, c.r_m);

@@ -5,14 +5,22 @@
 // vertices from the dock's -y side to its +y side so the outward normal of a->b is (dy, -dx)):
 //
 //   name = "my-dock"                  # optional, at most 23 characters; default: the file name without .toml
-//   contact_offset_m = 0.0            # optional: the contacts' centre lies at (contact_offset_m, 0) in the frame the
-//                                     # points are written in; every point is shifted by -contact_offset_m in x
+//   contact_offset_m = 0.0            # optional, [-1, 1]: the contacts' centre lies at (contact_offset_m, 0) in the
+//                                     # frame the points are written in; every point is shifted by -contact_offset_m
 //   points = [[-0.07, -0.22], [0.0, -0.15], [0.0, 0.15], [-0.07, 0.22]]
 //
-// Integers are accepted where numbers are expected. Anything else — an unknown key, a value of the wrong type, a
-// point that is not two finite numbers, fewer than 2 or more than 32 points, two consecutive points closer than 1 mm
-// — is an error whose message starts with "<source>:<line>:<column>: " (1-based, from the TOML source region of the
-// offending key or value).
+//   [mounting]                        # optional: how the dock is installed (dockcore::DockMounting)
+//   kind = "wall"                     # "wall" | "free_standing" | "unknown" (default "unknown")
+//   wall_gap_m = [0.0, 0.10]          # only with kind = "wall": the wall's face lies min..max metres behind the
+//                                     # dock's back plane; each in [0, 0.5], min <= max; default [0, 0.10]
+//
+// Integers are accepted where numbers are expected. Anything else — an unknown key, a value of the wrong type or out
+// of range, a point that is not two finite numbers, fewer than 2 or more than 32 points, two consecutive points
+// closer than 1 mm, and an outline that dockcore::check_profile refuses for an LD06-class lidar (0.8°) at 2.5 m
+// (crossing itself, too small, or unable to fix x, y or yaw, e.g. a flat plate) — is an error whose message starts
+// with "<source>:<line>:<column>: " (1-based, from the TOML source region of the offending key or value; a crossing
+// points at the later segment's first point, the other outline verdicts at the points array).
+// The parser is dockcore/drivers/profile_toml.hpp, which dockd's config uses for the same files.
 // Host-side: errors are exceptions (ProfileFileError).
 #include <stdexcept>
 #include <string>
@@ -53,8 +61,8 @@ dockcore::DockProfile resolve_profile(const std::string& name_or_path);
 /// decide whether a detector made for one particular dock (the breakpoint detector) applies.
 bool same_outline_as_builtin(const dockcore::DockProfile& profile, const char* builtin_name);
 
-/// The profile as TOML in the format above (points with 6 decimals, contact_offset_m omitted). Round-trips through
-/// parse_profile_toml.
+/// The profile as TOML in the format above (points with 6 decimals, contact_offset_m omitted, [mounting] unless the
+/// kind is unknown). Round-trips through parse_profile_toml.
 std::string profile_to_toml(const dockcore::DockProfile& profile);
 
 }  // namespace docksim

@@ -100,6 +100,36 @@ struct WorldCircle {
   double r_m = 0.1;
 };
 
+/// Furniture beside the dock ([[dock.furniture]]), placed in the dock frame. At load it is added to the world's boxes
+/// and circles (so the lidar sees it and it counts for obstacle clearance).
+enum class FurnitureKind : std::uint8_t {
+  kBox,    ///< "box": a box depth_m (dock x) by width_m (dock y), sides parallel to the dock's axes.
+  kBin,    ///< "bin": a round bin (a cylinder) of radius_m.
+  kChair,  ///< "chair": four round legs of leg_radius_m at the corners of a seat_m square.
+};
+
+/// Stable TOML name of a furniture kind ("box", "bin", "chair"). Never null.
+const char* to_string(FurnitureKind k);
+
+struct DockFurniture {
+  FurnitureKind kind = FurnitureKind::kBox;
+  int side = 1;             ///< +1: on the dock's left (+y), -1: on its right (-y).
+  double gap_m = 0.3;       ///< Free space along the dock's y from the dock's outermost vertex on that side to the
+                            ///< object's nearest point, m.
+  double depth_m = 0.4;     ///< box: extent along the dock's x, m.
+  double width_m = 0.4;     ///< box: extent along the dock's y, m.
+  double radius_m = 0.15;   ///< bin, m.
+  double seat_m = 0.45;     ///< chair: seat side, m (leg centres lie leg_radius_m inside its corners).
+  double leg_radius_m = 0.015;  ///< chair, m.
+  /// Centre along the dock's x, m. Default (x_set false): the object's back stands kFurnitureWallClearanceM in front
+  /// of the wall's face, or on the dock's back plane when there is no wall.
+  bool x_set = false;
+  double x_m = 0;
+};
+
+/// Default clearance between furniture and the wall behind it, m (furniture does not stand exactly on the wall line).
+constexpr double kFurnitureWallClearanceM = 0.01;
+
 /// Host behaviour around the task manager.
 struct HostSpec {
   double chassis_stale_s = 0.1;  ///< No chassis feedback for this long: chassis_ok = false.
@@ -126,13 +156,17 @@ struct Scenario {
   LidarModel lidar{};
   double scan_latency_s = 0.03;  ///< Scan time (stamp) to delivery to dockcore.
 
-  // Dock and world.
+  // Dock and world. profile.mounting is what the detector is told ([dock.mounting], else the profile file's).
   dockcore::DockProfile profile{};
   std::string profile_name = "plate-v";
   Pose2 dock_pose{};                ///< Dock frame in the world.
   double dock_face_half_width_m = 0.15;
-  bool wall = true;                 ///< A wall behind the dock, flush with the profile's minimum x.
+  /// The world behind the dock (what the lidar sees, whatever the detector is told: that is profile.mounting):
+  bool wall = true;                 ///< A wall behind the dock, parallel to its face; false: free-standing.
+  double wall_gap_m = 0;            ///< The wall's face lies this far behind the profile's minimum x, m, [0, 0.5].
+  bool wall_glass = false;          ///< Glass: lidar beams pass through it (absent from the lidar's world).
   double wall_half_length_m = 2.0;
+  std::vector<DockFurniture> furniture;  ///< Beside the dock; also expanded into boxes / circles below.
   std::vector<WorldPolyline> polylines;
   std::vector<WorldBox> boxes;
   std::vector<WorldCircle> circles;

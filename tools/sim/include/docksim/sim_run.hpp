@@ -115,7 +115,12 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
 /// The robot's outline in the body frame (rectangle corners or a 24-gon). O(1).
 std::vector<dockcore::Vec2> footprint_outline(const ChassisParams& chassis);
 
-/// The static world the lidar sees: dock, wall, polylines, boxes, circles (no event obstacles). O(objects).
+/// The wall behind the dock (Scenario::wall, wall_gap_m, wall_half_length_m) as a world segment a-b, glass or not;
+/// false when the dock is free-standing. O(vertices).
+bool dock_wall(const Scenario& sc, dockcore::Vec2* a, dockcore::Vec2* b);
+
+/// The static world the lidar sees: dock, wall (unless glass), polylines, boxes and circles (furniture included; no
+/// event obstacles). O(objects).
 World scenario_world(const Scenario& sc, bool with_dock = true);
 
 }  // namespace docksim
