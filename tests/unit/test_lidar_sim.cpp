@@ -170,7 +170,7 @@ TEST(LidarSim, ModelsHaveTheirDatasheetGeometry) {
   REAL_EQUAL(30.0, m.max_range_m, 0);
   CHECK_FALSE(lidar_model("nope", &m));
   for (const std::string& n : lidar_model_names()) CHECK_TRUE(lidar_model(n, nullptr));
-  LONGS_EQUAL(3, lidar_model_names().size());
+  LONGS_EQUAL(4, lidar_model_names().size());
 }
 
 TEST(LidarSim, IdealScanMatchesGeometryAndCarriesMetadata) {

@@ -24,6 +24,8 @@
 #include "docksim/profile_file.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenes.hpp"
+#include "perception_generated.hpp"
+#include "perception_stats.hpp"
 
 namespace docksim_cli {
 namespace {
@@ -54,31 +56,6 @@ struct Options {
   std::string cost_detector = "all";
 };
 
-/// Errors of one detection against the truth, in the dock frame (longitudinal = along the dock's x axis).
-struct Errors {
-  double pos_m = 0, lon_m = 0, lat_m = 0, yaw_rad = 0;
-};
-
-Errors errors_of(const Pose2& truth, const Pose2& est) {
-  const dockcore::Vec2 d(est.x_m - truth.x_m, est.y_m - truth.y_m);
-  const dockcore::Vec2 ex(std::cos(truth.yaw_rad), std::sin(truth.yaw_rad));
-  Errors e;
-  e.pos_m = d.norm();
-  e.lon_m = std::fabs(d.dot(ex));
-  e.lat_m = std::fabs(ex.x() * d.y() - ex.y() * d.x());
-  e.yaw_rad = std::fabs(dockcore::wrap_angle(est.yaw_rad - truth.yaw_rad));
-  return e;
-}
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const double idx = p * static_cast<double>(v.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(idx));
-  const std::size_t hi = std::min(v.size() - 1, lo + 1);
-  return v[lo] + (v[hi] - v[lo]) * (idx - static_cast<double>(lo));
-}
-
 /// Accumulates one cell of a results table.
 struct Cell {
   int n = 0;
@@ -105,11 +82,15 @@ struct Cell {
     json j;
     j["n"] = n;
     j["detection_rate"] = n ? static_cast<double>(found) / n : 0.0;
-    j["pos_mm"] = {{"p50", mm(percentile(pos, 0.5))}, {"p95", mm(percentile(pos, 0.95))}, {"max", mm(percentile(pos, 1.0))}};
-    j["lateral_mm"] = {{"p50", mm(percentile(lat, 0.5))}, {"p95", mm(percentile(lat, 0.95))}, {"max", mm(percentile(lat, 1.0))}};
-    j["longitudinal_mm"] = {{"p50", mm(percentile(lon, 0.5))}, {"p95", mm(percentile(lon, 0.95))}, {"max", mm(percentile(lon, 1.0))}};
+    j["pos_mm"] = {
+        {"p50", mm(percentile(pos, 0.5))}, {"p95", mm(percentile(pos, 0.95))}, {"max", mm(percentile(pos, 1.0))}};
+    j["lateral_mm"] = {
+        {"p50", mm(percentile(lat, 0.5))}, {"p95", mm(percentile(lat, 0.95))}, {"max", mm(percentile(lat, 1.0))}};
+    j["longitudinal_mm"] = {
+        {"p50", mm(percentile(lon, 0.5))}, {"p95", mm(percentile(lon, 0.95))}, {"max", mm(percentile(lon, 1.0))}};
     if (has_yaw) {
-      j["yaw_deg"] = {{"p50", dg(percentile(yaw, 0.5))}, {"p95", dg(percentile(yaw, 0.95))}, {"max", dg(percentile(yaw, 1.0))}};
+      j["yaw_deg"] = {
+          {"p50", dg(percentile(yaw, 0.5))}, {"p95", dg(percentile(yaw, 0.95))}, {"max", dg(percentile(yaw, 1.0))}};
     } else {
       j["yaw_deg"] = nullptr;
     }
@@ -151,8 +132,8 @@ struct Scene {
   dockcore::LaserScan scan;
 };
 
-void simulate(const dockcore::DockProfile& prof, const docksim::LidarModel& m, double d, double b, double y, int clutter,
-              docksim::Rng& rng, Scene* out) {
+void simulate(const dockcore::DockProfile& prof, const docksim::LidarModel& m, double d, double b, double y,
+              int clutter, docksim::Rng& rng, Scene* out) {
   docksim::SceneSpec spec;
   spec.profile = prof;
   spec.dock_pose_in_world = docksim::dock_pose_from_lidar(d, b, y);
@@ -195,8 +176,8 @@ json run_accuracy(const Options& o) {
           const double b = rng.uniform(-60, 60) * kDeg;
           const double y = rng.uniform(-45, 45) * kDeg;
           simulate(prof, m, d, b, y, o.clutter, rng, scene.get());
-          const docksim::Crlb bound = docksim::dock_pose_crlb(prof, scene->truth, m.angle_min_rad, m.angle_increment_rad,
-                                                              m.beams, sigma, 0);
+          const docksim::Crlb bound =
+              docksim::dock_pose_crlb(prof, scene->truth, m.angle_min_rad, m.angle_increment_rad, m.beams, sigma, 0);
           for (const DetectorResult& r : set.run(scene->scan.view(), Pose2{})) {
             if (!r.applicable) continue;
             auto& bands = cells[detector_name(r.detector)];
@@ -359,13 +340,14 @@ json run_false_positives(const Options& o) {
         pr.tick();
       }
       for (auto& [det, n] : fp) {
-        pj[label][det] = {{"scenes", o.fp_scenes}, {"false_positives", n},
-                          {"rate", static_cast<double>(n) / o.fp_scenes}};
+        pj[label][det] = {
+            {"scenes", o.fp_scenes}, {"false_positives", n}, {"rate", static_cast<double>(n) / o.fp_scenes}};
       }
-      pj[label]["estimator_confirmed_3_scans"] = {{"scenes", o.fp_scenes}, {"false_positives", fp_confirmed},
+      pj[label]["estimator_confirmed_3_scans"] = {{"scenes", o.fp_scenes},
+                                                  {"false_positives", fp_confirmed},
                                                   {"rate", static_cast<double>(fp_confirmed) / o.fp_scenes}};
-      pj[label]["estimator_hinted_0.5m"] = {{"scenes", o.fp_scenes}, {"false_positives", fp_hint},
-                                            {"rate", static_cast<double>(fp_hint) / o.fp_scenes}};
+      pj[label]["estimator_hinted_0.5m"] = {
+          {"scenes", o.fp_scenes}, {"false_positives", fp_hint}, {"rate", static_cast<double>(fp_hint) / o.fp_scenes}};
     }
     out[pname] = pj;
   }
@@ -402,8 +384,8 @@ json run_cost(const Options& o) {
       const auto t1 = std::chrono::steady_clock::now();
       ns.push_back(static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count()));
     }
-    out[name] = {{"points", o.points}, {"scans", o.scans}, {"ns_per_scan_median", percentile(ns, 0.5)},
-                 {"found", found}};
+    out[name] = {
+        {"points", o.points}, {"scans", o.scans}, {"ns_per_scan_median", percentile(ns, 0.5)}, {"found", found}};
   };
   const dockcore::EstimatorParams params = params_for(0.010);
   if (want("estimator")) {
@@ -472,11 +454,12 @@ void print_text(const json& j) {
     for (const auto& [pname, pj] : j["targets"].items()) {
       for (const auto& [section, sj] : pj.items()) {
         for (const auto& [det, c] : sj.items()) {
-          std::printf("%-10s %-24s %-10s n=%-5d detected %6.2f%%  pos p95 %s mm  yaw p95 %s°  (CRLB lat %s mm, yaw %s°)\n",
-                      pname.c_str(), section.c_str(), det.c_str(), c["n"].get<int>(),
-                      100 * c["detection_rate"].get<double>(), num(c["pos_mm"]["p95"], "%.1f").c_str(),
-                      c["yaw_deg"].is_null() ? "-" : num(c["yaw_deg"]["p95"], "%.2f").c_str(),
-                      num(c["crlb_lateral_mm_median"], "%.1f").c_str(), num(c["crlb_yaw_deg_median"], "%.2f").c_str());
+          std::printf(
+              "%-10s %-24s %-10s n=%-5d detected %6.2f%%  pos p95 %s mm  yaw p95 %s°  (CRLB lat %s mm, yaw %s°)\n",
+              pname.c_str(), section.c_str(), det.c_str(), c["n"].get<int>(), 100 * c["detection_rate"].get<double>(),
+              num(c["pos_mm"]["p95"], "%.1f").c_str(),
+              c["yaw_deg"].is_null() ? "-" : num(c["yaw_deg"]["p95"], "%.2f").c_str(),
+              num(c["crlb_lateral_mm_median"], "%.1f").c_str(), num(c["crlb_yaw_deg_median"], "%.2f").c_str());
         }
       }
     }
@@ -528,8 +511,21 @@ void register_perception(CLI::App& app) {
   sub->add_option("--profiles", *profiles, "Comma-separated profiles (built-in names or .toml files)");
   sub->add_option("--lidars", *lidars, "Comma-separated lidar models");
   sub->add_option("--sigmas-mm", *sigmas, "Comma-separated range noise levels, millimetres");
-  sub->add_option("--sections", *sections, "Comma-separated: accuracy, targets, fp");
-  sub->add_option("--trials", o->trials, "Scenes per (profile, lidar, sigma) in the accuracy grid")->check(CLI::PositiveNumber);
+  sub->add_option("--sections", *sections, "Comma-separated: accuracy, targets, fp, generated");
+  auto gen = std::make_shared<GeneratedOptions>();
+  sub->add_option("--gen-scenes", gen->scenes, "generated: docking scenes (one scan each)")->check(CLI::PositiveNumber);
+  sub->add_option("--gen-fp-scenes", gen->fp_scenes,
+                  "generated: dock-less scenes, 3 scans each (default: as many as --gen-scenes)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--gen-filter-runs", gen->filter_runs,
+                  "generated: 1 s filtered approaches (default: a fifth of --gen-scenes)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--gen-profiles", gen->profiles, "generated: random profiles in the pool")
+      ->check(CLI::Range(1, 10000));
+  sub->add_option("--jobs", gen->jobs, "generated: worker threads (the figures do not depend on it)")
+      ->check(CLI::Range(1, 64));
+  sub->add_option("--trials", o->trials, "Scenes per (profile, lidar, sigma) in the accuracy grid")
+      ->check(CLI::PositiveNumber);
   sub->add_option("--target-trials", o->target_trials, "Scenes in the target zone")->check(CLI::PositiveNumber);
   sub->add_option("--fp-scenes", o->fp_scenes, "Dock-less scenes per clutter kind")->check(CLI::PositiveNumber);
   sub->add_option("--filter-runs", o->filter_runs, "1 s filtered runs")->check(CLI::PositiveNumber);
@@ -542,7 +538,7 @@ void register_perception(CLI::App& app) {
   sub->add_option("--detector", o->cost_detector,
                   "Cost: all | estimator | estimator-tracking | breakpoint | vmarker (one detector for callgrind)")
       ->check(CLI::IsMember({"all", "estimator", "estimator-tracking", "breakpoint", "vmarker"}));
-  sub->callback([o, profiles, lidars, sigmas, sections]() {
+  sub->callback([o, gen, profiles, lidars, sigmas, sections]() {
     o->profiles = split_csv(*profiles);
     o->lidars = split_csv(*lidars);
     o->sigmas.clear();
@@ -559,15 +555,25 @@ void register_perception(CLI::App& app) {
       j["cost"] = run_cost(*o);
     } else {
       const std::vector<std::string> secs = split_csv(*sections);
+      for (const std::string& s : secs) {
+        if (s != "accuracy" && s != "targets" && s != "fp" && s != "generated") {
+          throw CLI::ValidationError("--sections", "unknown section " + s + " (accuracy, targets, fp, generated)");
+        }
+      }
       auto has = [&secs](const char* s) { return std::find(secs.begin(), secs.end(), s) != secs.end(); };
       if (has("accuracy")) j["accuracy"] = run_accuracy(*o);
       if (has("targets")) j["targets"] = run_targets(*o);
       if (has("fp")) j["false_positives"] = run_false_positives(*o);
+      if (has("generated")) {
+        gen->seed = o->seed;
+        j["generated"] = run_generated(*gen);
+      }
     }
     if (o->json_out) {
       std::printf("%s\n", j.dump().c_str());
     } else {
       print_text(j);
+      if (j.contains("generated")) print_generated(j["generated"]);
     }
   });
 }

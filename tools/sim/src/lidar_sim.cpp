@@ -293,6 +293,19 @@ bool lidar_model(const std::string& name, LidarModel* out) {
     m.dropout_prob = 0.02;
     m.angular_jitter_rad = 0.1 * kDegD;
     m.beam_divergence_rad = 0.5 * kDegD;
+  } else if (name == "rplidar-a2") {
+    // Slamtec RPLIDAR A2M8 at 8000 samples/s and 10 Hz: 800 points (0.45 deg), 0.15-12 m, accuracy ~1 % of range.
+    m.rate_hz = 10.0;
+    m.beams = 800;
+    m.angle_increment_rad = kTwoPiD / 800.0;
+    m.angle_min_rad = -kPiD;
+    m.min_range_m = 0.15;
+    m.max_range_m = 12.0;
+    m.sigma_const_m = 0.003;
+    m.sigma_prop = 0.01;
+    m.dropout_prob = 0.01;
+    m.angular_jitter_rad = 0.05 * kDegD;
+    m.beam_divergence_rad = 0.4 * kDegD;
   } else if (name == "industrial") {
     // SICK TiM/LMS-class safety-rated scanner: 0.25 deg over 270 deg (1081 beams), 25 Hz, 0.05-30 m, 5 mm.
     m.rate_hz = 25.0;
@@ -313,7 +326,7 @@ bool lidar_model(const std::string& name, LidarModel* out) {
   return true;
 }
 
-std::vector<std::string> lidar_model_names() { return {"ld06", "rplidar-a1", "industrial"}; }
+std::vector<std::string> lidar_model_names() { return {"ld06", "rplidar-a1", "rplidar-a2", "industrial"}; }
 
 void simulate_scan(const World& world, const Pose2& lidar_pose, const LidarModel& model, Rng& rng,
                    dockcore::LaserScan* out, std::uint64_t stamp_us) {

@@ -17,7 +17,9 @@ double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
   return (X(a) - X(o)) * (Y(b) - Y(o)) - (Y(a) - Y(o)) * (X(b) - X(o));
 }
 
-// Convex hull, counter-clockwise (Andrew's monotone chain).
+}  // namespace
+
+// Andrew's monotone chain.
 std::vector<Vec2> convex_hull(std::vector<Vec2> p) {
   std::sort(p.begin(), p.end(), [](const Vec2& a, const Vec2& b) { return X(a) < X(b) || (X(a) == X(b) && Y(a) < Y(b)); });
   if (p.size() < 3) return p;
@@ -35,6 +37,7 @@ std::vector<Vec2> convex_hull(std::vector<Vec2> p) {
   return h;
 }
 
+namespace {
 double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {
   const double ex = X(b) - X(a), ey = Y(b) - Y(a);
   const double l2 = ex * ex + ey * ey;
@@ -42,8 +45,8 @@ double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {
   u = std::min(1.0, std::max(0.0, u));
   return std::hypot(X(a) + u * ex - X(p), Y(a) + u * ey - Y(p));
 }
+}  // namespace
 
-// Distance from p to a convex CCW polygon; 0 inside.
 double distance_to_convex(const Vec2& p, const std::vector<Vec2>& poly) {
   if (poly.empty()) return 1e300;
   if (poly.size() == 1) return std::hypot(X(p) - X(poly[0]), Y(p) - Y(poly[0]));
@@ -57,6 +60,8 @@ double distance_to_convex(const Vec2& p, const std::vector<Vec2>& poly) {
   }
   return inside ? 0.0 : d;
 }
+
+namespace {
 
 // A candidate object: kind, pose and shape parameters; its bounding circle is about `pose`'s origin.
 struct Candidate {

@@ -76,8 +76,8 @@ struct LidarModel {
   double intensity_ref_range_m = 4.0;     ///< Range at which the intensity falls to half its near value.
 };
 
-/// Built-in models: "ld06" (LD06/LD19: 4500 pts/s, 10 Hz, 0.8°), "rplidar-a1" (~1°, 5.5 Hz, 360 pts), "industrial"
-/// (0.25°, 25 Hz, 270° field of view). Returns false for an unknown name.
+/// Built-in models: "ld06" (LD06/LD19: 4500 pts/s, 10 Hz, 0.8°), "rplidar-a1" (~1°, 5.5 Hz, 360 pts), "rplidar-a2"
+/// (A2M8: 0.45°, 10 Hz, 800 pts), "industrial" (0.25°, 25 Hz, 270° field of view). Returns false for an unknown name.
 bool lidar_model(const std::string& name, LidarModel* out);
 /// Names of the built-in models.
 std::vector<std::string> lidar_model_names();

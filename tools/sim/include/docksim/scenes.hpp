@@ -113,4 +113,11 @@ Pose2 dock_pose_in_world_from_lidar(const Pose2& lidar_pose_in_world, double dis
 std::vector<Vec2> dock_outline_points(const dockcore::DockProfile& profile, const Pose2& dock_pose_in_world,
                                       int per_segment = 5);
 
+/// Convex hull of `points`, counter-clockwise, without collinear points. O(n log n).
+std::vector<Vec2> convex_hull(std::vector<Vec2> points);
+
+/// Distance from p to the convex counter-clockwise polygon `poly` (as convex_hull returns); 0 inside, 1e300 for an
+/// empty polygon. O(vertices).
+double distance_to_convex(const Vec2& p, const std::vector<Vec2>& poly);
+
 }  // namespace docksim
