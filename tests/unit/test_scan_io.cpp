@@ -198,3 +198,76 @@ TEST(ScanIo, FileRoundTrip) {
   CHECK_FALSE(read_scan_file("/nonexistent/dir/x.jsonl", &out, &err));
   CHECK_TRUE(contains(err, "cannot open"));
 }
+
+// A recording with bad lines among good ones: each bad line is reported with its number and skipped, counted; the
+// good lines read exactly as they would alone.
+TEST(ScanIo, BadLinesAreReportedSkippedAndCounted) {
+  const std::string good = format_scan_line(sample_scan(10, true));
+  const std::string head = R"({"stamp_us":7,"angle_min_rad":0,"angle_increment_rad":0.01,)";
+  std::stringstream ss;
+  ss << good << "\n"  // line 1
+     << head << R"("ranges_m":[1,2,3],"intensities":[5,6]})"
+     << "\n"  // 2: wrong intensity count
+     << R"({"stamp_us":7,"angle_min_rad":NaN,"angle_increment_rad":0.01,"ranges_m":[1,2]})"
+     << "\n"  // 3
+     << R"({"stamp_us":7,"angle_min_rad":0,"angle_increment_rad":1e999,"ranges_m":[1,2]})"
+     << "\n"  // 4
+     << R"({"stamp_us":7,"angle_min_rad":0,"angle_increment_rad":0,"ranges_m":[1,2]})"
+     << "\n"           // 5: zero step
+     << "\n"           // 6: blank, not counted
+     << good << "\n";  // 7
+  std::vector<RecordedScan> scans;
+  ScanReadSummary summary;
+  CHECK_TRUE(read_scans_skipping_bad(ss, &scans, &summary));
+  LONGS_EQUAL(2, scans.size());
+  LONGS_EQUAL(2, summary.scans);
+  LONGS_EQUAL(4, summary.skipped);
+  LONGS_EQUAL(7, summary.lines);
+  LONGS_EQUAL(4, summary.errors.size());
+  STRCMP_EQUAL("line 2: \"intensities\" has 2 values for 3 ranges", summary.errors[0].c_str());
+  STRCMP_EQUAL("line 3: non-finite number NaN in \"angle_min_rad\"", summary.errors[1].c_str());
+  STRCMP_EQUAL("line 4: non-finite number 1e999 in \"angle_increment_rad\"", summary.errors[2].c_str());
+  STRCMP_EQUAL("line 5: \"angle_increment_rad\" is 0", summary.errors[3].c_str());
+  // The good lines are untouched by their bad neighbours.
+  RecordedScan alone;
+  std::string err;
+  CHECK_TRUE(parse_scan_line(good, &alone, &err));
+  for (const RecordedScan& s : scans) STRCMP_EQUAL(format_scan_line(alone).c_str(), format_scan_line(s).c_str());
+}
+
+TEST(ScanIo, SkippingReaderKeepsTheFirstErrorsAndCountsTheRest) {
+  std::stringstream ss;
+  for (std::size_t i = 0; i < kMaxReportedScanErrors + 5; ++i) ss << "{\"stamp_us\":1}\n";
+  ss << format_scan_line(sample_scan(3, false)) << "\n";
+  std::vector<RecordedScan> scans;
+  ScanReadSummary summary;
+  CHECK_TRUE(read_scans_skipping_bad(ss, &scans, &summary));
+  LONGS_EQUAL(kMaxReportedScanErrors + 5, summary.skipped);
+  LONGS_EQUAL(kMaxReportedScanErrors, summary.errors.size());
+  LONGS_EQUAL(1, scans.size());
+  STRCMP_EQUAL("line 1: missing \"angle_min_rad\"", summary.errors.front().c_str());
+}
+
+TEST(ScanIo, SkippingReaderStopsAfterMaxScans) {
+  const std::string good = format_scan_line(sample_scan(3, false));
+  std::stringstream ss;
+  ss << good << "\n{}\n" << good << "\n" << good << "\n";
+  std::vector<RecordedScan> scans;
+  ScanReadSummary summary;
+  CHECK_TRUE(read_scans_skipping_bad(ss, &scans, &summary, 2));
+  LONGS_EQUAL(2, scans.size());
+  LONGS_EQUAL(1, summary.skipped);
+  LONGS_EQUAL(3, summary.lines);
+  std::string err;
+  CHECK_FALSE(read_scan_file_skipping_bad("/nonexistent/dir/x.jsonl", &scans, &summary, &err));
+  CHECK_TRUE(contains(err, "cannot open"));
+}
+
+TEST(ScanIo, NonFiniteValuesAreNamed) {
+  const std::string head = R"({"stamp_us":1,"angle_min_rad":0,"angle_increment_rad":0.01,)";
+  CHECK_TRUE(contains(error_of(head + R"("ranges_m":[1,Infinity]})"), "non-finite number Infinity in \"ranges_m\""));
+  CHECK_TRUE(contains(error_of(head + R"("ranges_m":[1,-1e400]})"), "non-finite number -1e400"));
+  // A string that merely spells NaN is not a number; a plain syntax error stays "not valid JSON".
+  CHECK_TRUE(error_of(head + R"("note":"NaN 1e999","ranges_m":[1]})").empty());
+  CHECK_TRUE(contains(error_of(head + R"("ranges_m":[1,,2]})"), "not valid JSON"));
+}

@@ -22,6 +22,8 @@
 #include "docksim/crlb.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/profile_file.hpp"
+#include "docksim/real_perception.hpp"
+#include "docksim/realdata.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenes.hpp"
 #include "perception_generated.hpp"
@@ -54,6 +56,11 @@ struct Options {
   int points = 720;
   int scans = 200;
   std::string cost_detector = "all";
+  // Real data (sections real, composite).
+  std::string realdata_dir;                  // --realdata; empty: $DOCKCORE_REALDATA, else <repo>/../shared/realdata
+  std::size_t real_limit = 0;                // scans per recording, 0 = all
+  std::vector<std::string> real_recordings;  // empty = all
+  std::size_t composite_per_cell = 100;      // composites per (recording, profile, kind)
 };
 
 /// Accumulates one cell of a results table.
@@ -420,6 +427,365 @@ json run_cost(const Options& o) {
   return out;
 }
 
+// ---------------------------------------------------------------- real data
+
+constexpr double kTargetSingleFpPct = 1.0;
+constexpr double kTargetConfirmedFpPct = 0.05;
+constexpr double kTargetCompositePct = 98.0;
+
+double pct(std::size_t num, std::size_t den) {
+  return den ? 100.0 * static_cast<double>(num) / static_cast<double>(den) : 0.0;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The recordings the real sections run on, loaded once for both.
+struct RealData {
+  docksim::RealDataLocation where;
+  std::vector<docksim::LoadedRecording> recordings;
+  double load_s = 0;
+  json load_json;  // one entry per recording: scans, skipped lines, pose match
+};
+
+std::unique_ptr<RealData> load_real_data(const Options& o) {
+  auto d = std::make_unique<RealData>();
+  d->where = docksim::locate_realdata(o.realdata_dir);
+  // The tables say where it looked; with --json the document does, and stderr tells the person running it.
+  if (o.json_out) std::fprintf(stderr, "%s\n", d->where.describe().c_str());
+  if (!d->where.found()) return d;
+  std::vector<const docksim::RealRecording*> which;
+  if (o.real_recordings.empty()) {
+    for (const auto& r : docksim::real_recordings()) which.push_back(&r);
+  } else {
+    for (const auto& name : o.real_recordings) {
+      const docksim::RealRecording* r = docksim::find_real_recording(name);
+      if (r == nullptr) throw CLI::ValidationError("--real-recordings", "unknown recording " + name);
+      which.push_back(r);
+    }
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  d->load_json = json::array();
+  for (const docksim::RealRecording* r : which) {
+    docksim::LoadedRecording rec;
+    std::string error;
+    if (!docksim::load_real_recording(d->where.dir, *r, o.real_limit, &rec, &error)) {
+      std::fprintf(stderr, "real data: %s: %s (recording left out)\n", r->name, error.c_str());
+      continue;
+    }
+    for (const std::string& e : rec.read.errors)
+      std::fprintf(stderr, "%s/%s: %s (skipped)\n", d->where.dir.c_str(), r->file, e.c_str());
+    const docksim::PoseMatch& m = rec.match;
+    json lj;
+    lj["name"] = r->name;
+    lj["file"] = r->file;
+    lj["environment"] = r->environment;
+    lj["scans"] = rec.scans.size();
+    lj["skipped_lines"] = rec.read.skipped;
+    lj["sigma_mm"] = r->sigma_m * 1000;
+    lj["resolution_mm"] = r->resolution_m * 1000;
+    lj["pose_source"] = docksim::to_string(r->poses);
+    if (r->pose_log != nullptr) {
+      lj["pose_log"] = r->pose_log;
+      lj["pose_match"] = {{"log_messages", m.log_messages},  {"every", r->pose_every},     {"matched", m.matched},
+                          {"mismatched", m.mismatched},      {"log_errors", m.log_errors}, {"ok", m.ok()},
+                          {"first_problem", m.first_problem}};
+    }
+    lj["poses_used"] = rec.has_poses();
+    d->load_json.push_back(lj);
+    d->recordings.push_back(std::move(rec));
+  }
+  d->load_s = seconds_since(t0);
+  return d;
+}
+
+json location_json(const docksim::RealDataLocation& w) {
+  json j;
+  j["found"] = w.found();
+  j["dir"] = w.dir;
+  j["source"] = w.source;
+  j["looked"] = w.looked;
+  j["message"] = w.describe();
+  return j;
+}
+
+/// The estimator's refusals by reason (only the reasons that occurred).
+json rejections_json(const dockcore::EstimatorCounters& c) {
+  json rej = json::object();
+  for (std::size_t k = 1; k < static_cast<std::size_t>(dockcore::RejectReason::kCount); ++k) {
+    if (c.rejected_by[k] != 0) rej[dockcore::to_string(static_cast<dockcore::RejectReason>(k))] = c.rejected_by[k];
+  }
+  return rej;
+}
+
+json run_real_fp(const Options& o, const RealData& d) {
+  json out;
+  out["data"] = location_json(d.where);
+  if (!d.where.found()) return out;
+  const auto t0 = std::chrono::steady_clock::now();
+  const docksim::ConfirmRule rule;
+  out["targets"] = {{"single_scan_fp_max_pct", kTargetSingleFpPct}, {"confirmed_fp_max_pct", kTargetConfirmedFpPct}};
+  out["rule"] = {{"scans", rule.scans},
+                 {"agree_m", rule.agree_m},
+                 {"agree_deg", rule.agree_rad / kDeg},
+                 {"static_max_gap_s", rule.static_max_gap_s},
+                 {"text", "a window is " + std::to_string(rule.scans) +
+                              " consecutive scans; the first is searched without a hint, the others with the first "
+                              "detection (carried by the poses into their sensor frame) as the hint; the window is a "
+                              "confirmed detection when every scan finds a dock and each lies within 5 cm and 5 deg of "
+                              "the first in the world frame (standing sensor: in the sensor frame, stamps <= 1 s "
+                              "apart). Denominator: windows (scans - 2 per recording with poses)."}};
+  out["recordings"] = d.load_json;
+  json rows = json::array();
+  json totals = json::array();
+  for (const auto& pname : o.profiles) {
+    const dockcore::DockProfile prof = docksim::resolve_profile(pname);
+    std::size_t scans = 0, found = 0, windows = 0, confirmed = 0;
+    Progress pr{"real: false positives", static_cast<long>(d.recordings.size())};
+    for (const docksim::LoadedRecording& rec : d.recordings) {
+      const docksim::RealFpResult r = docksim::measure_real_false_positives(rec, prof, rule);
+      json row;
+      row["recording"] = rec.info->name;
+      row["profile"] = pname;
+      row["sigma_mm"] = rec.info->sigma_m * 1000;
+      row["scans"] = r.scans;
+      row["found"] = r.found;
+      row["fp_pct"] = pct(r.found, r.scans);
+      row["confirm_frame"] = docksim::to_string(r.frame);
+      if (r.frame != docksim::ConfirmFrame::kNone) {
+        row["windows"] = r.windows;
+        row["attempts"] = r.attempts;
+        row["confirmed"] = r.confirmed;
+        row["confirmed_pct"] = pct(r.confirmed, r.windows);
+      } else {
+        row["windows"] = nullptr;
+        row["attempts"] = nullptr;
+        row["confirmed"] = nullptr;
+        row["confirmed_pct"] = nullptr;
+      }
+      json ex = json::array();
+      for (const docksim::FalseDock& f : r.examples) {
+        ex.push_back({{"scan", f.scan},
+                      {"x_m", round6(f.pose.x_m)},
+                      {"y_m", round6(f.pose.y_m)},
+                      {"yaw_rad", round6(f.pose.yaw_rad)}});
+      }
+      row["examples"] = ex;
+      row["confirmed_starts"] = r.confirmed_starts;
+      row["candidates"] = r.counters.candidates;
+      row["rejected_by"] = rejections_json(r.counters);
+      rows.push_back(row);
+      scans += r.scans;
+      found += r.found;
+      windows += r.windows;
+      confirmed += r.confirmed;
+      pr.tick();
+    }
+    totals.push_back({{"profile", pname},
+                      {"scans", scans},
+                      {"found", found},
+                      {"fp_pct", pct(found, scans)},
+                      {"meets_single_target", pct(found, scans) <= kTargetSingleFpPct},
+                      {"windows", windows},
+                      {"confirmed", confirmed},
+                      {"confirmed_pct", pct(confirmed, windows)},
+                      {"meets_confirmed_target", windows > 0 && pct(confirmed, windows) <= kTargetConfirmedFpPct}});
+  }
+  out["rows"] = rows;
+  out["totals"] = totals;
+  out["load_seconds"] = d.load_s;
+  out["seconds"] = seconds_since(t0);
+  return out;
+}
+
+json run_real_composite(const Options& o, const RealData& d) {
+  json out;
+  out["data"] = location_json(d.where);
+  if (!d.where.found()) return out;
+  const auto t0 = std::chrono::steady_clock::now();
+  docksim::CompositeOptions co;
+  co.per_cell = o.composite_per_cell;
+  co.seed = o.seed;
+  const docksim::CompositeSiteParams& sp = co.site;
+  out["target_detection_min_pct"] = kTargetCompositePct;
+  out["per_cell"] = co.per_cell;
+  out["seed"] = o.seed;
+  out["match"] = {{"m", co.match_m}, {"deg", co.match_rad / kDeg}};
+  out["sites"] = {{"range_m", {sp.min_range_m, sp.max_range_m}},
+                  {"wall_margin_m", sp.margin_m},
+                  {"max_incidence_deg", sp.max_incidence_rad / kDeg},
+                  {"gap_m", {sp.gap_min_m, sp.gap_max_m}},
+                  {"free_distance_m", {sp.free_min_m, sp.free_max_m}},
+                  {"free_yaw_deg", sp.free_yaw_rad / kDeg},
+                  {"free_behind_m", sp.free_behind_m}};
+  json rows = json::array();
+  json totals = json::array();
+  auto mm = [](const std::vector<double>& v) {
+    const double p = percentile(v, 0.95);
+    return std::isnan(p) ? json(nullptr) : json(std::round(p * 1e4) / 10.0);
+  };
+  auto dg = [](const std::vector<double>& v) {
+    const double p = percentile(v, 0.95);
+    return std::isnan(p) ? json(nullptr) : json(std::round(p / kDeg * 100) / 100.0);
+  };
+  auto mm50 = [](const std::vector<double>& v) {
+    const double p = percentile(v, 0.5);
+    return std::isnan(p) ? json(nullptr) : json(std::round(p * 1e4) / 10.0);
+  };
+  for (const auto& pname : o.profiles) {
+    const dockcore::DockProfile prof = docksim::resolve_profile(pname);
+    for (int k = 0; k < docksim::kCompositeKinds; ++k) {
+      const auto kind = static_cast<docksim::CompositeKind>(k);
+      docksim::CompositeResult all;
+      Progress pr{"real: composites", static_cast<long>(d.recordings.size())};
+      for (const docksim::LoadedRecording& rec : d.recordings) {
+        const docksim::CompositeResult r = docksim::measure_real_composites(rec, prof, kind, co);
+        rows.push_back({{"recording", rec.info->name},
+                        {"profile", pname},
+                        {"kind", docksim::to_string(kind)},
+                        {"scans_tried", r.scans_tried},
+                        {"no_site", r.no_site},
+                        {"placed", r.placed},
+                        {"detected", r.detected},
+                        {"wrong", r.wrong},
+                        {"missed", r.missed},
+                        {"detection_pct", r.placed ? json(pct(r.detected, r.placed)) : json(nullptr)},
+                        {"pos_mm_p95", mm(r.pos_err_m)},
+                        {"yaw_deg_p95", dg(r.yaw_err_rad)},
+                        {"wrong_pos_mm_median", mm50(r.wrong_pos_err_m)},
+                        {"rejected_by", rejections_json(r.counters)}});
+        all.scans_tried += r.scans_tried;
+        all.no_site += r.no_site;
+        all.placed += r.placed;
+        all.detected += r.detected;
+        all.wrong += r.wrong;
+        all.missed += r.missed;
+        all.pos_err_m.insert(all.pos_err_m.end(), r.pos_err_m.begin(), r.pos_err_m.end());
+        all.yaw_err_rad.insert(all.yaw_err_rad.end(), r.yaw_err_rad.begin(), r.yaw_err_rad.end());
+        pr.tick();
+      }
+      totals.push_back({{"profile", pname},
+                        {"kind", docksim::to_string(kind)},
+                        {"placed", all.placed},
+                        {"detected", all.detected},
+                        {"wrong", all.wrong},
+                        {"missed", all.missed},
+                        {"detection_pct", all.placed ? json(pct(all.detected, all.placed)) : json(nullptr)},
+                        {"meets_target", all.placed > 0 && pct(all.detected, all.placed) >= kTargetCompositePct},
+                        {"pos_mm_p95", mm(all.pos_err_m)},
+                        {"yaw_deg_p95", dg(all.yaw_err_rad)}});
+    }
+  }
+  out["rows"] = rows;
+  out["totals"] = totals;
+  out["seconds"] = seconds_since(t0);
+  return out;
+}
+
+void print_real_text(const json& j) {
+  for (const char* section : {"real", "composite"}) {
+    if (j.contains(section) && !j[section]["data"]["found"].get<bool>()) {
+      std::printf("%s\n", j[section]["data"]["message"].get<std::string>().c_str());  // one line: skipped
+      return;
+    }
+  }
+  auto opt = [](const json& v, const char* fmt) {
+    char buf[32];
+    if (v.is_null()) return std::string("-");
+    std::snprintf(buf, sizeof buf, fmt, v.get<double>());
+    return std::string(buf);
+  };
+  if (j.contains("real")) {
+    const json& r = j["real"];
+    std::printf(
+        "\n== Real data: false positives (dock-less real scans; estimator with params for each recording's "
+        "noise, lidar at the origin, no hint)\n%s\n",
+        r["data"]["message"].get<std::string>().c_str());
+    if (r["data"]["found"].get<bool>()) {
+      std::printf("\n-- Recordings (σ = README p25 noise at 1-2 m; poses matched by order, verified range by range)\n");
+      std::printf("%-26s %6s %7s %6s %6s  %-18s %s\n", "recording", "scans", "skipped", "σ mm", "res mm", "poses",
+                  "pose match");
+      for (const auto& l : r["recordings"]) {
+        std::string match = "-";
+        if (l.contains("pose_match")) {
+          const auto& m = l["pose_match"];
+          char buf[160];
+          std::snprintf(buf, sizeof buf, "%zu of %zu scans = log messages (every %zu) %s%s",
+                        m["matched"].get<std::size_t>(), l["scans"].get<std::size_t>(), m["every"].get<std::size_t>(),
+                        m["ok"].get<bool>() ? "ok" : "NOT USED: ", m["first_problem"].get<std::string>().c_str());
+          match = buf;
+        } else if (l["poses_used"].get<bool>()) {
+          match = "standing sensor (identity poses)";
+        }
+        std::printf("%-26s %6zu %7zu %6.1f %6.2g  %-18s %s\n", l["name"].get<std::string>().c_str(),
+                    l["scans"].get<std::size_t>(), l["skipped_lines"].get<std::size_t>(), l["sigma_mm"].get<double>(),
+                    l["resolution_mm"].get<double>(), l["pose_source"].get<std::string>().c_str(), match.c_str());
+      }
+      std::printf("\nConfirmed: %s\n\n", r["rule"]["text"].get<std::string>().c_str());
+      std::printf("(att = windows whose first scan found a dock: the only ones that can confirm)\n");
+      std::printf("%-26s %-10s %6s %5s %7s | %-6s %7s %5s %5s %7s\n", "recording", "profile", "scans", "FP", "FP %",
+                  "frame", "windows", "att", "conf", "conf %");
+      for (const auto& row : r["rows"]) {
+        std::printf("%-26s %-10s %6zu %5zu %7.2f | %-6s %7s %5s %5s %7s\n", row["recording"].get<std::string>().c_str(),
+                    row["profile"].get<std::string>().c_str(), row["scans"].get<std::size_t>(),
+                    row["found"].get<std::size_t>(), row["fp_pct"].get<double>(),
+                    row["confirm_frame"].get<std::string>().c_str(),
+                    row["windows"].is_null() ? "-" : std::to_string(row["windows"].get<std::size_t>()).c_str(),
+                    row["attempts"].is_null() ? "-" : std::to_string(row["attempts"].get<std::size_t>()).c_str(),
+                    row["confirmed"].is_null() ? "-" : std::to_string(row["confirmed"].get<std::size_t>()).c_str(),
+                    opt(row["confirmed_pct"], "%.3f").c_str());
+      }
+      std::printf(
+          "\n-- Totals per profile (targets: single scan <= %.2f %% of scans, confirmed <= %.2f %% of windows)\n",
+          kTargetSingleFpPct, kTargetConfirmedFpPct);
+      std::printf("%-10s %6s %5s %7s %-6s | %7s %5s %7s %-6s\n", "profile", "scans", "FP", "FP %", "target", "windows",
+                  "conf", "conf %", "target");
+      for (const auto& t : r["totals"]) {
+        std::printf("%-10s %6zu %5zu %7.2f %-6s | %7zu %5zu %7.3f %-6s\n", t["profile"].get<std::string>().c_str(),
+                    t["scans"].get<std::size_t>(), t["found"].get<std::size_t>(), t["fp_pct"].get<double>(),
+                    t["meets_single_target"].get<bool>() ? "met" : "MISSED", t["windows"].get<std::size_t>(),
+                    t["confirmed"].get<std::size_t>(), t["confirmed_pct"].get<double>(),
+                    t["meets_confirmed_target"].get<bool>() ? "met" : "MISSED");
+      }
+      std::printf("(loading %.1f s, measuring %.1f s)\n", r["load_seconds"].get<double>(), r["seconds"].get<double>());
+    }
+  }
+  if (j.contains("composite")) {
+    const json& c = j["composite"];
+    std::printf("\n== Real data: composite scenes (a dock ray-cast into real scans with the recording's noise)\n%s\n",
+                c["data"]["message"].get<std::string>().c_str());
+    if (c["data"]["found"].get<bool>()) {
+      std::printf("detected = found within %.0f cm / %.0f° of the truth; wrong = found elsewhere; seed %llu\n",
+                  100 * c["match"]["m"].get<double>(), c["match"]["deg"].get<double>(),
+                  static_cast<unsigned long long>(c["seed"].get<std::uint64_t>()));
+      std::printf("\n%-26s %-10s %-13s %6s %7s %6s %5s %5s %6s %8s %8s %8s\n", "recording", "profile", "kind", "tried",
+                  "no site", "placed", "det", "wrong", "missed", "det %", "pos95mm", "yaw95°");
+      for (const auto& row : c["rows"]) {
+        std::printf("%-26s %-10s %-13s %6zu %7zu %6zu %5zu %5zu %6zu %8s %8s %8s\n",
+                    row["recording"].get<std::string>().c_str(), row["profile"].get<std::string>().c_str(),
+                    row["kind"].get<std::string>().c_str(), row["scans_tried"].get<std::size_t>(),
+                    row["no_site"].get<std::size_t>(), row["placed"].get<std::size_t>(),
+                    row["detected"].get<std::size_t>(), row["wrong"].get<std::size_t>(),
+                    row["missed"].get<std::size_t>(), opt(row["detection_pct"], "%.1f").c_str(),
+                    opt(row["pos_mm_p95"], "%.1f").c_str(), opt(row["yaw_deg_p95"], "%.2f").c_str());
+      }
+      std::printf("\n-- Totals per profile and placement (target: detected >= %.0f %%)\n",
+                  c["target_detection_min_pct"].get<double>());
+      std::printf("%-10s %-13s %6s %6s %5s %6s %8s %-6s %8s %8s\n", "profile", "kind", "placed", "det", "wrong",
+                  "missed", "det %", "target", "pos95mm", "yaw95°");
+      for (const auto& t : c["totals"]) {
+        std::printf("%-10s %-13s %6zu %6zu %5zu %6zu %8s %-6s %8s %8s\n", t["profile"].get<std::string>().c_str(),
+                    t["kind"].get<std::string>().c_str(), t["placed"].get<std::size_t>(),
+                    t["detected"].get<std::size_t>(), t["wrong"].get<std::size_t>(), t["missed"].get<std::size_t>(),
+                    opt(t["detection_pct"], "%.1f").c_str(), t["meets_target"].get<bool>() ? "met" : "MISSED",
+                    opt(t["pos_mm_p95"], "%.1f").c_str(), opt(t["yaw_deg_p95"], "%.2f").c_str());
+      }
+      std::printf("(measuring %.1f s)\n", c["seconds"].get<double>());
+    }
+  }
+}
+
 // ---------------------------------------------------------------- printing
 
 void print_text(const json& j) {
@@ -475,6 +841,7 @@ void print_text(const json& j) {
       }
     }
   }
+  print_real_text(j);
   if (j.contains("cost")) {
     std::printf("\n== Cost per scan\n");
     for (const auto& [det, c] : j["cost"].items()) {
@@ -511,7 +878,9 @@ void register_perception(CLI::App& app) {
   sub->add_option("--profiles", *profiles, "Comma-separated profiles (built-in names or .toml files)");
   sub->add_option("--lidars", *lidars, "Comma-separated lidar models");
   sub->add_option("--sigmas-mm", *sigmas, "Comma-separated range noise levels, millimetres");
-  sub->add_option("--sections", *sections, "Comma-separated: accuracy, targets, fp, generated");
+  sub->add_option("--sections", *sections,
+                  "Comma-separated: accuracy, targets, fp (simulated); generated (generated worlds); real (false "
+                  "positives on the real dock-less recordings), composite (docks ray-cast into real scans)");
   auto gen = std::make_shared<GeneratedOptions>();
   sub->add_option("--gen-scenes", gen->scenes, "generated: docking scenes (one scan each)")->check(CLI::PositiveNumber);
   sub->add_option("--gen-fp-scenes", gen->fp_scenes,
@@ -524,8 +893,15 @@ void register_perception(CLI::App& app) {
       ->check(CLI::Range(1, 10000));
   sub->add_option("--jobs", gen->jobs, "generated: worker threads (the figures do not depend on it)")
       ->check(CLI::Range(1, 64));
-  sub->add_option("--trials", o->trials, "Scenes per (profile, lidar, sigma) in the accuracy grid")
+  sub->add_option("--realdata", o->realdata_dir,
+                  "Real-data folder (default: $DOCKCORE_REALDATA, else <repo>/../shared/realdata)");
+  sub->add_option("--real-limit", o->real_limit, "Real data: use only the first N scans of each recording (0 = all)");
+  auto real_names = std::make_shared<std::string>();
+  sub->add_option("--real-recordings", *real_names, "Real data: comma-separated recording names (default: all)");
+  sub->add_option("--composite-n", o->composite_per_cell,
+                  "Composite scenes per (recording, profile, placement), at most one per scan")
       ->check(CLI::PositiveNumber);
+  sub->add_option("--trials", o->trials, "Scenes per (profile, lidar, sigma) in the accuracy grid")->check(CLI::PositiveNumber);
   sub->add_option("--target-trials", o->target_trials, "Scenes in the target zone")->check(CLI::PositiveNumber);
   sub->add_option("--fp-scenes", o->fp_scenes, "Dock-less scenes per clutter kind")->check(CLI::PositiveNumber);
   sub->add_option("--filter-runs", o->filter_runs, "1 s filtered runs")->check(CLI::PositiveNumber);
@@ -538,8 +914,9 @@ void register_perception(CLI::App& app) {
   sub->add_option("--detector", o->cost_detector,
                   "Cost: all | estimator | estimator-tracking | breakpoint | vmarker (one detector for callgrind)")
       ->check(CLI::IsMember({"all", "estimator", "estimator-tracking", "breakpoint", "vmarker"}));
-  sub->callback([o, gen, profiles, lidars, sigmas, sections]() {
+  sub->callback([o, gen, profiles, lidars, sigmas, sections, real_names]() {
     o->profiles = split_csv(*profiles);
+    o->real_recordings = split_csv(*real_names);
     o->lidars = split_csv(*lidars);
     o->sigmas.clear();
     for (const auto& s : split_csv(*sigmas)) {
@@ -556,8 +933,9 @@ void register_perception(CLI::App& app) {
     } else {
       const std::vector<std::string> secs = split_csv(*sections);
       for (const std::string& s : secs) {
-        if (s != "accuracy" && s != "targets" && s != "fp" && s != "generated") {
-          throw CLI::ValidationError("--sections", "unknown section " + s + " (accuracy, targets, fp, generated)");
+        if (s != "accuracy" && s != "targets" && s != "fp" && s != "generated" && s != "real" && s != "composite") {
+          throw CLI::ValidationError("--sections",
+                                     "unknown section " + s + " (accuracy, targets, fp, generated, real, composite)");
         }
       }
       auto has = [&secs](const char* s) { return std::find(secs.begin(), secs.end(), s) != secs.end(); };
@@ -567,6 +945,11 @@ void register_perception(CLI::App& app) {
       if (has("generated")) {
         gen->seed = o->seed;
         j["generated"] = run_generated(*gen);
+      }
+      if (has("real") || has("composite")) {
+        const std::unique_ptr<RealData> data = load_real_data(*o);
+        if (has("real")) j["real"] = run_real_fp(*o, *data);
+        if (has("composite")) j["composite"] = run_real_composite(*o, *data);
       }
     }
     if (o->json_out) {

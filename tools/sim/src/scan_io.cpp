@@ -1,8 +1,10 @@
 // JSON-lines scan recordings (see docksim/scan_io.hpp).
 #include "docksim/scan_io.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 
@@ -35,6 +37,65 @@ bool depth_ok(const std::string& s) {
     }
   }
   return true;
+}
+
+// JSON has no NaN or infinity, so a recorder that writes one (NaN, Infinity, 1e999) makes the line invalid JSON.
+// After a failed parse this names the culprit: "non-finite number <token> in \"<key>\"". Byte-at-a-time scan
+// with explicit state (inside a string or not, the last string seen = the key the value belongs to).
+bool find_nonfinite(const std::string& s, std::string* what) {
+  enum class State { kOutside, kString, kEscape, kToken };
+  State st = State::kOutside;
+  std::string last_string, current, token;
+  auto finish_token = [&]() {
+    if (token.empty()) return false;
+    char* end = nullptr;
+    const double v = std::strtod(token.c_str(), &end);
+    const bool consumed = end != nullptr && *end == '\0';
+    const bool bad_literal = token == "NaN" || token == "nan" || token == "Infinity" || token == "-Infinity" ||
+                             token == "inf" || token == "-inf" || token == "-NaN" || token == "-nan";
+    if (bad_literal || (consumed && !std::isfinite(v))) {
+      *what = "non-finite number " + token + " in \"" + last_string + "\"";
+      return true;
+    }
+    token.clear();
+    return false;
+  };
+  for (const char ch : s) {
+    switch (st) {
+      case State::kString:
+        if (ch == '\\')
+          st = State::kEscape;
+        else if (ch == '"') {
+          last_string = current;
+          st = State::kOutside;
+        } else {
+          current.push_back(ch);
+        }
+        break;
+      case State::kEscape:
+        current.push_back(ch);
+        st = State::kString;
+        break;
+      case State::kToken:
+        if (std::isalnum(static_cast<unsigned char>(ch)) || ch == '.' || ch == '+' || ch == '-') {
+          if (token.size() < 64) token.push_back(ch);
+          break;
+        }
+        if (finish_token()) return true;
+        st = State::kOutside;
+        [[fallthrough]];
+      case State::kOutside:
+        if (ch == '"') {
+          current.clear();
+          st = State::kString;
+        } else if (std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '.') {
+          token.assign(1, ch);
+          st = State::kToken;
+        }
+        break;
+    }
+  }
+  return st == State::kToken && finish_token();
 }
 
 bool get_finite(const json& obj, const char* key, double* out, std::string* error) {
@@ -158,7 +219,7 @@ bool parse_scan_line(const std::string& line, RecordedScan* out, std::string* er
   }
   const json j = json::parse(line, nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) {
-    *error = "not valid JSON";
+    if (!find_nonfinite(line, error)) *error = "not valid JSON";
     return false;
   }
   if (!j.is_object()) {
@@ -287,6 +348,43 @@ bool read_scans(std::istream& in, std::vector<RecordedScan>* out, std::string* e
       case ScanReader::Status::kError: return false;
     }
   }
+}
+
+bool read_scans_skipping_bad(std::istream& in, std::vector<RecordedScan>* out, ScanReadSummary* summary,
+                             std::size_t max_scans) {
+  ScanReader reader(in);
+  *summary = ScanReadSummary{};
+  for (;;) {
+    if (max_scans != 0 && summary->scans >= max_scans) break;
+    RecordedScan s;
+    std::string error;
+    const ScanReader::Status st = reader.next(&s, &error);
+    summary->lines = reader.line_number();
+    if (st == ScanReader::Status::kEnd) break;
+    if (st == ScanReader::Status::kError) {
+      ++summary->skipped;
+      if (summary->errors.size() < kMaxReportedScanErrors) summary->errors.push_back(error);
+      continue;
+    }
+    out->push_back(std::move(s));
+    ++summary->scans;
+  }
+  return !in.bad();
+}
+
+bool read_scan_file_skipping_bad(const std::string& path, std::vector<RecordedScan>* out, ScanReadSummary* summary,
+                                 std::string* error, std::size_t max_scans) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) {
+    if (error) *error = "cannot open " + path;
+    *summary = ScanReadSummary{};
+    return false;
+  }
+  if (!read_scans_skipping_bad(f, out, summary, max_scans)) {
+    if (error) *error = "read error on " + path;
+    return false;
+  }
+  return true;
 }
 
 bool read_scan_file(const std::string& path, std::vector<RecordedScan>* out, std::string* error) {

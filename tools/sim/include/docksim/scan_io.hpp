@@ -65,6 +65,28 @@ class ScanReader {
 
 /// Reads every scan; stops at the first bad line with *error = "line N: <what>" (scans before it are in *out).
 bool read_scans(std::istream& in, std::vector<RecordedScan>* out, std::string* error);
+
+/// What read_scans_skipping_bad read and what it skipped.
+struct ScanReadSummary {
+  std::size_t lines = 0;    ///< Lines read, blank ones included.
+  std::size_t scans = 0;    ///< Scans appended to the output.
+  std::size_t skipped = 0;  ///< Malformed lines skipped (every one counted).
+  /// "line N: <what>" of the first kMaxReportedScanErrors skipped lines, in file order.
+  std::vector<std::string> errors;
+};
+
+/// Skipped lines whose message ScanReadSummary keeps (the count goes on beyond).
+constexpr std::size_t kMaxReportedScanErrors = 20;
+
+/// Reads the scans of a recording that may hold bad lines: a malformed line (every parse_scan_line error: wrong
+/// number of intensities, non-finite or missing angles, zero increment, ...) is skipped, counted and reported with
+/// its line number; every other line is read exactly as read_scans would. Stops after `max_scans` scans (0: all).
+/// Returns false only when the stream itself fails (*summary then holds what was read so far). O(bytes).
+bool read_scans_skipping_bad(std::istream& in, std::vector<RecordedScan>* out, ScanReadSummary* summary,
+                             std::size_t max_scans = 0);
+/// As read_scans_skipping_bad from a file; false with *error = "cannot open <path>" or "read error on <path>".
+bool read_scan_file_skipping_bad(const std::string& path, std::vector<RecordedScan>* out, ScanReadSummary* summary,
+                                 std::string* error, std::size_t max_scans = 0);
 /// As read_scans from a file; "cannot open <path>" when it cannot be opened.
 bool read_scan_file(const std::string& path, std::vector<RecordedScan>* out, std::string* error);
 /// Writes one line per scan, each terminated by '\n'. Returns false on a stream error.
