@@ -309,7 +309,8 @@ TEST(DockdConfig, EstimatorTuningKeys) {
   CHECK_EQUAL(4u, c.estimator.segments.min_points);
   // Untouched keys keep the estimator's defaults.
   const dockcore::EstimatorParams d{};
-  REAL_EQUAL(d.max_rms_m, c.estimator.max_rms_m, 0);
+  REAL_EQUAL(d.min_evidence_nats, c.estimator.min_evidence_nats, 0);
+  REAL_EQUAL(d.wall_tolerance_m, c.estimator.wall_tolerance_m, 0);
   // Out of range, wrong type, unknown: at the value / key.
   STRCMP_CONTAINS("t.toml:2:17: estimator.inlier_gate_m = 0.6 is out of range [0.001, 0.5]",
                   error_of("[estimator]\ninlier_gate_m = 0.6\n").c_str());

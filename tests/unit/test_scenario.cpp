@@ -395,9 +395,10 @@ TEST(Scenario, EstimatorTuningKeys) {
   CHECK_EQUAL(14u, sc.estimator.min_inliers);
   CHECK_EQUAL(4u, sc.estimator.segments.min_points);
   const dockcore::EstimatorParams d{};
-  REAL_EQUAL(d.max_rms_m, sc.estimator.max_rms_m, 0);
+  REAL_EQUAL(d.min_evidence_nats, sc.estimator.min_evidence_nats, 0);
   refused_at("[estimator]\ninlier_gate_m = 0.6\n", 2, 17, "estimator.inlier_gate_m = 0.6 is out of range [0.001, 0.5]");
   refused_at("[estimator]\nmax_view_angle_deg = 95\n", 2, 22, "estimator.max_view_angle_deg = 95 is out of range [1, 90]");
   refused_at("[estimator]\nselect = \"first\"\n", 2, 10, "estimator.select = \"first\" is not one of nearest, hint");
-  refused_at("[estimator]\nwall_tolerance_m = 0.1\n", 2, 1, "unknown key 'estimator.wall_tolerance_m'");
+  refused_at("[estimator]\nwall_tolerance_m = 0.3\n", 2, 20, "estimator.wall_tolerance_m = 0.3 is out of range [0, 0.2]");
+  refused_at("[estimator]\nrequire_wall_behind = false\n", 2, 1, "unknown key 'estimator.require_wall_behind'");
 }

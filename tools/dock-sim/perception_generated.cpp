@@ -160,17 +160,14 @@ int bin_of(Factor f, const docksim::GenScene& s, const docksim::WorldGenParams& 
 }
 
 /// The estimator's configuration in case c. The user configures the lidar's noise as its σ at 1 m. Told: the
-/// profile's mounting is the world's, and the wall-behind test is on exactly for a wall mounting (what
-/// EstimatorParams::require_wall_behind asks of a free-standing dock). Unknown: mounting kUnknown, default params.
+/// profile's mounting is the world's. Unknown: mounting kUnknown. The parameters are the same in both.
 dockcore::DockProfile profile_for_case(const docksim::GenScene& s, int c) {
   dockcore::DockProfile p = s.profile;
   p.mounting = c == 0 ? s.told_mounting : dockcore::DockMounting{};
   return p;
 }
-dockcore::EstimatorParams params_for_case(const docksim::GenScene& s, int c) {
-  dockcore::EstimatorParams p = dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0)));
-  if (c == 0) p.require_wall_behind = s.told_mounting.kind == dockcore::DockMountKind::kWall;
-  return p;
+dockcore::EstimatorParams params_for_case(const docksim::GenScene& s, int /*c*/) {
+  return dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0)));
 }
 
 /// Why the scene's profile is left out of the figures ("" when it is not): check_profile for the scene's lidar and

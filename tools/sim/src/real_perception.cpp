@@ -315,7 +315,6 @@ void composite_installation(const RealRecording& rec, CompositeKind kind, dockco
   *params = real_estimator_params(rec);
   if (kind == CompositeKind::kFreeStanding) {
     profile->mounting = dockcore::DockMounting{dockcore::DockMountKind::kFreeStanding, 0, static_cast<Real>(0.10)};
-    params->require_wall_behind = false;
   } else {
     profile->mounting = dockcore::DockMounting{dockcore::DockMountKind::kWall, 0, static_cast<Real>(0.10)};
   }

@@ -134,7 +134,7 @@ std::size_t paste_dock(const dockcore::ScanView& background, const dockcore::Doc
                        dockcore::LaserScan* out, std::size_t* occluded = nullptr);
 
 /// The dock as installed for a composite kind: wall kinds get mounting kWall (gap 0-0.10 m) and the default
-/// require_wall_behind; kFreeStanding gets mounting kFreeStanding and require_wall_behind = false. Params are
+/// kFreeStanding gets mounting kFreeStanding. Params are
 /// real_estimator_params(rec) otherwise. O(1).
 void composite_installation(const RealRecording& rec, CompositeKind kind, dockcore::DockProfile* profile,
                             dockcore::EstimatorParams* params);
