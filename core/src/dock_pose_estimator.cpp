@@ -39,6 +39,11 @@ constexpr Real kMissingNats = static_cast<Real>(-3.59);
 constexpr Real kContinuesNats = static_cast<Real>(-2.46);
 constexpr Real kConstraintNats = static_cast<Real>(1.31);   // per e-fold of `constraint`
 constexpr Real kMinConstraint = static_cast<Real>(0.01);
+// The inlier gate of the lidars the weights were fitted on (estimator_params_for_noise's floor).
+constexpr Real kReferenceGateM = static_cast<Real>(0.015);
+// How much of a wider gate's extra chance matches is charged: all of it (1) if chance surfaces were spread evenly in
+// range; rooms are not, and charging all of it halves detection at 10 mm noise for little gain on real scans.
+constexpr Real kGateGrowthShare = static_cast<Real>(0.5);
 // Wall beams. Unknown mounting: the fitted weight of a wall seen; none seen is not held against the dock. A
 // wall-mounted dock: log(0.85/0.2) for a wall where the gap range puts it and log(0.15/0.8) for none.
 constexpr Real kWallSeenUnknownNats = static_cast<Real>(0.363);
@@ -417,6 +422,17 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
   // explains a winged dock's face and half of each wing).
   std::uint16_t seg_expected[kMaxProfileVertices] = {};
   std::uint16_t seg_inliers[kMaxProfileVertices] = {};
+  // Returns on the wall the mounting allows behind the dock are the wall's, not a dock surface carrying on: a wall
+  // a few centimetres behind a winged dock crosses the wings' lines just past their tips.
+  const DockMountKind mount = profile_.mounting.kind;
+  const Real gap_max_m = mount == DockMountKind::kWall ? profile_.mounting.wall_gap_max_m : DockMounting{}.wall_gap_max_m;
+  const Vec2 t_dock(r.pose.x_m, r.pose.y_m);
+  const Vec2 x_dock(std::cos(r.pose.yaw_rad), std::sin(r.pose.yaw_rad));
+  auto wall_band = [&](const Vec2& p) {
+    const Real x = x_dock.dot(p - t_dock);
+    return x < back_x_m_ + gate && x > back_x_m_ - gap_max_m - gate;
+  };
+  const bool check_band = mount != DockMountKind::kFreeStanding;
   for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
     std::size_t i = 0;
     if (!beam_at(first, k, &i)) continue;
@@ -453,7 +469,7 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
         }
       }
     }
-    if (m != 0) {
+    if (m != 0 && !(check_band && wall_band(m * dir_[i]))) {
       const int ext = continues_past_end(m * dir_[i]);
       if (ext == 1) f.stops += weight(m);
       if (ext == 2) {
@@ -477,7 +493,6 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
     }
   }
   const Real w_dock = weight(dist_to_dock);
-  const DockMountKind mount = profile_.mounting.kind;
   if (r.expected > 0 && mount != DockMountKind::kFreeStanding) {
     wall_behind(r.pose, first, k_first_hit, k_last_hit, &r.wall_seen, &r.wall_looked);
     f.wall_seen = w_dock * static_cast<Real>(r.wall_seen);
@@ -490,7 +505,10 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
     f.constraint = w_dock * min_eigen_sym3(scale * r.h * scale);
   }
   Real* cue = r.evidence.cue_nats;
-  cue[static_cast<std::size_t>(EvidenceCue::kFit)] = kFitBaseNats + kFitPerHitNats * f.hit + kFitPerSqNats * f.hit_sq;
+  // A wider gate (a noisier lidar) catches chance surfaces more often: a hit is worth less by the gate's growth.
+  const Real gate_growth = gate > kReferenceGateM ? kGateGrowthShare * std::log(gate / kReferenceGateM) : R(0);
+  cue[static_cast<std::size_t>(EvidenceCue::kFit)] =
+      kFitBaseNats + (kFitPerHitNats - gate_growth) * f.hit + kFitPerSqNats * f.hit_sq;
   cue[static_cast<std::size_t>(EvidenceCue::kSeeThrough)] = kBeyondNats * f.beyond;
   cue[static_cast<std::size_t>(EvidenceCue::kFreeSpace)] = kFrontNats * f.front;
   cue[static_cast<std::size_t>(EvidenceCue::kSupport)] = kMissingNats * f.missing;
