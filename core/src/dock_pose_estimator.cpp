@@ -440,7 +440,10 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
     Real expected_m = 0;
     std::size_t seg = 0;
     if (placed_.raycast(dir_[i], &expected_m, &seg)) {
-      const Real w = weight(expected_m);
+      // The surface length this beam covers: its spacing stretched by the incidence (capped as in the fit).
+      Real cos_inc = std::fabs(placed_.n[seg].dot(dir_[i]));
+      cos_inc = cos_inc > kMinCosIncidence ? cos_inc : kMinCosIncidence;
+      const Real w = weight(expected_m / cos_inc);
       if (r.expected == 0) k_first_hit = k;
       k_last_hit = k;
       ++r.expected;
