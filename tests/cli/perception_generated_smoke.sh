@@ -32,5 +32,7 @@ if fail:
     print("\n".join(fail), file=sys.stderr)
     sys.exit(1)
 PY
-/usr/bin/python3 "$report" "$dir/a.json" | grep -q "^#### Targets" || { echo "perception-report lost the section" >&2; exit 1; }
+# To a file first: `grep -q` would close the pipe on its match while the report still writes (EPIPE under pipefail).
+/usr/bin/python3 "$report" "$dir/a.json" >"$dir/a.md"
+grep -q "^#### Targets" "$dir/a.md" || { echo "perception-report lost the section" >&2; exit 1; }
 echo "perception generated smoke: ok"
