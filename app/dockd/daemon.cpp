@@ -881,6 +881,9 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
                                                   : FaultCode::kNone;
   const dockcore::hal::LidarCounters& lc = io_.lidar->counters();
   const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
+  // The latest scan's detection decision: its evidence and each cue (for a miss, the best refused candidate's).
+  const dockcore::DockEstimate& e = core_->last_estimate();
+  auto cue = [&e](dockcore::EvidenceCue c) { return static_cast<double>(e.evidence.cue_nats[static_cast<std::size_t>(c)]); };
   const int n = std::snprintf(
       buf, size,
       "{\"type\":\"status\",\"stamp_us\":%llu,\"state\":\"%s\",\"state_code\":%u,\"phase\":%u,\"phase_name\":\"%s\","
@@ -895,7 +898,9 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       "\"lidar_late_scans\":%u,"
       "\"can_bad_frames\":%u,"
       "\"can_send_failures\":%u,\"commands\":%u,\"commands_rejected\":%u,\"resumes\":%u,\"can_host_rejected\":%u,"
-      "\"udp_not_allowed\":%u,\"config_reloads\":%u,\"config_reloads_rejected\":%u,\"config_reload_pending\":%s}",
+      "\"udp_not_allowed\":%u,\"config_reloads\":%u,\"config_reloads_rejected\":%u,\"config_reload_pending\":%s,"
+      "\"det_found\":%s,\"det_evidence_nats\":%.1f,\"det_cues_nats\":[%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f],"
+      "\"det_reject\":\"%s\"}",
       static_cast<unsigned long long>(now_us), dockcore::to_string(s.state), static_cast<unsigned>(s.state), s.phase,
       s.state == TaskState::kAlign ? controller_->phase_name(s.phase) : "", static_cast<unsigned>(s.fault),
       dockcore::to_string(s.fault), static_cast<unsigned>(watchdog_fault), s.retries, s.dock_id,
@@ -914,7 +919,12 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       cc.send_failures, counters_.commands, commands_rejected_total(), counters_.resumes,
       io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u,
       io_.udp_host != nullptr ? io_.udp_host->counters().not_allowed : 0u, counters_.config_reloads,
-      counters_.config_reloads_rejected, pending_cfg_ != nullptr ? "true" : "false");
+      counters_.config_reloads_rejected, pending_cfg_ != nullptr ? "true" : "false", e.found ? "true" : "false",
+      static_cast<double>(e.evidence.total_nats), cue(dockcore::EvidenceCue::kFit),
+      cue(dockcore::EvidenceCue::kSeeThrough), cue(dockcore::EvidenceCue::kFreeSpace),
+      cue(dockcore::EvidenceCue::kSupport), cue(dockcore::EvidenceCue::kEdges), cue(dockcore::EvidenceCue::kWall),
+      cue(dockcore::EvidenceCue::kGeometry), cue(dockcore::EvidenceCue::kPrior),
+      e.found ? "none" : dockcore::to_string(e.reject));
   if (n < 0 || static_cast<std::size_t>(n) >= size) return 0;
   return static_cast<std::size_t>(n);
 }

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -519,6 +520,12 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
   char json[dockcore::drivers::kMaxHostReply];
   CHECK(r.daemon->status_json(json, sizeof json - 64, r.clock.t) > 0);  // still fits the status reply
+  // The latest scan's decision: the dock in view is accepted, with its evidence above the threshold and each cue.
+  STRCMP_CONTAINS("\"det_found\":true,\"det_evidence_nats\":", json);
+  STRCMP_CONTAINS("\"det_reject\":\"none\"}", json);
+  const char* ev = std::strstr(json, "\"det_evidence_nats\":");
+  CHECK(ev != nullptr && std::atof(ev + 20) >= 3.5);
+  CHECK(std::strstr(json, "\"det_cues_nats\":[") != nullptr);
   STRCMP_CONTAINS("\"config_reloads\":1,\"config_reloads_rejected\":2,\"config_reload_pending\":true", json);
   r.host.command(2, 0);  // stop: idle -> the pending reload applies on that tick
   CHECK_TRUE(r.run_until([&] { return !r.daemon->reload_pending(); }, 1.0));
