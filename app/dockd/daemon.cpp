@@ -900,7 +900,7 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       "\"can_send_failures\":%u,\"commands\":%u,\"commands_rejected\":%u,\"resumes\":%u,\"can_host_rejected\":%u,"
       "\"udp_not_allowed\":%u,\"config_reloads\":%u,\"config_reloads_rejected\":%u,\"config_reload_pending\":%s,"
       "\"det_found\":%s,\"det_evidence_nats\":%.1f,\"det_cues_nats\":[%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f],"
-      "\"det_reject\":\"%s\"}",
+      "\"det_reject\":\"%s\",\"dock_evidence_nats\":%.1f,\"dock_confirmed\":%s}",
       static_cast<unsigned long long>(now_us), dockcore::to_string(s.state), static_cast<unsigned>(s.state), s.phase,
       s.state == TaskState::kAlign ? controller_->phase_name(s.phase) : "", static_cast<unsigned>(s.fault),
       dockcore::to_string(s.fault), static_cast<unsigned>(watchdog_fault), s.retries, s.dock_id,
@@ -924,7 +924,8 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       cue(dockcore::EvidenceCue::kSeeThrough), cue(dockcore::EvidenceCue::kFreeSpace),
       cue(dockcore::EvidenceCue::kSupport), cue(dockcore::EvidenceCue::kEdges), cue(dockcore::EvidenceCue::kWall),
       cue(dockcore::EvidenceCue::kGeometry), cue(dockcore::EvidenceCue::kPrior),
-      e.found ? "none" : dockcore::to_string(e.reject));
+      e.found ? "none" : dockcore::to_string(e.reject), static_cast<double>(core_->filter().evidence_nats()),
+      core_->filter().confirmed() ? "true" : "false");
   if (n < 0 || static_cast<std::size_t>(n) >= size) return 0;
   return static_cast<std::size_t>(n);
 }

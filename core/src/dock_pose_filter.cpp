@@ -23,6 +23,8 @@ void DockPoseFilter::reset() {
   initialised_ = false;
   have_odom_ = false;
   consecutive_gated_ = 0;
+  evidence_nats_ = 0;
+  fused_since_start_ = 0;
 }
 
 void DockPoseFilter::predict(const Pose2& odom_pose) {
@@ -43,7 +45,9 @@ void DockPoseFilter::predict(const Pose2& odom_pose) {
   have_odom_ = true;
 }
 
-void DockPoseFilter::start(const Pose2& z, const Mat3& rz, std::uint64_t stamp_us) {
+void DockPoseFilter::start(const Pose2& z, const Mat3& rz, std::uint64_t stamp_us, Real evidence_nats) {
+  evidence_nats_ = evidence_nats;
+  fused_since_start_ = 1;
   dock_odom_ = z;
   cov_odom_ = rz;
   initialised_ = true;
@@ -52,8 +56,10 @@ void DockPoseFilter::start(const Pose2& z, const Mat3& rz, std::uint64_t stamp_u
 }
 
 FilterUpdate DockPoseFilter::update(const Pose2& dock_in_robot, const Mat3& cov_robot, const Pose2& odom_pose,
-                                    std::uint64_t stamp_us) {
-  if (!finite_pose(dock_in_robot) || !finite_pose(odom_pose) || !cov_robot.allFinite()) return FilterUpdate::kInvalid;
+                                    std::uint64_t stamp_us, Real evidence_nats) {
+  if (!finite_pose(dock_in_robot) || !finite_pose(odom_pose) || !cov_robot.allFinite() || !std::isfinite(evidence_nats)) {
+    return FilterUpdate::kInvalid;
+  }
   predict(odom_pose);
   // Detection mapped into the odometry frame, with its covariance rotated alongside.
   const Pose2 z = odom_pose.compose(dock_in_robot);
@@ -65,7 +71,7 @@ FilterUpdate DockPoseFilter::update(const Pose2& dock_in_robot, const Mat3& cov_
   rz(1, 1) += floor_p;
   rz(2, 2) += floor_y;
   if (!initialised_) {
-    start(z, rz, stamp_us);
+    start(z, rz, stamp_us, evidence_nats);
     ++fused_;
     return FilterUpdate::kInitialised;
   }
@@ -77,7 +83,7 @@ FilterUpdate DockPoseFilter::update(const Pose2& dock_in_robot, const Mat3& cov_
   if (!(last_d2_ <= params_.gate_chi2)) {
     if (++consecutive_gated_ >= params_.reinit_after) {
       ++reinits_;
-      start(z, rz, stamp_us);
+      start(z, rz, stamp_us, evidence_nats);
       return FilterUpdate::kReinitialised;
     }
     ++gated_;
@@ -94,6 +100,8 @@ FilterUpdate DockPoseFilter::update(const Pose2& dock_in_robot, const Mat3& cov_
   consecutive_gated_ = 0;
   last_update_us_ = stamp_us;
   ++fused_;
+  ++fused_since_start_;
+  evidence_nats_ += evidence_nats;
   return FilterUpdate::kFused;
 }
 

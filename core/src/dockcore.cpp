@@ -68,7 +68,8 @@ const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_
     } else {
       ++pending_dropped_;  // keep the oldest: a push shows in the first detections after it
     }
-    const FilterUpdate u = filter_.update(last_estimate_.pose, last_estimate_.covariance, odom_pose, stamp_us);
+    const FilterUpdate u = filter_.update(last_estimate_.pose, last_estimate_.covariance, odom_pose, stamp_us,
+                                           last_estimate_.evidence.total_nats);
     // A (re)started filter rests on this one detection, which may be clutter: confirmed once a second detection
     // agrees with it (is fused).
     if (u == FilterUpdate::kInitialised || u == FilterUpdate::kReinitialised) filter_confirmed_ = false;

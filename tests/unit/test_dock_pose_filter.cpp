@@ -103,3 +103,31 @@ TEST(DockPoseFilter, NonFiniteInputChangesNothing) {
   REAL_EQUAL(1.0, f.dock_in_odom().x_m, 1e-12);
   CHECK_EQUAL(1u, f.fused());
 }
+
+// The sequential test: agreeing detections add their evidence; a single strong scan, gated detections or a restart
+// do not confirm.
+TEST(DockPoseFilter, EvidenceOfAgreeingDetectionsConfirms) {
+  DockPoseFilter f;
+  const Pose2 odom{};
+  const Pose2 dock{1.0, 0.0, kPi};
+  f.update(dock, diag_cov(0.005, 0.01), odom, 0, 20.0);
+  CHECK_FALSE(f.confirmed());  // one scan, however strong
+  REAL_EQUAL(20.0, f.evidence_nats(), 1e-12);
+  DockPoseFilter g;
+  for (int k = 0; k < 3; ++k) g.update(dock, diag_cov(0.005, 0.01), odom, static_cast<std::uint64_t>(k), 3.5);
+  CHECK_FALSE(g.confirmed());  // 10.5 nats < 12
+  g.update(dock, diag_cov(0.005, 0.01), odom, 3, 3.5);
+  CHECK_TRUE(g.confirmed());
+  CHECK_EQUAL(4u, g.fused_since_start());
+  // A gated jump adds nothing; three of them restart the test from the newest detection.
+  const Pose2 elsewhere{1.0, 0.5, kPi - 0.5};
+  g.update(elsewhere, diag_cov(0.005, 0.01), odom, 4, 9.0);
+  REAL_EQUAL(14.0, g.evidence_nats(), 1e-12);
+  g.update(elsewhere, diag_cov(0.005, 0.01), odom, 5, 9.0);
+  g.update(elsewhere, diag_cov(0.005, 0.01), odom, 6, 9.0);
+  CHECK_FALSE(g.confirmed());
+  REAL_EQUAL(9.0, g.evidence_nats(), 1e-12);
+  g.reset();
+  CHECK_FALSE(g.confirmed());
+  REAL_EQUAL(0.0, g.evidence_nats(), 1e-12);
+}

@@ -522,7 +522,8 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   CHECK(r.daemon->status_json(json, sizeof json - 64, r.clock.t) > 0);  // still fits the status reply
   // The latest scan's decision: the dock in view is accepted, with its evidence above the threshold and each cue.
   STRCMP_CONTAINS("\"det_found\":true,\"det_evidence_nats\":", json);
-  STRCMP_CONTAINS("\"det_reject\":\"none\"}", json);
+  STRCMP_CONTAINS("\"det_reject\":\"none\",", json);
+  STRCMP_CONTAINS("\"dock_confirmed\":true}", json);
   const char* ev = std::strstr(json, "\"det_evidence_nats\":");
   CHECK(ev != nullptr && std::atof(ev + 20) >= 3.5);
   CHECK(std::strstr(json, "\"det_cues_nats\":[") != nullptr);

@@ -541,7 +541,7 @@ json run_real_fp(const Options& o, const RealData& d) {
   json totals = json::array();
   for (const auto& pname : o.profiles) {
     const dockcore::DockProfile prof = docksim::resolve_profile(pname);
-    std::size_t scans = 0, found = 0, windows = 0, confirmed = 0;
+    std::size_t scans = 0, found = 0, windows = 0, confirmed = 0, confirmed_seq = 0;
     Progress pr{"real: false positives", static_cast<long>(d.recordings.size())};
     for (const docksim::LoadedRecording& rec : d.recordings) {
       const docksim::RealFpResult r = docksim::measure_real_false_positives(rec, prof, rule);
@@ -558,6 +558,7 @@ json run_real_fp(const Options& o, const RealData& d) {
         row["attempts"] = r.attempts;
         row["confirmed"] = r.confirmed;
         row["confirmed_pct"] = pct(r.confirmed, r.windows);
+        row["confirmed_sequential"] = r.confirmed_sequential;
       } else {
         row["windows"] = nullptr;
         row["attempts"] = nullptr;
@@ -580,6 +581,7 @@ json run_real_fp(const Options& o, const RealData& d) {
       found += r.found;
       windows += r.windows;
       confirmed += r.confirmed;
+      confirmed_seq += r.confirmed_sequential;
       pr.tick();
     }
     totals.push_back({{"profile", pname},
@@ -590,6 +592,8 @@ json run_real_fp(const Options& o, const RealData& d) {
                       {"windows", windows},
                       {"confirmed", confirmed},
                       {"confirmed_pct", pct(confirmed, windows)},
+                      {"confirmed_sequential", confirmed_seq},
+                      {"confirmed_sequential_pct", pct(confirmed_seq, windows)},
                       {"meets_confirmed_target", windows > 0 && pct(confirmed, windows) <= kTargetConfirmedFpPct}});
   }
   out["rows"] = rows;
@@ -739,14 +743,16 @@ void print_real_text(const json& j) {
       std::printf(
           "\n-- Totals per profile (targets: single scan <= %.2f %% of scans, confirmed <= %.2f %% of windows)\n",
           kTargetSingleFpPct, kTargetConfirmedFpPct);
-      std::printf("%-10s %6s %5s %7s %-6s | %7s %5s %7s %-6s\n", "profile", "scans", "FP", "FP %", "target", "windows",
-                  "conf", "conf %", "target");
+      std::printf("%-10s %6s %5s %7s %-6s | %7s %5s %7s %-6s | %s\n", "profile", "scans", "FP", "FP %", "target",
+                  "windows", "conf", "conf %", "target", "of which sequential test (>= 12 nats)");
       for (const auto& t : r["totals"]) {
-        std::printf("%-10s %6zu %5zu %7.2f %-6s | %7zu %5zu %7.3f %-6s\n", t["profile"].get<std::string>().c_str(),
-                    t["scans"].get<std::size_t>(), t["found"].get<std::size_t>(), t["fp_pct"].get<double>(),
+        std::printf("%-10s %6zu %5zu %7.2f %-6s | %7zu %5zu %7.3f %-6s | %zu (%.3f %%)\n",
+                    t["profile"].get<std::string>().c_str(), t["scans"].get<std::size_t>(),
+                    t["found"].get<std::size_t>(), t["fp_pct"].get<double>(),
                     t["meets_single_target"].get<bool>() ? "met" : "MISSED", t["windows"].get<std::size_t>(),
                     t["confirmed"].get<std::size_t>(), t["confirmed_pct"].get<double>(),
-                    t["meets_confirmed_target"].get<bool>() ? "met" : "MISSED");
+                    t["meets_confirmed_target"].get<bool>() ? "met" : "MISSED",
+                    t["confirmed_sequential"].get<std::size_t>(), t["confirmed_sequential_pct"].get<double>());
       }
       std::printf("(loading %.1f s, measuring %.1f s)\n", r["load_seconds"].get<double>(), r["seconds"].get<double>());
     }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 
+#include "dockcore/dock_pose_filter.hpp"
 #include "dockcore/line_segments.hpp"
 #include "dockcore/profile_geometry.hpp"
 #include "docksim/scenes.hpp"
@@ -161,6 +162,7 @@ RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dock
   const Pose2 mount = real_lidar_mount();
   std::vector<char> found(n, 0);
   std::vector<Pose2> pose(n);
+  std::vector<double> evidence(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     if (!rec.scans[i].to_laser_scan(scan.get())) continue;  // the reader already refuses > kMaxScanPoints
     ++out.scans;
@@ -168,6 +170,7 @@ RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dock
     if (!e.found) continue;
     found[i] = 1;
     pose[i] = e.pose;
+    evidence[i] = static_cast<double>(e.evidence.total_nats);
     ++out.found;
     if (out.examples.size() < kMaxFalseDockExamples) out.examples.push_back(FalseDock{i, e.pose});
   }
@@ -193,6 +196,7 @@ RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dock
     // The lidar sits at the robot's origin (real_lidar_mount), so the robot frame is the sensor frame.
     const Pose2 first_world = rec.sensor_in_world[i].compose(pose[i]);
     bool confirmed = true;
+    double evidence_nats = evidence[i];
     for (std::size_t k = 1; k < w && confirmed; ++k) {
       const std::size_t j = i + k;
       const Pose2 hint = rec.sensor_in_world[j].inverse().compose(first_world);
@@ -200,9 +204,13 @@ RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dock
       if (!confirmed) break;
       const dockcore::DockEstimate e = tracker->estimate(scan->view(), mount, &hint);
       confirmed = e.found && agree(rec.sensor_in_world[j].compose(e.pose), first_world, rule.agree_m, rule.agree_rad);
+      evidence_nats += static_cast<double>(e.evidence.total_nats);
     }
     if (confirmed) {
       ++out.confirmed;
+      if (evidence_nats >= static_cast<double>(dockcore::DockFilterParams{}.confirm_evidence_nats)) {
+        ++out.confirmed_sequential;
+      }
       if (out.confirmed_starts.size() < kMaxFalseDockExamples) out.confirmed_starts.push_back(i);
     }
   }

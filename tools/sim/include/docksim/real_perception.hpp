@@ -56,6 +56,9 @@ struct RealFpResult {
   std::size_t windows = 0;                    ///< Confirmation opportunities: windows of rule.scans consecutive scans.
   std::size_t attempts = 0;                   ///< Windows whose first scan found a dock (the others cannot confirm).
   std::size_t confirmed = 0;                  ///< Windows whose detections all agreed (each is a confirmed false dock).
+  /// Of those, windows whose detections' evidence also adds up to DockFilterParams::confirm_evidence_nats: what the
+  /// dock filter's sequential test (DockPoseFilter::confirmed) would confirm from those scans.
+  std::size_t confirmed_sequential = 0;
   std::vector<FalseDock> examples;            ///< The first kMaxFalseDockExamples false docks.
   std::vector<std::size_t> confirmed_starts;  ///< First scan of the first kMaxFalseDockExamples confirmed windows.
   /// The estimator's counters after the single-scan pass (candidates, rejections by reason).
