@@ -25,19 +25,19 @@ constexpr Real kExtensionMinM = static_cast<Real>(0.04);
 constexpr Real kExtensionMaxM = static_cast<Real>(0.12);
 
 // The decision's cue weights, nats per unit of each DecisionFeatures field. They are the coefficients of a logistic
-// model (so the total is calibrated log-odds) fitted to candidates from simulated docks of every built-in profile,
-// mounting (flush, 0-10 cm gap, glass, free-standing), three lidar models and 5-20 mm noise, against the best
-// candidates in half of the real dock-less recordings; docs/performance.md gives the rates on the other half and on
-// independently generated worlds. Dropped beams and stopping edges are left out: their fitted weights carried the
-// simulator's habits, not the dock's.
-constexpr Real kFitBaseNats = static_cast<Real>(-4.98);     // a dock-sized match by chance
-constexpr Real kFitPerHitNats = static_cast<Real>(1.90);
-constexpr Real kFitPerSqNats = static_cast<Real>(-0.324);
-constexpr Real kBeyondNats = static_cast<Real>(-1.08);
-constexpr Real kFrontNats = static_cast<Real>(-4.41);
-constexpr Real kMissingNats = static_cast<Real>(-3.59);
-constexpr Real kContinuesNats = static_cast<Real>(-2.46);
-constexpr Real kConstraintNats = static_cast<Real>(1.31);   // per e-fold of `constraint`
+// model (so the total is calibrated log-odds) fitted by `dock-sim features` + tools/fit-evidence to candidates from
+// simulated docks of every built-in profile, mounting (flush, 0-10 cm gap, glass, free-standing), three lidar models
+// and 5-20 mm noise, against the best candidates in half of the real dock-less recordings (docs/docks.md gives the
+// commands); docs/performance.md gives the rates on the other half and on independently generated worlds. Dropped
+// beams and stopping edges are left out: their fitted weights carried the simulator's habits, not the dock's.
+constexpr Real kFitBaseNats = static_cast<Real>(-9.82);     // a dock-sized match by chance
+constexpr Real kFitPerHitNats = static_cast<Real>(2.655);
+constexpr Real kFitPerSqNats = static_cast<Real>(-0.412);
+constexpr Real kBeyondNats = static_cast<Real>(-1.109);
+constexpr Real kFrontNats = static_cast<Real>(-2.466);
+constexpr Real kMissingNats = static_cast<Real>(-2.235);
+constexpr Real kContinuesNats = static_cast<Real>(-5.956);
+constexpr Real kConstraintNats = static_cast<Real>(1.078);   // per e-fold of `constraint`
 constexpr Real kMinConstraint = static_cast<Real>(0.01);
 // The inlier gate of the lidars the weights were fitted on (estimator_params_for_noise's floor).
 constexpr Real kReferenceGateM = static_cast<Real>(0.015);
@@ -46,7 +46,7 @@ constexpr Real kReferenceGateM = static_cast<Real>(0.015);
 constexpr Real kGateGrowthShare = static_cast<Real>(0.5);
 // Wall beams. Unknown mounting: the fitted weight of a wall seen; none seen is not held against the dock. A
 // wall-mounted dock: log(0.85/0.2) for a wall where the gap range puts it and log(0.15/0.8) for none.
-constexpr Real kWallSeenUnknownNats = static_cast<Real>(0.363);
+constexpr Real kWallSeenUnknownNats = static_cast<Real>(0.196);
 constexpr Real kWallSeenMountedNats = static_cast<Real>(1.45);
 constexpr Real kWallMissedMountedNats = static_cast<Real>(-1.67);
 // Beams closer together than this on a surface are not independent evidence: rooms are made of smooth surfaces, so

@@ -16,5 +16,7 @@ void register_run(CLI::App& app);
 void register_montecarlo(CLI::App& app);
 /// `dock-sim soak`: N consecutive dock -> charge -> undock cycles of one continuous robot (soak.cpp).
 void register_soak(CLI::App& app);
+/// `dock-sim features`: the estimator's decision features of labelled candidates, CSV (features.cpp).
+void register_features(CLI::App& app);
 
 }  // namespace docksim_cli

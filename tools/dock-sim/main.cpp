@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   docksim_cli::register_run(app);
   docksim_cli::register_montecarlo(app);
   docksim_cli::register_soak(app);
+  docksim_cli::register_features(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -143,7 +143,7 @@ struct EstimatorParams {
   Real extension_band_m = static_cast<Real>(0.02);
   /// Accept a candidate when its evidence (sum of the cues' log-likelihood ratios) reaches this, nats. Higher: fewer
   /// false detections, more misses of partly seen docks. docs/performance.md gives the rates per setting.
-  Real min_evidence_nats = static_cast<Real>(3.5);
+  Real min_evidence_nats = static_cast<Real>(3.8);
   Real max_sigma_m = static_cast<Real>(0.05);     ///< Reject when the position 1-σ (covariance) exceeds this.
   Real max_view_angle_rad = static_cast<Real>(1.2);     ///< Dock face seen more obliquely than this is rejected.
   Real hint_gate_m = static_cast<Real>(0.3);      ///< A verified pose farther than this from the hint ignores it.
