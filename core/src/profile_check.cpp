@@ -49,14 +49,14 @@ bool segments_meet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
 void sym3_eigen(const Mat3& a, Vec3* values, Mat3* vectors) {
   Mat3 m = a;
   Mat3 v = Mat3::Identity();
-  const std::size_t pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  const Eigen::Index pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
   for (int sweep = 0; sweep < 32; ++sweep) {
     const Real off = m(0, 1) * m(0, 1) + m(0, 2) * m(0, 2) + m(1, 2) * m(1, 2);
     const Real diag = m(0, 0) * m(0, 0) + m(1, 1) * m(1, 1) + m(2, 2) * m(2, 2);
     if (!(off > r(1e-30) * diag)) break;
     for (const auto& pq : pairs) {
-      const std::size_t p = pq[0];
-      const std::size_t q = pq[1];
+      const Eigen::Index p = pq[0];
+      const Eigen::Index q = pq[1];
       if (m(p, q) == 0) continue;
       const Real theta = (m(q, q) - m(p, p)) / (2 * m(p, q));
       const Real abs_theta = std::fabs(theta);
