@@ -49,6 +49,9 @@ constexpr Real kGateGrowthShare = static_cast<Real>(0.5);
 constexpr Real kWallSeenUnknownNats = static_cast<Real>(0.196);
 constexpr Real kWallSeenMountedNats = static_cast<Real>(1.45);
 constexpr Real kWallMissedMountedNats = static_cast<Real>(-1.67);
+// Between two verified objects, evidence stronger by this much (a likelihood ratio of e^3 = 20) decides over
+// nearness; closer than that, both are taken for docks and the nearest is chosen.
+constexpr Real kSelectMarginNats = static_cast<Real>(3);
 // Beams closer together than this on a surface are not independent evidence: rooms are made of smooth surfaces, so
 // where one beam lands on a dock-like surface by chance its neighbours do too.
 constexpr Real kCorrelationLengthM = static_cast<Real>(0.05);
@@ -797,10 +800,15 @@ DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lida
     const bool by_hint = params_.select == DockSelect::kHint && hint != nullptr;
     const Real key = by_hint ? dist2(r.pose, hint_lidar) : r.pose.x_m * r.pose.x_m + r.pose.y_m * r.pose.y_m;
     // Two verified poses within the dock's own size explain the same object: keep the one that explains it better
-    // (a face placed on a wing can verify on the beams it predicts, with a worse fit). Otherwise select by key.
+    // (a face placed on a wing can verify on the beams it predicts, with a worse fit). Two objects: one whose
+    // evidence is far stronger wins (a look-alike box nearer than the dock must not take turns with it from scan to
+    // scan); otherwise select by key (nearest, or nearest the hint).
     const bool same_object = best.ok && dist2(r.pose, best.pose) < profile_radius_m_ * profile_radius_m_;
-    const bool better =
-        !best.ok || (same_object ? r.evidence.total_nats > best.evidence.total_nats : key < best_key);
+    const Real margin = r.evidence.total_nats - best.evidence.total_nats;
+    const bool better = !best.ok || (same_object                    ? margin > 0
+                                     : margin > kSelectMarginNats   ? true
+                                     : margin < -kSelectMarginNats  ? false
+                                                                    : key < best_key);
     if (better) {
       best = r;
       best_key = key;
