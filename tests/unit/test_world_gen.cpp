@@ -2,7 +2,9 @@
 // truth is where a clean scan sees the dock, its walls are where the mounting says, and it is deterministic per seed.
 #include "docksim/world_gen.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -17,6 +19,11 @@ using namespace docksim;
 using dockcore::DockMountKind;
 
 namespace {
+// Geometry checks on values that passed through core's Real (metres, up to a few): exact to 1e-9 in the double
+// build, to a few dozen float ulps at 3 m in the float build, where composes and casts round.
+const double kEps =
+    std::max(1e-9, 64.0 * 3.0 * static_cast<double>(std::numeric_limits<dockcore::Real>::epsilon()));
+
 
 constexpr double kDeg = dockcore::kPi / 180.0;
 
@@ -43,8 +50,8 @@ double cross(const Vec2& a, const Vec2& b) {
 bool segments_meet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
   const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a), d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
   if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
-  return dist_to_segment(c, a, b) < 1e-9 || dist_to_segment(d, a, b) < 1e-9 || dist_to_segment(a, c, d) < 1e-9 ||
-         dist_to_segment(b, c, d) < 1e-9;
+  return dist_to_segment(c, a, b) < kEps || dist_to_segment(d, a, b) < kEps || dist_to_segment(a, c, d) < kEps ||
+         dist_to_segment(b, c, d) < kEps;
 }
 
 // A lidar with no noise of any kind, the scene's sampling otherwise.
@@ -76,12 +83,12 @@ TEST(WorldGen, RandomProfilesAreSimplePlausibleAndFaceForward) {
     CHECK_TRUE(p.vertex_count >= 2 && p.vertex_count <= 8);
     ++by_count[p.vertex_count];
     const double w = static_cast<double>(p.width_m());
-    CHECK_TRUE(w >= 0.2 - 1e-9 && w <= 0.7 + 1e-9);
+    CHECK_TRUE(w >= 0.2 - kEps && w <= 0.7 + kEps);
     bool prev_step = false;
     for (std::size_t k = 0; k + 1 < p.vertex_count; ++k) {
       const Vec2 e = p.vertices_m[k + 1] - p.vertices_m[k];
       CHECK_TRUE(e.y() >= 0);                                    // -y to +y: every normal has x >= 0 (faces +x).
-      CHECK_TRUE(static_cast<double>(e.norm()) >= 0.02 - 1e-9);  // Features >= 2 cm.
+      CHECK_TRUE(static_cast<double>(e.norm()) >= 0.02 - kEps);  // Features >= 2 cm.
       const bool step = e.y() == 0;
       CHECK_FALSE(step && prev_step);
       prev_step = step;
@@ -91,7 +98,7 @@ TEST(WorldGen, RandomProfilesAreSimplePlausibleAndFaceForward) {
       // Each bend is >= 2 cm off the line through its neighbours.
       const Vec2 a = p.vertices_m[k - 1], c = p.vertices_m[k + 1];
       const double off = std::fabs(cross(c - a, p.vertices_m[k] - a)) / static_cast<double>((c - a).norm());
-      CHECK_TRUE(off >= 0.02 - 1e-9);
+      CHECK_TRUE(off >= 0.02 - kEps);
     }
     for (std::size_t s = 0; s + 1 < p.vertex_count; ++s) {
       for (std::size_t t = s + 2; t + 1 < p.vertex_count; ++t) {
@@ -99,10 +106,10 @@ TEST(WorldGen, RandomProfilesAreSimplePlausibleAndFaceForward) {
       }
     }
     // The contacts (origin) lie on the outline.
-    CHECK_TRUE(dist_to_outline(p, Vec2(0, 0)) < 1e-9);
+    CHECK_TRUE(dist_to_outline(p, Vec2(0, 0)) < kEps);
     double depth = 0;
     for (std::size_t k = 0; k < p.vertex_count; ++k) depth = std::max(depth, -static_cast<double>(p.vertices_m[k].x()));
-    CHECK_TRUE(depth <= 0.20 + 1e-9);
+    CHECK_TRUE(depth <= 0.20 + kEps);
   }
   for (std::size_t n = 2; n <= 8; ++n) CHECK_TRUE(by_count[n] > 20);
 }
@@ -141,11 +148,11 @@ TEST(WorldGen, DrawsStayInsideTheDocumentedDistributions) {
     const Pose2 l = s.lidar_in_world(0);
     const double dx = static_cast<double>(s.dock_in_world.x_m - l.x_m),
                  dy = static_cast<double>(s.dock_in_world.y_m - l.y_m);
-    DOUBLES_EQUAL(s.distance_m, std::hypot(dx, dy), 1e-9);
-    DOUBLES_EQUAL(s.bearing_rad, std::atan2(dy, dx), 1e-9);
+    DOUBLES_EQUAL(s.distance_m, std::hypot(dx, dy), kEps);
+    DOUBLES_EQUAL(s.bearing_rad, std::atan2(dy, dx), kEps);
     const double facing = std::atan2(-dy, -dx);
     DOUBLES_EQUAL(s.dock_yaw_rad,
-                  static_cast<double>(dockcore::wrap_angle(static_cast<Real>(s.dock_in_world.yaw_rad - facing))), 1e-9);
+                  static_cast<double>(dockcore::wrap_angle(static_cast<Real>(s.dock_in_world.yaw_rad - facing))), kEps);
     // Told mounting: what the world has.
     CHECK_TRUE(dockcore::mounting_valid(s.told_mounting));
     switch (s.mount) {
@@ -224,8 +231,8 @@ TEST(WorldGen, TruthIsWhereACleanScanSeesTheDock) {
     const Pose2 truth = s.dock_in_sensor(0);
     // The robot-frame truth is the sensor-frame truth seen through the true mount.
     const Pose2 via = s.true_mount().compose(truth), robot = s.dock_in_robot(0);
-    DOUBLES_EQUAL(static_cast<double>(robot.x_m), static_cast<double>(via.x_m), 1e-9);
-    DOUBLES_EQUAL(static_cast<double>(robot.y_m), static_cast<double>(via.y_m), 1e-9);
+    DOUBLES_EQUAL(static_cast<double>(robot.x_m), static_cast<double>(via.x_m), kEps);
+    DOUBLES_EQUAL(static_cast<double>(robot.y_m), static_cast<double>(via.y_m), kEps);
     dockcore::PlacedProfile placed;
     placed.place(s.profile, truth);
     double x_back = 1e9;
