@@ -17,7 +17,8 @@
 ///     (as the dock's mounting says: required, evidence when seen, or not looked for) and the pose prior (hint). A
 ///     candidate is accepted when the sum reaches min_evidence_nats. A few structural checks stay hard (too few
 ///     beams, out of range, seen edge-on, pose too uncertain, outside the hint radius).
-///  4. Selection among verified candidates: nearest to the lidar, or nearest to the hint.
+///  4. Selection among accepted candidates: one whose evidence is far stronger (kSelectMarginNats) wins; otherwise
+///     the nearest to the lidar, or the nearest to the hint.
 ///
 /// Cost: O(B) to read the scan (B beams, no trig per beam), O(B) segmentation, then per candidate
 /// O(I · W · S) with I <= max_iterations, W beams in the dock's span, S visible profile segments; at most
@@ -185,7 +186,7 @@ struct DockEstimate {
   Pose2 refused_pose{};
   std::uint8_t iterations = 0;  ///< Gauss-Newton iterations of the winning candidate.
   std::uint16_t candidates = 0; ///< Hypotheses refined this scan.
-  std::uint16_t verified = 0;   ///< Of which passed verification.
+  std::uint16_t verified = 0;   ///< Of which were accepted (passed the hard checks and reached min_evidence_nats).
   bool from_hint = false;       ///< The winner came from the hint (tracking) rather than a global search.
 };
 
