@@ -751,6 +751,17 @@ std::size_t DockPoseEstimator::generate_candidates() {
   return keep;
 }
 
+void DockPoseEstimator::report(const Refined& r, DockEstimate* est) {
+  est->inliers = r.inliers;
+  est->expected = r.expected;
+  est->violations = r.violations;
+  est->occluded = r.occluded;
+  est->extensions = r.extensions;
+  est->wall_seen = r.wall_seen;
+  est->wall_looked = r.wall_looked;
+  est->evidence = r.evidence;
+}
+
 DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lidar_mount, const Pose2* hint) {
   DockEstimate est;
   ++counters_.scans;
@@ -846,16 +857,9 @@ DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lida
   if (!best.ok) {
     est.status = EstimateStatus::kNotVerified;
     if (have_refused) {
-      est.evidence = best_refused.evidence;
+      report(best_refused, &est);
       est.reject = best_refused.reject;
       est.refused_pose = lidar_mount.compose(best_refused.pose);
-      est.inliers = best_refused.inliers;
-      est.expected = best_refused.expected;
-      est.violations = best_refused.violations;
-      est.occluded = best_refused.occluded;
-      est.extensions = best_refused.extensions;
-      est.wall_seen = best_refused.wall_seen;
-      est.wall_looked = best_refused.wall_looked;
     }
     return est;
   }
@@ -885,14 +889,7 @@ DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lida
   est.pose = lidar_mount.compose(best.pose);
   est.rms_m = best.rms_m;
   est.shape_rms_m = best.shape_rms_m;
-  est.inliers = best.inliers;
-  est.expected = best.expected;
-  est.violations = best.violations;
-  est.occluded = best.occluded;
-  est.extensions = best.extensions;
-  est.wall_seen = best.wall_seen;
-  est.wall_looked = best.wall_looked;
-  est.evidence = best.evidence;
+  report(best, &est);
   est.iterations = best.iterations;
   est.from_hint = best_from_hint;
   ++counters_.found;

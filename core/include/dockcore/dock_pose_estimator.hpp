@@ -228,6 +228,8 @@ class DockPoseEstimator {
     bool ok;
     RejectReason reject;
   };
+  /// Copies a candidate's beam counts and evidence into an estimate (accepted or best refused). O(1).
+  static void report(const Refined& r, DockEstimate* est);
   bool load_scan(const ScanView& scan);
   /// Fills points_ from the loaded beams (global search only).
   void build_points();
