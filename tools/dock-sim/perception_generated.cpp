@@ -185,7 +185,24 @@ struct Outcome {
   bool found = false, correct = false;
   Errors sensor, robot;
   double lat_over_crlb = std::nan("");
+  std::string miss;  // when not a correct detection: why (miss_cause)
 };
+
+/// Why a docking scene's dock was not detected, from the estimate: what the best refused candidate was refused for,
+/// whether it lay at the dock (the right pose refused) or elsewhere (the dock never became a candidate that was
+/// refined to it), or that another pose was accepted.
+std::string miss_cause(const dockcore::DockEstimate& e, const Pose2& truth_sensor, const Pose2& mount_inv) {
+  if (e.found) return "found elsewhere";
+  if (e.status != dockcore::EstimateStatus::kNotVerified) return dockcore::to_string(e.status);
+  const Errors d = errors_of(truth_sensor, mount_inv.compose(e.refused_pose));
+  const bool at_dock = d.pos_m <= kCorrectPosM && d.yaw_rad <= kCorrectYawRad;
+  std::string r = std::string(at_dock ? "at dock: " : "elsewhere: ") + dockcore::to_string(e.reject);
+  if (at_dock && e.reject == dockcore::RejectReason::kWeakEvidence) {
+    const dockcore::EvidenceCue w = e.evidence.weakest();
+    if (w != dockcore::EvidenceCue::kCount) r += std::string(", weakest ") + dockcore::to_string(w);
+  }
+  return r;
+}
 
 struct DockRecord {
   std::string excluded;
@@ -265,11 +282,13 @@ DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
     const dockcore::DockEstimate e = w.est[c]->estimate(w.scan->view(), s.lidar_mount);
     Outcome& o = r.c[c];
     o.found = e.found;
-    if (!e.found) continue;
-    o.sensor = errors_of(truth_sensor, mount_inv.compose(e.pose));
-    o.robot = errors_of(truth_robot, e.pose);
-    o.correct = o.sensor.pos_m <= kCorrectPosM && o.sensor.yaw_rad <= kCorrectYawRad;
-    if (crlb_lat > 0) o.lat_over_crlb = o.sensor.lat_m / crlb_lat;
+    if (e.found) {
+      o.sensor = errors_of(truth_sensor, mount_inv.compose(e.pose));
+      o.robot = errors_of(truth_robot, e.pose);
+      o.correct = o.sensor.pos_m <= kCorrectPosM && o.sensor.yaw_rad <= kCorrectYawRad;
+      if (crlb_lat > 0) o.lat_over_crlb = o.sensor.lat_m / crlb_lat;
+    }
+    if (!o.correct) o.miss = miss_cause(e, truth_sensor, mount_inv);
   }
   return r;
 }
@@ -601,6 +620,28 @@ json run_generated(const GeneratedOptions& o) {
     }
     out["overall"] = overall;
   }
+  // Misses in the envelope at σ ≤ 20 mm by cause, most frequent first.
+  {
+    json misses;
+    for (int c = 0; c < kCases; ++c) {
+      std::map<std::string, int> count[2];
+      int n[2] = {};
+      for (const auto& r : docks) {
+        if (!r.excluded.empty() || !in_envelope(r, -1) || r.noise > 1) continue;
+        ++n[r.noise];
+        if (!r.c[c].correct) ++count[r.noise][r.c[c].miss];
+      }
+      for (int k = 0; k < 2; ++k) {
+        std::vector<std::pair<int, std::string>> v;
+        for (const auto& [why, m] : count[k]) v.emplace_back(m, why);
+        std::stable_sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+        json rows = json::array();
+        for (const auto& [m, why] : v) rows.push_back(json{{"cause", why}, {"misses", m}});
+        misses[kCaseNames[c]][k == 0 ? "sigma_le_10mm" : "sigma_10_20mm"] = json{{"scenes", n[k]}, {"causes", rows}};
+      }
+    }
+    out["misses"] = misses;
+  }
   // False positives by look-alike.
   {
     json rows = json::array();
@@ -798,6 +839,19 @@ void print_generated(const json& j) {
   std::printf("\n-- overall\n");
   print_header(kFactorColumns);
   for (int c = 0; c < kCases; ++c) print_row(kFactorColumns, factor_cells("all", c, j["overall"][kCaseNames[c]]));
+
+  std::printf("\n-- misses in the envelope by cause (share of the scenes of that noise class)\n");
+  for (int c = 0; c < kCases; ++c) {
+    for (const char* k : {"sigma_le_10mm", "sigma_10_20mm"}) {
+      const json& m = j["misses"][kCaseNames[c]][k];
+      const int n = m["scenes"].get<int>();
+      std::printf("%s, %s (%d scenes):\n", kCaseNames[c], std::string(k) == "sigma_le_10mm" ? "σ ≤ 10 mm" : "σ 10-20 mm",
+                  n);
+      for (const auto& row : m["causes"])
+        std::printf("  %6.2f %%  %5d  %s\n", n ? 100.0 * row["misses"].get<int>() / n : 0.0, row["misses"].get<int>(),
+                    row["cause"].get<std::string>().c_str());
+    }
+  }
 
   std::printf("\n-- false positives by look-alike (dock-less scenes)\n");
   const std::vector<Column> lc = {
