@@ -80,6 +80,9 @@ void Daemon::build_core() {
   core_cfg_.task = cfg_.task;
   core_cfg_.footprint = cfg_.footprint;
   core_cfg_.lidar_mount = cfg_.lidar_mount;
+  core_cfg_.drive = cfg_.drive;
+  core_cfg_.limits = cfg_.limits;
+  core_cfg_.control_period_s = static_cast<Real>(kNominalTickUs) * static_cast<Real>(1e-6);
   // dockd's own watchdog (receive time, lidar_stale_ms) is the tight one; Dockcore's scan-stamp check is a backstop
   // that must not fire first (a scan's stamp is its first sample, a whole turn before delivery).
   core_cfg_.lidar_stale_s = static_cast<Real>(cfg_.lidar_stale_ms) * static_cast<Real>(1e-3) + static_cast<Real>(0.3);
@@ -187,7 +190,6 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
     return false;
   }
   io_.stderr_level = cfg_.log_level;
-  prev_cmd_ = dockcore::Twist2{};
   ++counters_.config_reloads;
   message = cfg_.source + ": config reloaded";
   log_reload(now_us, "applied", message, LogLevel::kWarn);
@@ -271,7 +273,7 @@ void Daemon::send_zero(std::uint64_t, int frames) {
   dockcore::hal::WheelCommand z;
   z.count = static_cast<std::uint8_t>(dockcore::drive_wheel_count(cfg_.drive.kind));
   for (int i = 0; i < frames; ++i) send_wheels(z);
-  prev_cmd_ = dockcore::Twist2{};
+  if (core_) core_->note_drive_stopped();
 }
 
 void Daemon::log_shutdown(std::uint64_t now_us, const char* reason) {
@@ -668,6 +670,7 @@ void Daemon::on_tick(std::uint64_t now_us) {
   const std::uint64_t fault_after = static_cast<std::uint64_t>(cfg_.watchdog_fault_after_ms) * 1000u;
   in.chassis_ok = !(chassis_stale_ && now_us - chassis_stale_since_us_ >= fault_after);
   in.lidar_ok = !(lidar_stale_ && now_us - lidar_stale_since_us_ >= fault_after);
+  in.hold = lidar_stale_ || chassis_stale_;
 
   // Watchdog resume: a command interrupted by a watchdog fault is re-issued once the data has been fresh for
   // kResumeHoldUs, at most kMaxResumes times per task (docs/dockd.md, "Watchdogs").
@@ -762,20 +765,11 @@ void Daemon::on_tick(std::uint64_t now_us) {
   }
   if (after == TaskState::kNotTasking || after == TaskState::kFinishTasking) running_cmd_ = HostCommandType::kNone;
 
-  // Motion: zero when a watchdog holds, whatever the task manager says (it faults on the same tick anyway).
-  dockcore::Twist2 cmd_twist{};
-  const bool hold = lidar_stale_ || chassis_stale_;
-  if (!hold) {
-    cmd_twist = dockcore::saturate_twist(cfg_.drive, cfg_.limits, out.cmd);
-    cmd_twist = dockcore::limit_acceleration(cfg_.limits, prev_cmd_, cmd_twist, static_cast<Real>(kNominalTickUs) * static_cast<Real>(1e-6));
-    // A zero twist (stop, fault, idle) is sent at once: the drive's own limits do the braking.
-    if (out.cmd.vx_mps == 0 && out.cmd.vy_mps == 0 && out.cmd.wz_radps == 0) cmd_twist = dockcore::Twist2{};
-  }
-  prev_cmd_ = cmd_twist;
-  const dockcore::WheelSpeeds ws = dockcore::twist_to_wheels(cfg_.drive, cmd_twist);
+  // Motion: Dockcore's shaped wheel speeds; zero while a watchdog holds (the task manager faults on the same tick
+  // anyway once the gap lasts).
   dockcore::hal::WheelCommand wc;
-  wc.count = static_cast<std::uint8_t>(ws.count);
-  for (std::size_t i = 0; i < ws.count && i < 4; ++i) wc.radps[i] = ws.radps[i];
+  wc.count = static_cast<std::uint8_t>(out.wheels.count);
+  for (std::size_t i = 0; i < out.wheels.count && i < 4; ++i) wc.radps[i] = out.wheels.radps[i];
   send_wheels(wc);
 
   const bool charge = out.status.charge_enable;
@@ -910,7 +904,7 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       static_cast<double>(fb_.battery_current_a), static_cast<double>(fb_.battery_voltage_v),
       static_cast<double>(fb_.soc), fb_.estop ? "true" : "false", lidar_stale_ ? "true" : "false",
       chassis_stale_ ? "true" : "false", static_cast<double>(odom_.x_m), static_cast<double>(odom_.y_m),
-      deg(odom_.yaw_rad), static_cast<double>(prev_cmd_.vx_mps), static_cast<double>(prev_cmd_.wz_radps),
+      deg(odom_.yaw_rad), static_cast<double>(core_->drive_cmd().vx_mps), static_cast<double>(core_->drive_cmd().wz_radps),
       teach_.active ? "true" : "false", state_.find(s.dock_id) != nullptr ? "true" : "false",
       static_cast<unsigned long long>(stats_.ticks), static_cast<unsigned long long>(stats_.worst_period_us),
       static_cast<unsigned long long>(stats_.overruns), static_cast<unsigned long long>(stats_.worst_work_us),

@@ -248,7 +248,6 @@ class Daemon {
 
   // Output.
   dockcore::TickOutput last_out_{};
-  dockcore::Twist2 prev_cmd_{};
   dockcore::hal::WheelCommand last_wheels_{};
   bool charge_requested_ = false;
   std::uint32_t charge_refresh_ = 0;

@@ -1054,3 +1054,63 @@ TEST(Dockcore, PushDuringALidarGapIsStillReported) {
     }
   }
 }
+
+TEST(Dockcore, DriveCommandIsSaturatedRateLimitedAndZeroedAtOnce) {
+  FacadeSim f;
+  DockcoreConfig cfg;
+  cfg.task.detect_wait_s = 0.3;
+  cfg.limits.max_vx_mps = 0.2;
+  cfg.limits.max_linear_accel_mps2 = 0.5;
+  cfg.limits.max_angular_accel_radps2 = 2.0;
+  cfg.control_period_s = 0.02;
+  CHECK(f.core->configure(f.w.profile, cfg));
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  bool moved = false;
+  Twist2 prev{};
+  for (int i = 0; i < 400 && f.core->task_manager().state() != TaskState::kFinishTasking; ++i) {
+    const TickOutput o = f.step();
+    const bool want_zero = o.cmd.vx_mps == 0 && o.cmd.vy_mps == 0 && o.cmd.wz_radps == 0;
+    if (want_zero) {
+      // A stop is sent at once, however fast the robot was going.
+      CHECK(o.drive_cmd.vx_mps == 0 && o.drive_cmd.wz_radps == 0);
+    } else {
+      moved = true;
+      CHECK(std::fabs(o.drive_cmd.vx_mps) <= 0.2 + 1e-9);
+      CHECK(std::fabs(o.drive_cmd.vx_mps - prev.vx_mps) <= 0.5 * 0.02 + 1e-9);
+      CHECK(std::fabs(o.drive_cmd.wz_radps - prev.wz_radps) <= 2.0 * 0.02 + 1e-9);
+    }
+    // The wheels realise exactly the shaped twist.
+    const WheelSpeeds w = twist_to_wheels(cfg.drive, o.drive_cmd);
+    LONGS_EQUAL(2, static_cast<long>(o.wheels.count));
+    REAL_EQUAL(w.radps[0], o.wheels.radps[0], 0);
+    REAL_EQUAL(w.radps[1], o.wheels.radps[1], 0);
+    prev = o.drive_cmd;
+  }
+  CHECK(moved);
+}
+
+TEST(Dockcore, HoldZeroesTheDriveAndTheRampRestartsFromRest) {
+  FacadeSim f;
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  TickOutput o;
+  for (int i = 0; i < 200; ++i) {
+    o = f.step();
+    if (o.drive_cmd.vx_mps != 0) break;
+  }
+  CHECK(o.drive_cmd.vx_mps != 0);
+  // A host hold: the task manager still wants to move, the drive gets zero.
+  TickInput in;
+  in.now_us = f.w.now_us;
+  in.odom_pose = f.w.odom;
+  in.hold = true;
+  const TickOutput held = f.core->tick(in);
+  CHECK(held.cmd.vx_mps != 0 || held.cmd.wz_radps != 0);
+  CHECK(held.drive_cmd.vx_mps == 0 && held.drive_cmd.wz_radps == 0);
+  CHECK(held.wheels.radps[0] == 0 && held.wheels.radps[1] == 0);
+  // Released: the acceleration limit ramps up from rest again.
+  in.hold = false;
+  in.now_us += 20000;
+  const TickOutput next = f.core->tick(in);
+  const DriveLimits lim = f.core->config().limits;
+  CHECK(std::fabs(next.drive_cmd.vx_mps) <= lim.max_linear_accel_mps2 * f.core->config().control_period_s + 1e-9);
+}

@@ -120,6 +120,9 @@ class SoakWorld {
     cfg.task = sc.task;
     cfg.footprint = sc.safety;
     cfg.lidar_mount = sc.lidar_mount;
+    cfg.drive = geom_;
+    cfg.limits = sc.limits;
+    cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
     configured_ = core_->configure(sc.profile, cfg);
     docksim::DockPlacement dp;
     dp.pose_world = sc.dock_pose;
@@ -168,7 +171,6 @@ class SoakWorld {
 
   /// One 5 ms step; true when it held a control tick.
   bool step(dockcore::HostCommandType cmd) {
-    const double dt = sc_.chassis.dt_s;
     const double t = t_s();
     const std::uint64_t now_us = static_cast<std::uint64_t>(std::llround(t * 1e6));
     const docksim::ChassisState& cs = chassis_.state();
@@ -217,12 +219,7 @@ class SoakWorld {
         AllocScope scope;
         last_ = core_->tick(in);
       }
-      const double tick_dt = dt * kStepsPerTick;
-      dockcore::Twist2 c = dockcore::saturate_twist(geom_, sc_.limits, last_.cmd);
-      c = dockcore::limit_acceleration(sc_.limits, prev_cmd_, c, static_cast<Real>(tick_dt));
-      if (last_.cmd.vx_mps == 0 && last_.cmd.vy_mps == 0 && last_.cmd.wz_radps == 0) c = dockcore::Twist2{};
-      prev_cmd_ = c;
-      const dockcore::WheelSpeeds w = dockcore::twist_to_wheels(geom_, c);
+      const dockcore::WheelSpeeds& w = last_.wheels;
       docksim::WheelRadps wr{};
       for (std::size_t i = 0; i < w.count && i < docksim::kMaxWheels; ++i) wr[i] = static_cast<double>(w.radps[i]);
       chassis_.command_wheels(wr);
@@ -258,7 +255,6 @@ class SoakWorld {
   std::uint64_t scans_dropped_ = 0;
   bool have_scan_ = false;
   dockcore::TickOutput last_{};
-  dockcore::Twist2 prev_cmd_{};
   double odom_err_m_ = 0;
 };
 
