@@ -33,6 +33,7 @@
 #include "dockcore/kinematics.hpp"
 #include "docksim/camera_sim.hpp"
 #include "docksim/chassis.hpp"
+#include "docksim/cli_checks.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenario.hpp"
@@ -626,8 +627,10 @@ void register_soak(CLI::App& app) {
   sub->add_option("scenario", o->scenario, "Scenario TOML file without events (docs/scenarios.md)")->required();
   sub->add_option("--cycles", o->cycles, "Dock -> charge -> undock cycles")->capture_default_str();
   sub->add_option("--controller", o->controller, "seed000, seed004, seed003 or smooth (default: the scenario's)");
-  CLI::Option* seed = sub->add_option("--seed", o->seed, "Base seed: starts (montecarlo's trial seeds) and noise "
-                                                         "(default: the scenario's)");
+  CLI::Option* seed = sub->add_option("--seed", o->seed,
+                                      "Base seed: starts (montecarlo's trial seeds) and noise "
+                                      "(default: the scenario's)")
+                          ->check(docksim::non_negative_integer());
   sub->add_option("--charge-s", o->charge_s, "Time on the charger per cycle, s")->capture_default_str();
   sub->add_option("--gap-s", o->gap_s, "Idle time after the robot is carried to its start, s")->capture_default_str();
   sub->add_option("--settle-s", o->settle_s, "Idle time after an undock before the robot is carried, s")->capture_default_str();
