@@ -791,6 +791,33 @@ TEST(TaskManager, TestModeReportsTheDockAndNeverMoves) {
   LONGS_EQUAL(0, s->zero_violations);
 }
 
+TEST(TaskManager, TestModeReportsItsDockIdAndRefusesABadOne) {
+  auto s = std::make_unique<Sim>();
+  TaskOutput o = s->command(HostCommandType::kTestMode, 3);
+  CHECK(o.command_result == CommandResult::kAccepted);
+  CHECK(o.status.state == TaskState::kTestMode);
+  LONGS_EQUAL(3, o.status.dock_id);
+  s->run_for(0.5);
+  LONGS_EQUAL(3, s->out.status.dock_id);
+  o = s->command(HostCommandType::kTestMode, 3);  // again on the same dock: nothing changes
+  CHECK(o.command_result == CommandResult::kAccepted);
+  LONGS_EQUAL(3, o.status.dock_id);
+  o = s->command(HostCommandType::kTestMode, 5);  // another dock while testing: cancel first
+  CHECK(o.command_result == CommandResult::kRejectedBusy);
+  LONGS_EQUAL(3, o.status.dock_id);
+  s->command(HostCommandType::kCancel);
+  // An id the task manager does not accept is refused and changes nothing.
+  s->params.accepted_dock_ids = 0x0Fu;  // ids 0..3
+  s->reconfigure();
+  o = s->command(HostCommandType::kTestMode, 4);
+  CHECK(o.command_result == CommandResult::kRejectedDockId);
+  CHECK(o.status.state == TaskState::kNotTasking);
+  o = s->command(HostCommandType::kTestMode, 40);
+  CHECK(o.command_result == CommandResult::kRejectedDockId);
+  CHECK(o.status.state == TaskState::kNotTasking);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
 TEST(TaskManager, Deterministic) {
   auto run = [] {
     auto s = std::make_unique<Sim>();
