@@ -286,8 +286,18 @@ void Daemon::log_shutdown(std::uint64_t now_us, const char* reason) {
 
 // --- inputs ------------------------------------------------------------------------------------------------------
 
-void Daemon::poll_chassis(std::uint64_t) {
+void Daemon::poll_chassis(std::uint64_t now_us) {
   fb_ = io_.chassis->poll();
+  // Error frames on the bus (bus-off, controller error passive, no ACK, ...): one event per poll that saw new ones.
+  const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
+  if (cc.bus_errors > reported_bus_errors_) {
+    char f[96];
+    std::snprintf(f, sizeof f, "\"bus_errors\":%u,\"bus_off\":%u,\"new\":%u", cc.bus_errors, cc.bus_off,
+                  cc.bus_errors - reported_bus_errors_);
+    log_event(now_us, "can_error", f, cc.bus_off > reported_bus_off_ ? LogLevel::kError : LogLevel::kWarn);
+  }
+  reported_bus_errors_ = cc.bus_errors;
+  reported_bus_off_ = cc.bus_off;
   if (fb_.wheels_stamp_us == 0 || fb_.wheels_stamp_us == last_wheels_stamp_us_) return;
   dockcore::WheelSpeeds w;
   w.count = dockcore::drive_wheel_count(cfg_.drive.kind);

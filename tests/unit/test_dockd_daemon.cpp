@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -186,6 +187,28 @@ TEST(DockdDaemon, DocksChargesAndUndocksInSimulation) {
 }
 
 // A failed attempt says why in the event log (issue #6: CI saw a retry and nothing told its cause): the charger's
+// CAN error frames (counted by the bus, mirrored by the chassis link) reach the session record as can_error events:
+// one per poll that saw new ones, with the totals and how many are new; nothing else changes.
+TEST(DockdDaemon, CanErrorFramesAreLoggedWithTheirTotals) {
+  Rig r("canerr", false, 1.2, true);
+  for (int i = 0; i < 5; ++i) r.tick();
+  CHECK_TRUE(r.events("can_error").empty());
+  r.link.c.bus_errors = 3;  // e.g. error passive, bus error, bus-off
+  r.link.c.bus_off = 1;
+  r.tick();
+  std::string ev = r.events("can_error");
+  STRCMP_CONTAINS("\"bus_errors\":3,\"bus_off\":1,\"new\":3", ev.c_str());
+  for (int i = 0; i < 5; ++i) r.tick();  // nothing new: no further event
+  ev = r.events("can_error");
+  LONGS_EQUAL(1, static_cast<long>(std::count(ev.begin(), ev.end(), '\n')));
+  r.link.c.bus_errors = 5;
+  r.tick();
+  ev = r.events("can_error");
+  LONGS_EQUAL(2, static_cast<long>(std::count(ev.begin(), ev.end(), '\n')));
+  STRCMP_CONTAINS("\"bus_errors\":5,\"bus_off\":1,\"new\":2", ev.c_str());
+  CHECK(r.daemon->state() == TaskState::kNotTasking);
+}
+
 // relay stays open for the first attempt, so WAIT_FOR_CHARGE times out into RETRY with charge_not_confirmed; the
 // second attempt charges.
 TEST(DockdDaemon, RetryEventSaysWhyTheAttemptEnded) {
