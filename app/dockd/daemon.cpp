@@ -352,10 +352,10 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
     have_scan_ = true;
     last_scan_late_ = false;
     last_scan_parsed_us_ = now_us;
-    // A scan is stamped with its first sample: one scan alone cannot say when its turn ended. Taking its start for
-    // its end made the first scan after start-up look one turn old, so the watchdog tripped just before the second
-    // one arrived — a 185 flap that a host docking right away saw in the status (CI, motion_obstacle). The lidar
-    // counts as fresh from the second scan on, when the turn's length is known; the first one still feeds the core.
+    // A scan is stamped with its first sample: one scan alone cannot say when its turn ended (taking its start for its
+    // end would make the first scan after start-up look one turn old and trip the watchdog just before the second).
+    // The lidar counts as fresh from the second scan on, when the turn's length is known; the first one still feeds
+    // the core.
     if (scan_period_us_ != 0 && turn_end_us > last_scan_rx_us_) last_scan_rx_us_ = turn_end_us;
     const dockcore::DockEstimate& e = core_->on_scan(scan_->view(), stamp, odom_at(stamp));
     if (e.found) {

@@ -1,4 +1,4 @@
-// chassis-sim: the scripted chassis of dock-sim (docksim::Chassis, scenario files of issue #3) on a real CAN
+// chassis-sim: the scripted chassis of dock-sim (docksim::Chassis, scenario files) on a real CAN
 // interface, plus the lidar it carries (through dockcore_emu's LidarEmitter on a pty or UDP), in real time.
 //
 // It plays the robot base for dockd in the vcan HIL suite: consumes wheel command frames (dockcore CAN v1 or AgileX

@@ -214,7 +214,7 @@ json run_accuracy(const Options& o) {
   return out;
 }
 
-// ---------------------------------------------------------------- the targets
+// ---------------------------------------------------------------- the perception targets
 
 json run_targets(const Options& o) {
   json out;

@@ -1,4 +1,4 @@
-// `dock-sim soak`: N consecutive dock -> charge -> undock cycles of ONE simulated robot (issue #6 §2).
+// `dock-sim soak`: N consecutive dock -> charge -> undock cycles of ONE simulated robot.
 //
 // Unlike montecarlo (independent runs), one Dockcore, one controller, one chassis, one lidar and one camera live for
 // the whole soak; simulated time, odometry, encoders, battery and every noise stream run on from cycle to cycle.

@@ -1,5 +1,5 @@
 #pragma once
-/// @file The docking task manager (issue #3 §4): host commands, detection search, alignment with any
+/// @file The docking task manager: host commands, detection search, alignment with any
 /// DockingController, obstacle and pose-deviation safety, charging confirmation with retries, undocking, faults.
 ///
 /// One tick (50 Hz in dockd) takes everything the robot knows now (TaskInput) and returns the body twist to command
