@@ -68,8 +68,7 @@ bool read_bounded(const std::string& path, std::size_t max_bytes, std::string& o
 /// robot's own structure (FootprintParams::self_sectors, at most kMaxSelfSectors). Bounds in [-180, 180]; from > to
 /// wraps through 180 (a sector behind the lidar). Stored through wrap_angle, the core's (-pi, pi] convention, so
 /// -180 is the same bearing as 180. A sector whose bounds name one bearing ([10, 10], [-180, 180]) is refused: it
-/// holds no beam in practice, and [-180, 180] reads as "all round", which would hide every obstacle inside the body
-/// again (the filter b426c4c removed).
+/// holds no beam in practice, and [-180, 180] reads as "all round", which would hide every obstacle inside the body.
 void self_sectors(const Parser& p, const toml::node& n, dockcore::FootprintParams& f) {
   const std::string key = p.key();
   const toml::array* a = n.as_array();

@@ -288,8 +288,18 @@ void Daemon::log_shutdown(std::uint64_t now_us, const char* reason) {
 
 // --- inputs ------------------------------------------------------------------------------------------------------
 
-void Daemon::poll_chassis(std::uint64_t) {
+void Daemon::poll_chassis(std::uint64_t now_us) {
   fb_ = io_.chassis->poll();
+  // Error frames on the bus (bus-off, controller error passive, no ACK, ...): one event per poll that saw new ones.
+  const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
+  if (cc.bus_errors > reported_bus_errors_) {
+    char f[96];
+    std::snprintf(f, sizeof f, "\"bus_errors\":%u,\"bus_off\":%u,\"new\":%u", cc.bus_errors, cc.bus_off,
+                  cc.bus_errors - reported_bus_errors_);
+    log_event(now_us, "can_error", f, cc.bus_off > reported_bus_off_ ? LogLevel::kError : LogLevel::kWarn);
+  }
+  reported_bus_errors_ = cc.bus_errors;
+  reported_bus_off_ = cc.bus_off;
   if (fb_.wheels_stamp_us == 0 || fb_.wheels_stamp_us == last_wheels_stamp_us_) return;
   dockcore::WheelSpeeds w;
   w.count = dockcore::drive_wheel_count(cfg_.drive.kind);
@@ -344,10 +354,10 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
     have_scan_ = true;
     last_scan_late_ = false;
     last_scan_parsed_us_ = now_us;
-    // A scan is stamped with its first sample: one scan alone cannot say when its turn ended. Taking its start for
-    // its end made the first scan after start-up look one turn old, so the watchdog tripped just before the second
-    // one arrived — a 185 flap that a host docking right away saw in the status (CI, motion_obstacle). The lidar
-    // counts as fresh from the second scan on, when the turn's length is known; the first one still feeds the core.
+    // A scan is stamped with its first sample: one scan alone cannot say when its turn ended (taking its start for its
+    // end would make the first scan after start-up look one turn old and trip the watchdog just before the second).
+    // The lidar counts as fresh from the second scan on, when the turn's length is known; the first one still feeds
+    // the core.
     if (scan_period_us_ != 0 && turn_end_us > last_scan_rx_us_) last_scan_rx_us_ = turn_end_us;
     const dockcore::DockEstimate& e = core_->on_scan(scan_->view(), stamp, odom_at(stamp));
     if (e.found) {

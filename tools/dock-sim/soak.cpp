@@ -1,4 +1,4 @@
-// `dock-sim soak`: N consecutive dock -> charge -> undock cycles of ONE simulated robot (issue #6 §2).
+// `dock-sim soak`: N consecutive dock -> charge -> undock cycles of ONE simulated robot.
 //
 // Unlike montecarlo (independent runs), one Dockcore, one controller, one chassis, one lidar and one camera live for
 // the whole soak; simulated time, odometry, encoders, battery and every noise stream run on from cycle to cycle.
@@ -33,6 +33,7 @@
 #include "dockcore/kinematics.hpp"
 #include "docksim/camera_sim.hpp"
 #include "docksim/chassis.hpp"
+#include "docksim/cli_checks.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenario.hpp"
@@ -622,8 +623,10 @@ void register_soak(CLI::App& app) {
   sub->add_option("scenario", o->scenario, "Scenario TOML file without events (docs/scenarios.md)")->required();
   sub->add_option("--cycles", o->cycles, "Dock -> charge -> undock cycles")->capture_default_str();
   sub->add_option("--controller", o->controller, "seed000, seed004, seed003 or smooth (default: the scenario's)");
-  CLI::Option* seed = sub->add_option("--seed", o->seed, "Base seed: starts (montecarlo's trial seeds) and noise "
-                                                         "(default: the scenario's)");
+  CLI::Option* seed = sub->add_option("--seed", o->seed,
+                                      "Base seed: starts (montecarlo's trial seeds) and noise "
+                                      "(default: the scenario's)")
+                          ->check(docksim::non_negative_integer());
   sub->add_option("--charge-s", o->charge_s, "Time on the charger per cycle, s")->capture_default_str();
   sub->add_option("--gap-s", o->gap_s, "Idle time after the robot is carried to its start, s")->capture_default_str();
   sub->add_option("--settle-s", o->settle_s, "Idle time after an undock before the robot is carried, s")->capture_default_str();
