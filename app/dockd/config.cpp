@@ -13,9 +13,9 @@
 
 #include <toml++/toml.h>
 
-#include "dockcore/drivers/estimator_toml.hpp"
-#include "dockcore/drivers/profile_toml.hpp"
-#include "dockcore/drivers/toml_reader.hpp"
+#include "dockcore/params/estimator_toml.hpp"
+#include "dockcore/params/profile_toml.hpp"
+#include "dockcore/params/toml_reader.hpp"
 
 namespace dockd {
 
@@ -24,14 +24,14 @@ using dockcore::Vec2;
 
 namespace {
 
-using dockcore::drivers::toml_reader::dir_of;
-using dockcore::drivers::toml_reader::Handler;
-using dockcore::drivers::toml_reader::Handlers;
-using dockcore::drivers::toml_reader::kDeg;
-using dockcore::drivers::toml_reader::type_name;
+using dockcore::params::toml_reader::dir_of;
+using dockcore::params::toml_reader::Handler;
+using dockcore::params::toml_reader::Handlers;
+using dockcore::params::toml_reader::kDeg;
+using dockcore::params::toml_reader::type_name;
 /// Every key dispatched to a handler, unknown keys and bad values reported at their TOML source position (the same
 /// reader as dock-sim's scenarios).
-using Parser = dockcore::drivers::toml_reader::Reader<ConfigError>;
+using Parser = dockcore::params::toml_reader::Reader<ConfigError>;
 
 /// Reads a regular file of at most `max_bytes` into `out`. False + reason otherwise: a FIFO, a device (/dev/zero)
 /// or an oversized file must not block dockd or grow its memory without bound.
@@ -112,8 +112,8 @@ dockcore::DockProfile load_profile(const Parser& p, const toml::node& at, const 
   std::string text, why;
   if (!read_bounded(path, kMaxProfileFileBytes, text, why)) p.fail(at.source(), "profile file " + path + ": " + why);
   try {
-    return dockcore::drivers::profile_toml::parse<ConfigError>(text, path,
-                                                               dockcore::drivers::profile_toml::name_from_path(path));
+    return dockcore::params::profile_toml::parse<ConfigError>(text, path,
+                                                               dockcore::params::profile_toml::name_from_path(path));
   } catch (const ConfigError& e) {
     const toml::source_position& w = at.source().begin;
     throw ConfigError(std::string(e.what()) + " (dock profile named at " + p.src() + ":" + std::to_string(w.line) +
@@ -176,7 +176,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   std::vector<std::pair<bool, dockcore::DockMounting>> dock_mountings;
   auto mounting_handler = [&](std::pair<bool, dockcore::DockMounting>* out, const std::string& path) {
     return [&p, out, path](const toml::node& v) {
-      *out = {true, dockcore::drivers::profile_toml::read_mounting(p, v, path)};
+      *out = {true, dockcore::params::profile_toml::read_mounting(p, v, path)};
     };
   };
 
@@ -460,7 +460,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
       {"estimator", p.sub("estimator.", [&]() {
          // The estimator's tuning, the same keys and bounds as dock-sim's scenarios; the range keys are in [lidar].
          Handlers h;
-         dockcore::drivers::estimator_toml::add_keys(p, h, c.estimator, "estimator.");
+         dockcore::params::estimator_toml::add_keys(p, h, c.estimator, "estimator.");
          return h;
        })},
       {"controller", p.sub("controller.", controller)},

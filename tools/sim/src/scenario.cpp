@@ -10,9 +10,9 @@
 
 #include <toml++/toml.h>
 
-#include "dockcore/drivers/estimator_toml.hpp"
-#include "dockcore/drivers/profile_toml.hpp"
-#include "dockcore/drivers/toml_reader.hpp"
+#include "dockcore/params/estimator_toml.hpp"
+#include "dockcore/params/profile_toml.hpp"
+#include "dockcore/params/toml_reader.hpp"
 
 #include "docksim/profile_file.hpp"
 
@@ -59,11 +59,11 @@ namespace {
 
 using dockcore::Real;
 using dockcore::Vec2;
-using dockcore::drivers::toml_reader::dir_of;
-using dockcore::drivers::toml_reader::Handler;
-using dockcore::drivers::toml_reader::Handlers;
-using dockcore::drivers::toml_reader::kDeg;
-using dockcore::drivers::toml_reader::type_name;
+using dockcore::params::toml_reader::dir_of;
+using dockcore::params::toml_reader::Handler;
+using dockcore::params::toml_reader::Handlers;
+using dockcore::params::toml_reader::kDeg;
+using dockcore::params::toml_reader::type_name;
 
 std::string stem_of(const std::string& path) {
   const std::size_t slash = path.find_last_of('/');
@@ -73,7 +73,7 @@ std::string stem_of(const std::string& path) {
 }
 
 /// The strict key reader (shared with dockd's config) plus the scenario's array forms.
-class Parser : public dockcore::drivers::toml_reader::Reader<ScenarioError> {
+class Parser : public dockcore::params::toml_reader::Reader<ScenarioError> {
  public:
   using Reader::Reader;
 
@@ -302,7 +302,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         {"wall_glass", p.flag(&sc.wall_glass)},
         {"wall_half_length_m", p.num(&sc.wall_half_length_m, 0.1, 100)},
         {"mounting", [&](const toml::node& n) {
-           st.mounting = dockcore::drivers::profile_toml::read_mounting(p, n, "dock.mounting.");
+           st.mounting = dockcore::params::profile_toml::read_mounting(p, n, "dock.mounting.");
            st.mounting_set = true;
          }},
         {"furniture", [&](const toml::node& n) {
@@ -500,7 +500,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
                {"min_range_m", p.real(&e.min_range_m, 0, 10)},
                {"range_sigma_m", p.real(&e.range_sigma_m, 0.0001, 1)}};
     // The tuning keys dockd's [estimator] takes, with the same bounds.
-    dockcore::drivers::estimator_toml::add_keys(p, h, e, "estimator.");
+    dockcore::params::estimator_toml::add_keys(p, h, e, "estimator.");
     return h;
   };
 

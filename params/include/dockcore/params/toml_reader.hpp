@@ -21,7 +21,7 @@
 
 #include "dockcore/geometry.hpp"
 
-namespace dockcore::drivers::toml_reader {
+namespace dockcore::params::toml_reader {
 
 inline constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
@@ -191,4 +191,4 @@ class Reader {
   mutable std::map<std::string, toml::source_region> where_;
 };
 
-}  // namespace dockcore::drivers::toml_reader
+}  // namespace dockcore::params::toml_reader

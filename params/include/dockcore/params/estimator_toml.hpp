@@ -13,9 +13,9 @@
 #include <toml++/toml.h>
 
 #include "dockcore/dock_pose_estimator.hpp"
-#include "dockcore/drivers/toml_reader.hpp"
+#include "dockcore/params/toml_reader.hpp"
 
-namespace dockcore::drivers::estimator_toml {
+namespace dockcore::params::estimator_toml {
 
 /// Appends the handlers of the estimator's tuning keys to `h`; each stores its checked value in `e`. `prefix` is the
 /// table's name in messages ("estimator."). Keys and bounds:
@@ -70,4 +70,4 @@ void add_keys(const toml_reader::Reader<Error>& p, toml_reader::Handlers& h, Est
   }));
 }
 
-}  // namespace dockcore::drivers::estimator_toml
+}  // namespace dockcore::params::estimator_toml
