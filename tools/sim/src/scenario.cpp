@@ -264,7 +264,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         {"angular_jitter_deg", [&](const toml::node& n) { st.lidar_jitter_rad = p.number(n, 0, 10) * kDeg; }},
         {"mixed_pixels", [&](const toml::node& n) { st.mixed_pixels = p.boolean(n) ? 1 : 0; }},
         {"rate_hz", [&](const toml::node& n) { st.lidar_rate_hz = p.number(n, 0.5, 100); }},
-        {"max_range_m", [&](const toml::node& n) { st.lidar_max_range_m = p.number(n, 0.5, 100); }},
+        // The sensor's range, under the name of dockd's [lidar] range key: it takes that key's bounds.
+        {"max_range_m", params::bounded_by(p, "lidar", "max_range_m", &st.lidar_max_range_m)},
         {"latency_s", p.num(&sc.scan_latency_s, 0, 2)},
     };
   };
