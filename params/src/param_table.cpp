@@ -16,47 +16,49 @@ constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 }  // namespace
 
 // One entry per parameter. T is the ParamTargets member, M the field within that struct.
-#define DC_REAL(TBL, KEY, UNIT, LO, HI, USE, T, M, MEANING)                                    \
-  ParamSpec {                                                                                  \
-    TBL, KEY, UNIT, ParamType::kReal, LO, HI, USE, MEANING,                                    \
-        [](const ParamTargets& t) { return static_cast<double>(t.T->M); },                     \
-        [](const ParamTargets& t, double v) { t.T->M = static_cast<Real>(v); }                 \
+#define DC_REAL(TBL, KEY, UNIT, LO, HI, USE, T, M, MEANING)                    \
+  ParamSpec {                                                                  \
+    TBL, KEY, UNIT, ParamType::kReal, LO, HI, USE, MEANING,                    \
+        [](const ParamTargets& t) { return static_cast<double>(t.T->M); },     \
+        [](const ParamTargets& t, double v) { t.T->M = static_cast<Real>(v); } \
   }
-#define DC_DEG(TBL, KEY, LO, HI, USE, T, M, MEANING)                                           \
-  ParamSpec {                                                                                  \
-    TBL, KEY, "°", ParamType::kDegrees, LO, HI, USE, MEANING,                                  \
-        [](const ParamTargets& t) { return static_cast<double>(t.T->M) * kDegPerRad; },        \
-        [](const ParamTargets& t, double v) { t.T->M = static_cast<Real>(v * kRadPerDeg); }    \
+#define DC_DEG(TBL, KEY, LO, HI, USE, T, M, MEANING)                                        \
+  ParamSpec {                                                                               \
+    TBL, KEY, "°", ParamType::kDegrees, LO, HI, USE, MEANING,                               \
+        [](const ParamTargets& t) { return static_cast<double>(t.T->M) * kDegPerRad; },     \
+        [](const ParamTargets& t, double v) { t.T->M = static_cast<Real>(v * kRadPerDeg); } \
   }
-#define DC_INT(TBL, KEY, UNIT, LO, HI, USE, T, M, MEANING)                                     \
-  ParamSpec {                                                                                  \
-    TBL, KEY, UNIT, ParamType::kInteger, LO, HI, USE, MEANING,                                 \
-        [](const ParamTargets& t) { return static_cast<double>(t.T->M); },                     \
-        [](const ParamTargets& t, double v) {                                                  \
-          t.T->M = static_cast<std::remove_reference_t<decltype(t.T->M)>>(static_cast<std::int64_t>(v)); \
-        }                                                                                      \
+#define DC_INT(TBL, KEY, UNIT, LO, HI, USE, T, M, MEANING)                                                       \
+  ParamSpec {                                                                                                    \
+    TBL, KEY, UNIT, ParamType::kInteger, LO, HI, USE, MEANING,                                                   \
+        [](const ParamTargets& t) { return static_cast<double>(t.T->M); }, [](const ParamTargets& t, double v) { \
+          t.T->M = static_cast<std::remove_reference_t<decltype(t.T->M)>>(static_cast<std::int64_t>(v));         \
+        }                                                                                                        \
   }
-#define DC_BOOL(TBL, KEY, USE, T, M, MEANING)                                                  \
-  ParamSpec {                                                                                  \
-    TBL, KEY, "–", ParamType::kBool, 0, 1, USE, MEANING,                                       \
-        [](const ParamTargets& t) { return t.T->M ? 1.0 : 0.0; },                              \
-        [](const ParamTargets& t, double v) { t.T->M = v != 0; }                               \
+#define DC_BOOL(TBL, KEY, USE, T, M, MEANING)                                                                      \
+  ParamSpec {                                                                                                      \
+    TBL, KEY, "–", ParamType::kBool, 0, 1, USE, MEANING, [](const ParamTargets& t) { return t.T->M ? 1.0 : 0.0; }, \
+        [](const ParamTargets& t, double v) { t.T->M = v != 0; }                                                   \
   }
 // A setting every controller shares, written into all four controllers' DockingCommonParams.
-#define DC_COMMON(KEY, UNIT, LO, HI, USE, M, MEANING)                                          \
-  ParamSpec {                                                                                  \
-    "controller", KEY, UNIT, ParamType::kReal, LO, HI, USE, MEANING,                           \
-        [](const ParamTargets& t) { return static_cast<double>(t.smooth->common.M); },         \
-        [](const ParamTargets& t, double v) {                                                  \
-          const Real r = static_cast<Real>(v);                                                 \
-          t.seed000->common.M = t.seed004->common.M = r;                                       \
-          t.seed003->common.M = t.smooth->common.M = r;                                        \
-        }                                                                                      \
+#define DC_COMMON(KEY, UNIT, LO, HI, USE, M, MEANING)                                  \
+  ParamSpec {                                                                          \
+    "controller", KEY, UNIT, ParamType::kReal, LO, HI, USE, MEANING,                   \
+        [](const ParamTargets& t) { return static_cast<double>(t.smooth->common.M); }, \
+        [](const ParamTargets& t, double v) {                                          \
+          const Real r = static_cast<Real>(v);                                         \
+          t.seed000->common.M = t.seed004->common.M = r;                               \
+          t.seed003->common.M = t.smooth->common.M = r;                                \
+        }                                                                              \
   }
 // The shared settings given for one controller only (dock-sim's per-controller tables), with the shared keys' bounds.
 #define DC_COMMON_OF(TBL, T)                                                                   \
-  DC_REAL(TBL, "pad_reach_m", "m", 0.01, 3, kScenario, T, common.pad_reach_m,                  \
-          "This controller only: robot centre to the pads' centre."),                          \
+  [] {                                                                                         \
+    ParamSpec s = DC_REAL(TBL, "pad_reach_m", "m", 0.01, 3, kScenario, T, common.pad_reach_m,  \
+                          "This controller only: robot centre to the pads' centre.");          \
+    s.default_text = "from the footprint";                                                     \
+    return s;                                                                                  \
+  }(),                                                                                         \
       DC_REAL(TBL, "creep_speed_mps", "m/s", 0.001, 1, kScenario, T, common.creep_speed_mps,   \
               "This controller only: slowest approach speed."),                                \
       DC_REAL(TBL, "stall_press_m", "m", -0.1, 0.1, kScenario, T, common.stall_press_m,        \
@@ -93,7 +95,14 @@ const ParamSpec kTable[] = {
     // [robot.footprint]: the obstacle check (dockcore FootprintParams). A scenario derives the body's outline from
     // its chassis (length_m, width_m, radius_m, centre_x_m); dockd gives it directly.
     [] {
-      ParamSpec s{"robot.footprint", "shape", "–", ParamType::kChoice, 0, 1, kBoth, "Body outline.",
+      ParamSpec s{"robot.footprint",
+                  "shape",
+                  "–",
+                  ParamType::kChoice,
+                  0,
+                  1,
+                  kBoth,
+                  "Body outline.",
                   [](const ParamTargets& t) { return t.footprint->shape == FootprintShape::kCircular ? 1.0 : 0.0; },
                   [](const ParamTargets& t, double v) {
                     t.footprint->shape = v != 0 ? FootprintShape::kCircular : FootprintShape::kSquare;
@@ -170,13 +179,19 @@ const ParamSpec kTable[] = {
     DC_REAL("estimator", "max_sigma_m", "m", 0.001, 1, kBoth, estimator, max_sigma_m,
             "Position 1-σ from the covariance, at most."),
     DC_DEG("estimator", "max_view_angle_deg", 1, 90, kBoth, estimator, max_view_angle_rad,
-           "Dock face seen more obliquely than this is refused."),
+           "Dock face seen more obliquely than this is refused (default 1.2 rad)."),
     DC_REAL("estimator", "hint_gate_m", "m", 0, 5, kBoth, estimator, hint_gate_m,
             "A verified pose farther than this from the hint ignores the hint."),
     DC_REAL("estimator", "hint_radius_m", "m", 0, 10, kBoth, estimator, hint_radius_m,
             "With a hint, only docks within this distance of it are accepted; 0: anywhere."),
     [] {
-      ParamSpec s{"estimator", "select", "–", ParamType::kChoice, 0, 1, kBoth,
+      ParamSpec s{"estimator",
+                  "select",
+                  "–",
+                  ParamType::kChoice,
+                  0,
+                  1,
+                  kBoth,
                   "Which verified dock wins: the nearest, or the one nearest the hint.",
                   [](const ParamTargets& t) { return t.estimator->select == DockSelect::kHint ? 1.0 : 0.0; },
                   [](const ParamTargets& t, double v) {
@@ -249,11 +264,13 @@ const ParamSpec kTable[] = {
     DC_REAL("task", "task_timeout_s", "s", 1, 3600, kBoth, task, task_timeout_s,
             "Docking (GET_TASKING_CMD..WAIT_FOR_CHARGE) longer: fault 189."),
     DC_REAL("task", "check_distance_error_tolerance_m", "m", 0, 100, kBoth, task,
-            deviation.check_distance_error_tolerance_m, "Dock estimate this far from the expected one: fault."),
+            deviation.check_distance_error_tolerance_m,
+            "The robot may be at most this far from the dock during alignment (fault 178)."),
     DC_REAL("task", "push_distance_tolerance_m", "m", 0, 100, kBoth, task, deviation.push_distance_tolerance_m,
-            "Robot moved this far without odometry seeing it (pushed): fault 178."),
-    DC_DEG("task", "check_angle_error_tolerance_deg", 0, 180, kBoth, task,
-           deviation.check_angle_error_tolerance_rad, "Dock yaw this far from the expected one: fault 179."),
+            "The dock seen by the lidar may lie at most this far from where odometry expects it (a push moves it: "
+            "fault 178)."),
+    DC_DEG("task", "check_angle_error_tolerance_deg", 0, 180, kBoth, task, deviation.check_angle_error_tolerance_rad,
+           "The dock's yaw seen by the lidar may differ at most this much from where odometry expects it (fault 179)."),
 
     // [controller]: the settings every controller shares, then each controller's own table.
     [] {
@@ -267,7 +284,7 @@ const ParamSpec kTable[] = {
 
     DC_COMMON_OF("controller.seed000", seed000),
     DC_REAL("controller.seed000", "angle_threshold_rad", "rad", 0, 3.2, kScenario, seed000, angle_threshold_rad,
-            "|Centre angle| below this ends the correction."),
+            "Centre angle (absolute) below this ends the correction."),
     DC_REAL("controller.seed000", "rotate_exit_rad", "rad", 0, 3.2, kScenario, seed000, rotate_exit_rad,
             "In-place turn ends within this."),
     DC_REAL("controller.seed000", "rotate_kp", "1/s", 0, 100, kScenario, seed000, rotate_kp,
@@ -329,8 +346,7 @@ const ParamSpec kTable[] = {
             "Filter weight of the raw sample."),
     DC_REAL("controller.seed003", "stage_switch_m", "m", 0, 1e4, kScenario, seed003, stage_switch_m,
             "Stage 1 while the filtered depth exceeds this."),
-    DC_REAL("controller.seed003", "stage1_kw", "rad/s/px", 0, 1e4, kScenario, seed003, stage1_kw,
-            "Stage 1 yaw gain."),
+    DC_REAL("controller.seed003", "stage1_kw", "rad/s/px", 0, 1e4, kScenario, seed003, stage1_kw, "Stage 1 yaw gain."),
     DC_REAL("controller.seed003", "stage1_max_wz_radps", "rad/s", 0, 1e4, kScenario, seed003, stage1_max_wz_radps,
             "Stage 1 yaw-rate cap."),
     DC_REAL("controller.seed003", "stage1_kv", "1/s", 0, 1e4, kScenario, seed003, stage1_kv, "Stage 1 speed gain."),
@@ -371,8 +387,8 @@ const ParamSpec kTable[] = {
 
     DC_COMMON_OF("controller.smooth", smooth),
     [] {
-      ParamSpec s = DC_BOOL("controller.smooth", "backwards", kScenario, smooth, backwards,
-                            "Dock backwards (rear pads).");
+      ParamSpec s =
+          DC_BOOL("controller.smooth", "backwards", kScenario, smooth, backwards, "Dock backwards (rear pads).");
       s.default_text = "pads = \"rear\"";
       return s;
     }(),
@@ -382,8 +398,7 @@ const ParamSpec kTable[] = {
     DC_REAL("controller.smooth", "lambda", "–", 0, 1e4, kScenario, smooth, lambda, "Curvature slow-down: exponent."),
     DC_REAL("controller.smooth", "v_max_mps", "m/s", 0.01, 2, kBoth, smooth, v_max_mps, "Cruise speed."),
     DC_REAL("controller.smooth", "w_max_radps", "rad/s", 0.05, 5, kBoth, smooth, w_max_radps, "Yaw-rate cap."),
-    DC_REAL("controller.smooth", "slowdown_radius_m", "m", 0, 3, kBoth, smooth, slowdown_radius_m,
-            "Slow-down radius."),
+    DC_REAL("controller.smooth", "slowdown_radius_m", "m", 0, 3, kBoth, smooth, slowdown_radius_m, "Slow-down radius."),
     DC_REAL("controller.smooth", "max_decel_mps2", "m/s²", 0, 1e4, kScenario, smooth, max_decel_mps2,
             "Braking profile towards the contact plane."),
     DC_REAL("controller.smooth", "goal_projection_m", "m", 0, 1, kBoth, smooth, goal_projection_m,
@@ -415,11 +430,15 @@ const ParamSpec kTable[] = {
 #undef DC_COMMON
 #undef DC_COMMON_OF
 
-/// Shortest text that reads back as `v` (at most 6 significant digits, as the docs write them).
+/// `v` as the docs write it: an integer in full, otherwise at most 6 significant digits.
 std::string number_text(double v) {
   std::ostringstream s;
-  s.precision(6);
-  s << (v == 0 ? 0.0 : v);
+  if (v == std::floor(v) && std::fabs(v) < 1e15) {
+    s << static_cast<long long>(v);  // bounds such as 1000000 in full
+  } else {
+    s.precision(6);
+    s << v;
+  }
   return s.str();
 }
 
@@ -515,7 +534,7 @@ std::string markdown_table(const std::string& table, ParamUse use) {
 }
 
 std::string update_param_blocks(const std::string& text, std::string& error) {
-  static const std::string kOpen = "<!-- params ", kClose = "<!-- /params -->";
+  const std::string kOpen = "<!-- params ", kClose = "<!-- /params -->";
   std::string out;
   std::size_t pos = 0;
   error.clear();

@@ -62,7 +62,8 @@ std::set<std::string> keys_of(ParamUse use, const std::string& table) {
   std::set<std::string> out;
   if (a == std::string::npos || b == std::string::npos || b < a) return out;
   std::string list = m.substr(a + open.size(), b - a - open.size()) + ", ";
-  for (std::size_t p = 0, q; (q = list.find(", ", p)) != std::string::npos; p = q + 2) out.insert(list.substr(p, q - p));
+  for (std::size_t p = 0, q; (q = list.find(", ", p)) != std::string::npos; p = q + 2)
+    out.insert(list.substr(p, q - p));
   return out;
 }
 

@@ -50,21 +50,21 @@ struct ParamTargets {
 
 /// One parameter.
 struct ParamSpec {
-  const char* table;        ///< TOML table it sits in ("task", "robot.limits", "estimator.segments").
-  const char* key;          ///< Key within that table.
-  const char* unit;         ///< "m", "s", "rad/s", "°", "–", ...
-  ParamType type;
-  double min;               ///< Smallest accepted value, in file units (kReal, kDegrees, kInteger).
-  double max;               ///< Largest accepted value, in file units.
-  std::uint8_t use;         ///< ParamUse bits.
-  const char* meaning;      ///< One line for the docs (Markdown).
+  const char* table;    ///< TOML table it sits in ("task", "robot.limits", "estimator.segments").
+  const char* key;      ///< Key within that table.
+  const char* unit;     ///< "m", "s", "rad/s", "°", "–", ...
+  ParamType type;       ///< How it is written in the file and stored.
+  double min;           ///< Smallest accepted value, in file units (kReal, kDegrees, kInteger).
+  double max;           ///< Largest accepted value, in file units.
+  std::uint8_t use;     ///< ParamUse bits.
+  const char* meaning;  ///< One line for the docs (Markdown).
   /// The value in file units (degrees for kDegrees, the choice's index for kChoice). O(1).
   double (*get)(const ParamTargets&);
   /// Stores a checked value given in file units (degrees for kDegrees, the index for kChoice). O(1).
   void (*set)(const ParamTargets&, double);
-  const char* choices = nullptr;        ///< kChoice: the words, '|'-separated, in index order.
-  const char* dockd_table = nullptr;    ///< dockd's table when it differs from `table` (the range keys: "lidar").
-  const char* default_text = nullptr;   ///< The docs' default when it is not the struct's value ("from the pads").
+  const char* choices = nullptr;       ///< kChoice: the words, '|'-separated, in index order.
+  const char* dockd_table = nullptr;   ///< dockd's table when it differs from `table` (the range keys: "lidar").
+  const char* default_text = nullptr;  ///< The docs' default when it is not the struct's value ("from the footprint").
   /// dock-sim's scenarios start from this value instead of the struct's (NaN: the struct's). The simulated
   /// default robot drives at 0.4 m/s.
   double scenario_default = __builtin_nan("");

@@ -22,11 +22,15 @@ toml_reader::Handler param_handler(const toml_reader::Reader<Error>& p, const Pa
   return [&p, &s, &t](const toml::node& n) {
     switch (s.type) {
       case ParamType::kReal:
-      case ParamType::kDegrees: s.set(t, p.number(n, s.min, s.max)); break;
+      case ParamType::kDegrees:
+        s.set(t, p.number(n, s.min, s.max));
+        break;
       case ParamType::kInteger:
         s.set(t, static_cast<double>(p.integer(n, static_cast<std::int64_t>(s.min), static_cast<std::int64_t>(s.max))));
         break;
-      case ParamType::kBool: s.set(t, p.boolean(n) ? 1.0 : 0.0); break;
+      case ParamType::kBool:
+        s.set(t, p.boolean(n) ? 1.0 : 0.0);
+        break;
       case ParamType::kChoice: {
         std::vector<std::string> words;
         for (std::size_t i = 0; i < choice_count(s); ++i) words.push_back(choice_word(s, i));
@@ -68,8 +72,8 @@ toml_reader::Handler param_sub(const toml_reader::Reader<Error>& p, const std::s
 /// takes that entry's bounds, so the key accepts the same values in both files. Throws std::logic_error when the
 /// table has no such numeric entry (a programming error, caught by the tests). O(table size).
 template <typename Error>
-toml_reader::Handler bounded_by(const toml_reader::Reader<Error>& p, const std::string& table,
-                                const std::string& key, double* out) {
+toml_reader::Handler bounded_by(const toml_reader::Reader<Error>& p, const std::string& table, const std::string& key,
+                                double* out) {
   const ParamSpec* s = find_param(table, key, kDockd);
   if (s == nullptr || s->type != ParamType::kReal) {
     throw std::logic_error("parameter table has no number " + table + "." + key);
