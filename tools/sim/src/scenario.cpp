@@ -216,12 +216,13 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
       CameraSpec& cam = sc.camera;
       return Handlers{
           {"enabled", p.flag(&cam.enabled)},
-          {"fx_px", p.real(&cam.model.fx_px, 1, 1e5)},
-          {"cx_px", p.real(&cam.model.cx_px, 0, 1e5)},
-          {"width_px", p.real(&cam.model.image_width_px, 1, 1e5)},
-          {"x_m", p.real(&cam.model.mount.x_m, -2, 2)},
-          {"y_m", p.real(&cam.model.mount.y_m, -2, 2)},
-          {"yaw_deg", p.real_deg(&cam.model.mount.yaw_rad, -180, 180)},
+          // The camera seed 003 steers by: the bounds of dockd's [controller.seed003] camera keys.
+          {"fx_px", params::bounded_by(p, "controller.seed003", "fx_px", &cam.model.fx_px)},
+          {"cx_px", params::bounded_by(p, "controller.seed003", "cx_px", &cam.model.cx_px)},
+          {"width_px", params::bounded_by(p, "controller.seed003", "image_width_px", &cam.model.image_width_px)},
+          {"x_m", params::bounded_by(p, "controller.seed003", "mount_x_m", &cam.model.mount.x_m)},
+          {"y_m", params::bounded_by(p, "controller.seed003", "mount_y_m", &cam.model.mount.y_m)},
+          {"yaw_deg", params::bounded_by(p, "controller.seed003", "mount_yaw_deg", &cam.model.mount.yaw_rad)},
           {"rate_hz", p.num(&cam.rate_hz, 0.1, 1000)},
           {"latency_s", p.num(&cam.latency_s, 0, 5)},
           {"sigma_px", p.num(&cam.sigma_px, 0, 1000)},

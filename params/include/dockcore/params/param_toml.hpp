@@ -68,17 +68,22 @@ toml_reader::Handler param_sub(const toml_reader::Reader<Error>& p, const std::s
   });
 }
 
-/// A number stored outside the core structs (a scenario's chassis) under a key the table declares for dockd: it
-/// takes that entry's bounds, so the key accepts the same values in both files. Throws std::logic_error when the
-/// table has no such numeric entry (a programming error, caught by the tests). O(table size).
-template <typename Error>
+/// A number stored outside the core structs (a scenario's chassis, camera or sensor; `T` double or Real) under a key
+/// that names the same quantity as a dockd entry of the table: it takes that entry's bounds (and, for kDegrees, its
+/// degrees-in-the-file), so a value the simulation accepts is one the robot accepts. Throws std::logic_error when
+/// the table has no such numeric dockd entry (a programming error, caught by the tests). O(table size).
+template <typename Error, typename T>
 toml_reader::Handler bounded_by(const toml_reader::Reader<Error>& p, const std::string& table, const std::string& key,
-                                double* out) {
+                                T* out) {
   const ParamSpec* s = find_param(table, key, kDockd);
-  if (s == nullptr || s->type != ParamType::kReal) {
+  if (s == nullptr || (s->type != ParamType::kReal && s->type != ParamType::kDegrees)) {
     throw std::logic_error("parameter table has no number " + table + "." + key);
   }
-  return p.num(out, s->min, s->max);
+  const bool degrees = s->type == ParamType::kDegrees;
+  return [&p, s, out, degrees](const toml::node& n) {
+    const double v = p.number(n, s->min, s->max);
+    *out = static_cast<T>(degrees ? v * toml_reader::kDeg : v);
+  };
 }
 
 }  // namespace dockcore::params
