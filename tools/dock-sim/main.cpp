@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   docksim_cli::register_montecarlo(app);
   docksim_cli::register_soak(app);
   docksim_cli::register_features(app);
+  docksim_cli::register_params(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {
