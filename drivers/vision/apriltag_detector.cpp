@@ -3,12 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 extern "C" {
 #include <apriltag/apriltag.h>
 #include <apriltag/apriltag_pose.h>
-#include <apriltag/common/homography.h>
+#include <apriltag/common/image_u8.h>
 #include <apriltag/common/matd.h>
 #include <apriltag/common/zarray.h>
 #include <apriltag/tag16h5.h>
@@ -56,6 +57,60 @@ const FamilyEntry* find_family(const std::string& name) {
   return nullptr;
 }
 
+// Debian's libapriltag 3.3 exports neither matd_create/matd_destroy nor homography_compute. A matd_t is one
+// calloc'ed block (header + data, matd.c), so the pose matrices estimate_tag_pose returns are released with free(),
+// and the 3×3 homography of corrected corners is made and fitted here.
+matd_t* make_mat3() {
+  void* m = std::calloc(1, sizeof(matd_t) + 9 * sizeof(double));
+  if (m == nullptr) return nullptr;
+  matd_t* h = static_cast<matd_t*>(m);
+  h->nrows = 3;
+  h->ncols = 3;
+  return h;
+}
+void free_mat(matd_t* m) { std::free(m); }
+
+/// (x, y) through H (row-major 3×3).
+void project(const matd_t* h, double x, double y, double& ox, double& oy) {
+  const double* a = h->data;
+  const double w = a[6] * x + a[7] * y + a[8];
+  ox = (a[0] * x + a[1] * y + a[2]) / w;
+  oy = (a[3] * x + a[4] * y + a[5]) / w;
+}
+
+/// The homography (h33 = 1) mapping the four `from` points exactly onto `to`: an 8×8 linear system solved by
+/// Gaussian elimination with partial pivoting. False when the points are degenerate.
+bool fit_homography4(const double from[4][2], const double to[4][2], matd_t* h) {
+  double a[8][9];
+  for (int i = 0; i < 4; ++i) {
+    const double x = from[i][0], y = from[i][1], u = to[i][0], v = to[i][1];
+    const double r0[9] = {x, y, 1, 0, 0, 0, -u * x, -u * y, u};
+    const double r1[9] = {0, 0, 0, x, y, 1, -v * x, -v * y, v};
+    for (int j = 0; j < 9; ++j) {
+      a[2 * i][j] = r0[j];
+      a[2 * i + 1][j] = r1[j];
+    }
+  }
+  for (int c = 0; c < 8; ++c) {
+    int piv = c;
+    for (int r = c + 1; r < 8; ++r) {
+      if (std::fabs(a[r][c]) > std::fabs(a[piv][c])) piv = r;
+    }
+    if (std::fabs(a[piv][c]) < 1e-12) return false;
+    if (piv != c) {
+      for (int j = 0; j < 9; ++j) std::swap(a[c][j], a[piv][j]);
+    }
+    for (int r = 0; r < 8; ++r) {
+      if (r == c) continue;
+      const double f = a[r][c] / a[c][c];
+      for (int j = c; j < 9; ++j) a[r][j] -= f * a[c][j];
+    }
+  }
+  for (int i = 0; i < 8; ++i) h->data[i] = a[i][8] / a[i][i];
+  h->data[8] = 1;
+  return true;
+}
+
 /// The tag-frame corner (±1, ±1) that libapriltag's homography maps nearest to each detected corner, so the
 /// corrected homography keeps the library's corner order whatever its convention.
 void tag_corner_coords(const apriltag_detection_t& d, double tag_xy[4][2]) {
@@ -64,7 +119,7 @@ void tag_corner_coords(const apriltag_detection_t& d, double tag_xy[4][2]) {
     double best = 1e300;
     for (const auto& c : cand) {
       double x = 0, y = 0;
-      homography_project(d.H, c[0], c[1], &x, &y);
+      project(d.H, c[0], c[1], x, y);
       const double e = (x - d.p[i][0]) * (x - d.p[i][0]) + (y - d.p[i][1]) * (y - d.p[i][1]);
       if (e < best) {
         best = e;
@@ -156,18 +211,14 @@ class AprilTagDetectorImpl final : public TagDetector {
     if (k.has_distortion()) {
       double tag_xy[4][2];
       tag_corner_coords(d, tag_xy);
-      zarray_t* corr = zarray_create(sizeof(float[4]));
-      for (int i = 0; i < 4; ++i) {
-        undistort_pixel(k, d.p[i][0], d.p[i][1], ideal.p[i][0], ideal.p[i][1]);
-        const float c[4] = {static_cast<float>(tag_xy[i][0]), static_cast<float>(tag_xy[i][1]),
-                            static_cast<float>(ideal.p[i][0]), static_cast<float>(ideal.p[i][1])};
-        zarray_add(corr, c);
+      for (int i = 0; i < 4; ++i) undistort_pixel(k, d.p[i][0], d.p[i][1], ideal.p[i][0], ideal.p[i][1]);
+      h = make_mat3();
+      if (h == nullptr || !fit_homography4(tag_xy, ideal.p, h)) {
+        free_mat(h);
+        return;
       }
-      h = homography_compute(corr, HOMOGRAPHY_COMPUTE_FLAG_SVD);
-      zarray_destroy(corr);
-      if (h == nullptr) return;
       ideal.H = h;
-      homography_project(h, 0, 0, &ideal.c[0], &ideal.c[1]);
+      project(h, 0, 0, ideal.c[0], ideal.c[1]);
       t.u_px = ideal.c[0];
       t.v_px = ideal.c[1];
     }
@@ -181,9 +232,9 @@ class AprilTagDetectorImpl final : public TagDetector {
       }
       t.has_pose = std::isfinite(t.translation_m[2]) && t.translation_m[2] > 0;
     }
-    if (pose.R != nullptr) matd_destroy(pose.R);
-    if (pose.t != nullptr) matd_destroy(pose.t);
-    if (h != nullptr) matd_destroy(h);
+    free_mat(pose.R);
+    free_mat(pose.t);
+    free_mat(h);
   }
 
   TagDetectorOptions opt_;
@@ -195,6 +246,33 @@ class AprilTagDetectorImpl final : public TagDetector {
 }  // namespace
 
 bool is_tag_family(const std::string& name) { return find_family(name) != nullptr; }
+
+bool draw_tag_upright(const std::string& family, int id, std::uint32_t cell_px, std::uint32_t x0_px,
+                      std::uint32_t y0_px, std::uint8_t* grey, std::uint32_t width_px, std::uint32_t height_px,
+                      std::uint32_t stride_bytes, std::uint32_t* black_side_px) {
+  const FamilyEntry* f = find_family(family);
+  if (f == nullptr || cell_px == 0 || grey == nullptr) return false;
+  apriltag_family_t* fam = f->create();
+  bool ok = id >= 0 && static_cast<std::uint32_t>(id) < fam->ncodes;
+  image_u8_t* im = ok ? apriltag_to_image(fam, id) : nullptr;
+  ok = im != nullptr;
+  if (ok) {
+    const std::uint32_t side = static_cast<std::uint32_t>(im->width) * cell_px;
+    ok = x0_px + side <= width_px && y0_px + side <= height_px;
+    if (ok) {
+      for (std::uint32_t r = 0; r < side; ++r) {
+        for (std::uint32_t c = 0; c < side; ++c) {
+          grey[static_cast<std::size_t>(y0_px + r) * stride_bytes + x0_px + c] =
+              im->buf[static_cast<std::size_t>(r / cell_px) * static_cast<std::size_t>(im->stride) + c / cell_px];
+        }
+      }
+      if (black_side_px != nullptr) *black_side_px = static_cast<std::uint32_t>(fam->width_at_border) * cell_px;
+    }
+    image_u8_destroy(im);
+  }
+  f->destroy(fam);
+  return ok;
+}
 
 void distort_pixel(const CameraIntrinsics& k, double u_px, double v_px, double& u_out_px, double& v_out_px) {
   const double x = (u_px - k.cx_px) / k.fx_px, y = (v_px - k.cy_px) / k.fy_px;

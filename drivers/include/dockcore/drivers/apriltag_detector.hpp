@@ -48,6 +48,14 @@ struct TagDetectorOptions {
   int max_hamming = 2;               ///< Bit errors corrected (0..2; libapriltag's default for tag36h11 is 2).
 };
 
+/// Draws tag `id` of `family` upright (no perspective) into a grey image, for tests and the benchmark: `cell_px`
+/// pixels per code cell, the top-left corner of its outer white ring at (x0_px, y0_px). `black_side_px` (optional)
+/// gets the side of the black square in pixels (the tag size the pose uses). False when the family or id is unknown
+/// or the tag does not fit. O(tag pixels); allocates (libapriltag's tag image).
+bool draw_tag_upright(const std::string& family, int id, std::uint32_t cell_px, std::uint32_t x0_px,
+                      std::uint32_t y0_px, std::uint8_t* grey, std::uint32_t width_px, std::uint32_t height_px,
+                      std::uint32_t stride_bytes, std::uint32_t* black_side_px = nullptr);
+
 /// One tag in one frame.
 struct TagDetection {
   int id = 0;
