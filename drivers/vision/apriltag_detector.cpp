@@ -25,11 +25,6 @@ extern "C" {
 
 namespace dockcore::drivers {
 
-const char* const kTagFamilyNames[] = {"tag16h5",        "tag25h9",        "tag36h10",
-                                       "tag36h11",       "tagCircle21h7",  "tagCircle49h12",
-                                       "tagCustom48h12", "tagStandard41h12", "tagStandard52h13",
-                                       nullptr};
-
 namespace {
 
 struct FamilyEntry {
@@ -38,6 +33,7 @@ struct FamilyEntry {
   void (*destroy)(apriltag_family_t*);
 };
 
+// The same names as kTagFamilyNames (drivers/src/tag_families.cpp, which config parsing uses without libapriltag).
 const FamilyEntry kFamilies[] = {
     {"tag16h5", tag16h5_create, tag16h5_destroy},
     {"tag25h9", tag25h9_create, tag25h9_destroy},
@@ -244,8 +240,6 @@ class AprilTagDetectorImpl final : public TagDetector {
 };
 
 }  // namespace
-
-bool is_tag_family(const std::string& name) { return find_family(name) != nullptr; }
 
 bool draw_tag_upright(const std::string& family, int id, std::uint32_t cell_px, std::uint32_t x0_px,
                       std::uint32_t y0_px, std::uint8_t* grey, std::uint32_t width_px, std::uint32_t height_px,
