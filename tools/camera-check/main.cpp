@@ -150,6 +150,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> controls;
   bool expect_reconnect = false;
   double give_up_s = 10;
+  std::uint64_t after_reconnect = 0;
   auto* cap = app.add_subcommand("capture", "capture frames; one JSON line per frame (--every N), state changes and a summary");
   cap->add_option("--device", cam_opt.device, "V4L2 device")->capture_default_str();
   cap->add_option("--format", format, "grey | yuyv")->check(CLI::IsMember({"grey", "yuyv"}))->capture_default_str();
@@ -164,6 +165,8 @@ int main(int argc, char** argv) {
   cap->add_option("--every", every, "print every N-th frame line (0 = none)")->capture_default_str();
   cap->add_option("--control", controls, "set a device control first, \"Name=value\" (repeatable)");
   cap->add_option("--give-up-seconds", give_up_s, "exit 3 after this long without a frame")->capture_default_str();
+  cap->add_option("--stop-after-reconnect-frames", after_reconnect,
+                  "stop once this many frames arrived after a reopen (0 = off)");
   cap->add_flag("--expect-reconnect", expect_reconnect, "exit 1 unless the device was lost and reopened");
 
   TagDetectorOptions det_opt;
@@ -216,8 +219,13 @@ int main(int argc, char** argv) {
     std::uint64_t prev_stamp = 0, backsteps = 0, max_age = 0;
     bool was_connected = cam->connected();
     std::uint64_t last_frame_us = start;
+    std::uint64_t frames_at_reconnect = 0;
     print_counters("start", *cam, 0, 0);
     for (;;) {
+      if (after_reconnect > 0 && cam->counters().reconnects > 0 &&
+          cam->counters().frames >= frames_at_reconnect + after_reconnect) {
+        break;
+      }
       if (mono_us() - last_frame_us > static_cast<std::uint64_t>(give_up_s * 1e6)) {
         print_counters("summary", *cam, backsteps, max_age);
         std::fprintf(stderr, "camera-check: no frame for %.1f s (%s)\n", give_up_s, cam->last_error());
@@ -229,7 +237,7 @@ int main(int argc, char** argv) {
       const auto st = cam->next_frame(f, 100);
       if (cam->connected() != was_connected) {
         was_connected = cam->connected();
-        prev_stamp = 0;  // a reopened device may restart its clock's use; stamps compare within one connection
+        if (was_connected) frames_at_reconnect = cam->counters().frames;
         print_counters("state", *cam, backsteps, max_age);
       }
       if (st != dockcore::hal::CameraFrameStatus::kFrame) continue;
