@@ -1,5 +1,6 @@
 // camera-check: the camera driver and the AprilTag detector outside dockd (docs/camera.md).
 //   camera-check capture --device /dev/video0 --frames 100          frames from a V4L2 device, stamps and counters
+//   camera-check capture --detect --fx 600 --tag-size 0.1 ...        the same, with the tags of every frame (pose)
 //   camera-check detect --image photo.jpg --fx 600 ...               tags in one image, with pose
 //   camera-check bench --image photo.jpg --frames 200                detection time per 640×480 grey frame
 // Output is JSON, one object per line. Exit status: 0 ok, 1 the check failed (capture: no frame, stamps not
@@ -142,6 +143,11 @@ int main(int argc, char** argv) {
   CLI::App app{"camera-check: V4L2 capture and AprilTag detection outside dockd (docs/camera.md)"};
   app.require_subcommand(1);
 
+  TagDetectorOptions det_opt;
+  std::string image;
+  double fx = 0, fy = 0, cx = -1, cy = -1;
+  std::vector<double> distortion;
+  bool live_detect = false;
   V4l2CameraOptions cam_opt;
   std::string format = "grey";
   std::uint64_t frames = 0;
@@ -169,12 +175,9 @@ int main(int argc, char** argv) {
                   "stop once this many frames arrived after a reopen (0 = off)");
   cap->add_flag("--expect-reconnect", expect_reconnect, "exit 1 unless the device was lost and reopened");
 
-  TagDetectorOptions det_opt;
-  std::string image;
-  double fx = 0, fy = 0, cx = -1, cy = -1;
   std::uint32_t bench_frames = 200, width = 640, height = 480;
-  auto add_detector_options = [&](CLI::App* s) {
-    s->add_option("--image", image, "JPEG file");
+  auto add_detector_options = [&](CLI::App* s, const char* image_help) {
+    if (image_help != nullptr) s->add_option("--image", image, image_help);
     s->add_option("--family", det_opt.family, "tag family")->capture_default_str();
     s->add_option("--decimate", det_opt.quad_decimate, "quad_decimate")->capture_default_str();
     s->add_option("--sigma", det_opt.quad_sigma, "quad_sigma, px")->capture_default_str();
@@ -182,14 +185,21 @@ int main(int argc, char** argv) {
     s->add_option("--refine-edges", det_opt.refine_edges, "true | false")->capture_default_str();
     s->add_option("--tag-size", det_opt.tag_size_m, "black square side, m")->capture_default_str();
   };
+  auto add_intrinsics = [&](CLI::App* s) {
+    s->add_option("--fx", fx, "px (with the tag size: poses)");
+    s->add_option("--fy", fy, "px (default: fx)");
+    s->add_option("--cx", cx, "px (default: image centre)");
+    s->add_option("--cy", cy, "px (default: image centre)");
+    s->add_option("--distortion", distortion, "k1 k2 p1 p2 [k3]")->expected(4, 5);
+  };
+  cap->add_flag("--detect", live_detect, "run the detector on every frame and print its tags (calibration check)");
+  add_detector_options(cap, nullptr);
+  add_intrinsics(cap);
   auto* det = app.add_subcommand("detect", "tags in one image (JSON line per tag)");
-  add_detector_options(det);
-  det->add_option("--fx", fx, "px (with --fy: poses)");
-  det->add_option("--fy", fy, "px");
-  det->add_option("--cx", cx, "px (default: image centre)");
-  det->add_option("--cy", cy, "px (default: image centre)");
+  add_detector_options(det, "JPEG file");
+  add_intrinsics(det);
   auto* bench = app.add_subcommand("bench", "detection time per grey frame (default 640×480; no timing assertion)");
-  add_detector_options(bench);
+  add_detector_options(bench, "JPEG file, its centre cropped to the size (default: a drawn frame of four tags)");
   bench->add_option("--frames", bench_frames, "detections timed")->capture_default_str();
   bench->add_option("--width", width, "frame width, px (the image's centre is cropped to it)")->capture_default_str();
   bench->add_option("--height", height, "frame height, px")->capture_default_str();
@@ -202,8 +212,29 @@ int main(int argc, char** argv) {
   }
 
   std::string err;
+  auto set_intrinsics = [&](std::uint32_t w, std::uint32_t h) {
+    if (fx <= 0) return;
+    CameraIntrinsics k{fx, fy > 0 ? fy : fx, cx >= 0 ? cx : (w - 1) / 2.0, cy >= 0 ? cy : (h - 1) / 2.0};
+    double d[5] = {0, 0, 0, 0, 0};
+    for (std::size_t i = 0; i < distortion.size() && i < 5; ++i) d[i] = distortion[i];
+    k.k1 = d[0];
+    k.k2 = d[1];
+    k.p1 = d[2];
+    k.p2 = d[3];
+    k.k3 = d[4];
+    det_opt.intrinsics = k;
+  };
   if (cap->parsed()) {
     cam_opt.format = *parse_camera_pixel_format(format);
+    std::unique_ptr<TagDetector> live;
+    if (live_detect) {
+      set_intrinsics(cam_opt.width_px, cam_opt.height_px);
+      live = TagDetector::create(det_opt, err);
+      if (!live) {
+        std::fprintf(stderr, "camera-check: %s\n", err.c_str());
+        return 2;
+      }
+    }
     for (const std::string& c : controls) {
       if (!set_control(cam_opt.device, c, err)) {
         std::fprintf(stderr, "camera-check: %s\n", err.c_str());
@@ -253,6 +284,12 @@ int main(int argc, char** argv) {
                     static_cast<unsigned>(f.grey[static_cast<std::size_t>(f.height_px / 2) * f.stride_bytes + f.width_px / 2]));
         std::fflush(stdout);
       }
+      if (live) {
+        TagDetection tags[kMaxTagDetections];
+        const std::size_t n = live->detect(f.grey, f.width_px, f.height_px, f.stride_bytes, tags, kMaxTagDetections);
+        for (std::size_t i = 0; i < n; ++i) print_detection(tags[i]);
+        std::fflush(stdout);
+      }
     }
     print_counters("summary", *cam, backsteps, max_age);
     const auto& c = cam->counters();
@@ -261,13 +298,26 @@ int main(int argc, char** argv) {
     return 0;
   }
 
-  if (image.empty()) {
-    std::fprintf(stderr, "camera-check: --image is required\n");
-    return 2;
-  }
   std::vector<std::uint8_t> frame;
   std::uint32_t w = width, h = height;
-  if (det->parsed()) {
+  if (image.empty() && det->parsed()) {
+    std::fprintf(stderr, "camera-check: detect needs --image\n");
+    return 2;
+  }
+  if (image.empty()) {
+    // No image: a drawn frame, mid-grey with four tag36h11 tags of 4, 6, 8 and 12 px per cell (ids 0..3).
+    frame.assign(static_cast<std::size_t>(w) * h, 128);
+    const std::uint32_t cells[4] = {4, 6, 8, 12};
+    std::uint32_t x = 10;
+    for (int i = 0; i < 4; ++i) {
+      if (!draw_tag_upright("tag36h11", i, cells[i], x, 20 + 20 * static_cast<std::uint32_t>(i), frame.data(), w, h, w)) {
+        std::fprintf(stderr, "camera-check: a %ux%u frame is too small for the drawn tags\n", w, h);
+        return 2;
+      }
+      x += 10 * cells[i] + 20;
+    }
+    image = "drawn";
+  } else if (det->parsed()) {
     camera_check::GreyImage img;
     if (!camera_check::decode_jpeg_grey(image, img, err)) {
       std::fprintf(stderr, "camera-check: %s\n", err.c_str());
@@ -276,10 +326,8 @@ int main(int argc, char** argv) {
     w = img.width_px;
     h = img.height_px;
     frame = std::move(img.pixels);
-    if (fx > 0) {
-      det_opt.intrinsics = CameraIntrinsics{fx, fy > 0 ? fy : fx, cx >= 0 ? cx : (w - 1) / 2.0, cy >= 0 ? cy : (h - 1) / 2.0};
-    }
-  } else if (!load_frame(image, w, h, frame, err)) {
+    set_intrinsics(w, h);
+  } else if (!load_frame(image, w, h, frame, err)) {  // bench on a photo
     std::fprintf(stderr, "camera-check: %s\n", err.c_str());
     return 2;
   }
