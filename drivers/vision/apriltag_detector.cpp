@@ -107,6 +107,9 @@ bool fit_homography4(const double from[4][2], const double to[4][2], matd_t* h) 
   return true;
 }
 
+/// libapriltag's pixel coordinates minus this are the calibration convention's (pixel centres at integers).
+constexpr double kApriltagPixelOffset = 0.5;
+
 /// The tag-frame corner (±1, ±1) that libapriltag's homography maps nearest to each detected corner, so the
 /// corrected homography keeps the library's corner order whatever its convention.
 void tag_corner_coords(const apriltag_detection_t& d, double tag_xy[4][2]) {
@@ -194,30 +197,44 @@ class AprilTagDetectorImpl final : public TagDetector {
     t.id = d.id;
     t.hamming = d.hamming;
     t.decision_margin = static_cast<double>(d.decision_margin);
-    for (int i = 0; i < 4; ++i) {
-      t.corners_px[i][0] = d.p[i][0];
-      t.corners_px[i][1] = d.p[i][1];
-    }
-    t.u_px = d.c[0];
-    t.v_px = d.c[1];
-    if (!(k.fx_px > 0 && k.fy_px > 0)) return;
-    // With distortion: the pose from the corrected corners and a homography fitted to them.
+    // libapriltag puts the centre of the top-left pixel at (0.5, 0.5); calibrations (and so cx, cy) put it at
+    // (0, 0). Everything reported and the pose use the calibration's convention.
     apriltag_detection_t ideal = d;
-    matd_t* h = nullptr;
+    for (int i = 0; i < 4; ++i) {
+      ideal.p[i][0] = d.p[i][0] - kApriltagPixelOffset;
+      ideal.p[i][1] = d.p[i][1] - kApriltagPixelOffset;
+      t.corners_px[i][0] = ideal.p[i][0];
+      t.corners_px[i][1] = ideal.p[i][1];
+    }
+    ideal.c[0] = d.c[0] - kApriltagPixelOffset;
+    ideal.c[1] = d.c[1] - kApriltagPixelOffset;
+    t.u_px = ideal.c[0];
+    t.v_px = ideal.c[1];
+    if (!(k.fx_px > 0 && k.fy_px > 0)) return;
+    matd_t* h = make_mat3();
+    if (h == nullptr) return;
     if (k.has_distortion()) {
+      // The pose from the corrected corners and a homography fitted to them.
       double tag_xy[4][2];
       tag_corner_coords(d, tag_xy);
-      for (int i = 0; i < 4; ++i) undistort_pixel(k, d.p[i][0], d.p[i][1], ideal.p[i][0], ideal.p[i][1]);
-      h = make_mat3();
-      if (h == nullptr || !fit_homography4(tag_xy, ideal.p, h)) {
+      for (int i = 0; i < 4; ++i) undistort_pixel(k, ideal.p[i][0], ideal.p[i][1], ideal.p[i][0], ideal.p[i][1]);
+      if (!fit_homography4(tag_xy, ideal.p, h)) {
         free_mat(h);
         return;
       }
-      ideal.H = h;
       project(h, 0, 0, ideal.c[0], ideal.c[1]);
       t.u_px = ideal.c[0];
       t.v_px = ideal.c[1];
+    } else {
+      // The library's homography moved by the same offset: rows 0 and 1 minus offset × row 2.
+      const double* a = d.H->data;
+      for (int c = 0; c < 3; ++c) {
+        h->data[c] = a[c] - kApriltagPixelOffset * a[6 + c];
+        h->data[3 + c] = a[3 + c] - kApriltagPixelOffset * a[6 + c];
+        h->data[6 + c] = a[6 + c];
+      }
     }
+    ideal.H = h;
     apriltag_detection_info_t info{&ideal, opt_.tag_size_m, k.fx_px, k.fy_px, k.cx_px, k.cy_px};
     apriltag_pose_t pose{nullptr, nullptr};
     t.pose_error = estimate_tag_pose(&info, &pose);

@@ -40,7 +40,9 @@ std::string apriltag_dir(const char* what) {
   return dir;
 }
 
-/// Lines "0, (277.9247 327.4884), (250.3570 329.7265), (251.6721 357.3356), (279.4720 354.6839)".
+/// Lines "0, (277.9247 327.4884), (250.3570 329.7265), (251.6721 357.3356), (279.4720 354.6839)". The listed corners are
+/// in libapriltag's pixel convention (top-left pixel centred at (0.5, 0.5)); they are returned in the wrapper's
+/// (calibration) convention, the top-left pixel centred at (0, 0): 0.5 px less on both axes.
 std::vector<TruthTag> read_truth(const std::string& path) {
   std::vector<TruthTag> out;
   std::ifstream in(path);
@@ -53,7 +55,11 @@ std::vector<TruthTag> read_truth(const std::string& path) {
     std::istringstream s(line);
     TruthTag t;
     s >> t.id;
-    for (auto& c : t.corners) s >> c[0] >> c[1];
+    for (auto& c : t.corners) {
+      s >> c[0] >> c[1];
+      c[0] -= 0.5;
+      c[1] -= 0.5;
+    }
     if (s) out.push_back(t);
   }
   return out;

@@ -4,6 +4,8 @@
 /// corners and the tag's pose in the camera frame from its printed size and the camera intrinsics
 /// (estimate_tag_pose). With lens distortion given, the centre, the corners used for the pose and the pose itself
 /// are corrected to the ideal pinhole image; `corners_px` stay as detected in the raw image.
+/// Pixel coordinates follow the camera-calibration convention (OpenCV, ROS): the centre of the top-left pixel is
+/// (0, 0), so they agree with cx, cy. libapriltag's own coordinates put it at (0.5, 0.5); they are shifted by −0.5 px.
 /// libapriltag allocates on every detect() call (its own images, lists and worker pool): run it off the control
 /// tick (CameraPipeline does).
 
