@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -99,9 +100,10 @@ TEST(TagDetector, DrawnTagCentreIdAndPoseMatchTheDrawing) {
   CHECK_EQUAL(7, d[0].id);
   CHECK_EQUAL(0, d[0].hamming);
   CHECK(d[0].decision_margin > 50);
-  // The ring is 10 cells (120 px): the centre is 60 px in, at the boundary between pixels 259 and 260 (259.5).
-  DOUBLES_EQUAL(259.5, d[0].u_px, 0.5);
-  DOUBLES_EQUAL(209.5, d[0].v_px, 0.5);
+  // The ring is 10 cells (120 px, pixels 200..319): its centre lies between pixels 259 and 260, at 259.5 in the
+  // calibration convention (pixel centres at integers) that the wrapper reports in.
+  DOUBLES_EQUAL(259.5, d[0].u_px, 0.2);
+  DOUBLES_EQUAL(209.5, d[0].v_px, 0.2);
   // Fronto-parallel at Z = fx · size / side = 600 · 0.10 / 96 = 0.625 m; X, Y from the offset to the principal point.
   CHECK(d[0].has_pose);
   DOUBLES_EQUAL(0.625, d[0].translation_m[2], 0.625 * 0.02);
@@ -261,4 +263,94 @@ TEST(CameraPipeline, StaleTargetsAreRefusedAndCounted) {
   CameraTarget t;
   CHECK_FALSE(p->poll_target(t));
   CHECK(p->stats().stale >= 1);
+}
+
+// The simulator's pinhole tag renderer (docksim/tag_render.hpp) and the detector together: a tag36h11 at a known
+// pose in front of a known camera is found where the projection puts it, with that pose.
+#include "docksim/tag_render.hpp"
+
+namespace {
+
+struct RenderedTag {
+  std::vector<std::uint8_t> image = std::vector<std::uint8_t>(kW * kH, 0);
+  docksim::PinholeView view{};
+  double black_side_m = 0;
+};
+
+RenderedTag render(int id, double x_m, double y_m, double z_m, double yaw_rad, double black_side_m) {
+  // The pattern, one pixel per cell: 10 × 10 for tag36h11 (white ring, black border, 6 × 6 data).
+  std::uint8_t cells[10 * 10] = {};
+  std::uint32_t black_cells = 0;
+  CHECK(draw_tag_upright("tag36h11", id, 1, 0, 0, cells, 10, 10, 10, &black_cells));
+  CHECK_EQUAL(8u, black_cells);
+  RenderedTag r;
+  r.black_side_m = black_side_m;
+  docksim::TagPattern p{cells, 10, black_side_m / black_cells};
+  r.view.translation_m[0] = x_m;
+  r.view.translation_m[1] = y_m;
+  r.view.translation_m[2] = z_m;
+  docksim::facing_rotation(yaw_rad, r.view.rotation);
+  CHECK(docksim::render_tag(p, r.view, r.image.data(), kW));
+  return r;
+}
+
+}  // namespace
+
+TEST_GROUP(RenderedTag){};
+
+TEST(RenderedTag, DetectedWhereTheProjectionPutsItWithItsPose) {
+  struct Case {
+    double x, y, z, yaw_deg;
+  };
+  const Case cases[] = {{0, 0, 0.8, 0}, {0.12, -0.05, 1.0, 25}, {-0.2, 0.04, 1.5, -35}, {0.05, 0.02, 0.5, 10}};
+  for (const Case& c : cases) {
+    const RenderedTag r = render(3, c.x, c.y, c.z, c.yaw_deg * 3.14159265358979 / 180, 0.10);
+    TagDetectorOptions o;
+    o.tag_size_m = r.black_side_m;
+    o.intrinsics = CameraIntrinsics{r.view.fx_px, r.view.fy_px, r.view.cx_px, r.view.cy_px};
+    std::string err;
+    auto det = TagDetector::create(o, err);
+    TagDetection d[4];
+    char msg[160];
+    std::snprintf(msg, sizeof msg, "tag at (%.2f, %.2f, %.2f) m, yaw %.0f deg", c.x, c.y, c.z, c.yaw_deg);
+    CHECK_EQUAL_TEXT(1u, det->detect(r.image.data(), kW, kH, kW, d, 4), msg);
+    CHECK_EQUAL_TEXT(3, d[0].id, msg);
+    double u = 0, v = 0;
+    CHECK(docksim::project_tag_point(r.view, 0, 0, u, v));
+    DOUBLES_EQUAL_TEXT(u, d[0].u_px, 0.25, msg);
+    DOUBLES_EQUAL_TEXT(v, d[0].v_px, 0.25, msg);
+    // Every detected corner is within 0.5 px of a projected corner of the black square.
+    const double h = r.black_side_m / 2;
+    for (const auto& corner : d[0].corners_px) {
+      double best = 1e9;
+      for (const double sx : {-h, h}) {
+        for (const double sy : {-h, h}) {
+          double cu = 0, cv = 0;
+          docksim::project_tag_point(r.view, sx, sy, cu, cv);
+          best = std::fmin(best, std::hypot(corner[0] - cu, corner[1] - cv));
+        }
+      }
+      CHECK_TEXT(best < 0.5, msg);
+    }
+    CHECK_TEXT(d[0].has_pose, msg);
+    DOUBLES_EQUAL_TEXT(c.x, d[0].translation_m[0], 0.01 * c.z, msg);
+    DOUBLES_EQUAL_TEXT(c.y, d[0].translation_m[1], 0.01 * c.z, msg);
+    DOUBLES_EQUAL_TEXT(c.z, d[0].translation_m[2], 0.01 * c.z, msg);
+  }
+}
+
+TEST(RenderedTag, RendererRefusesBadInput) {
+  std::vector<std::uint8_t> img(kW * kH, 7);
+  docksim::PinholeView v;
+  docksim::TagPattern empty{};
+  CHECK_FALSE(docksim::render_tag(empty, v, img.data(), kW));
+  const std::uint8_t cells[4] = {0, 255, 255, 0};
+  docksim::TagPattern p{cells, 2, 0.05};
+  v.supersample = 0;
+  CHECK_FALSE(docksim::render_tag(p, v, img.data(), kW));
+  CHECK_EQUAL(7, img[0]);  // untouched
+  v.supersample = 2;
+  v.translation_m[2] = -1;  // behind the camera: nothing but background
+  CHECK(docksim::render_tag(p, v, img.data(), kW));
+  CHECK_EQUAL(128, img[kW * (kH / 2) + kW / 2]);
 }
