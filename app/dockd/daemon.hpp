@@ -107,6 +107,8 @@ class Daemon {
   void on_chassis_readable(std::uint64_t now_us);
   void on_host_readable(std::uint64_t now_us);
   void on_camera_readable(std::uint64_t now_us);
+  /// The camera target the controllers get: the newest from the camera sources (invalid until one arrived).
+  const dockcore::CameraTarget& camera_target() const { return camera_; }
 
   /// Stop path (SIGTERM/SIGINT, fatal errors, end of tests): sends `frames` zero wheel commands back to back
   /// (main spaces them one tick apart by calling this once per frame) and logs the reason once. O(frames).
