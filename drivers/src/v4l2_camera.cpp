@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -72,10 +73,11 @@ int xioctl(int fd, unsigned long request, void* arg) {
 
 std::uint32_t fourcc(CameraPixelFormat f) { return f == CameraPixelFormat::kGrey ? V4L2_PIX_FMT_GREY : V4L2_PIX_FMT_YUYV; }
 
-std::string fourcc_name(std::uint32_t f) {
-  char s[5] = {static_cast<char>(f & 0xFFu), static_cast<char>((f >> 8) & 0xFFu), static_cast<char>((f >> 16) & 0xFFu),
-               static_cast<char>((f >> 24) & 0xFFu), 0};
-  return s;
+/// The four characters of a FourCC code, NUL-terminated, in `out`.
+const char* fourcc_name(std::uint32_t f, char (&out)[5]) {
+  for (int i = 0; i < 4; ++i) out[i] = static_cast<char>((f >> (8 * i)) & 0xFFu);
+  out[4] = '\0';
+  return out;
 }
 
 /// Why an open attempt failed.
@@ -185,16 +187,24 @@ class V4l2CameraImpl final : public V4l2Camera {
 
   bool connected() const override { return fd_ >= 0; }
   const hal::CameraFrameCounters& counters() const override { return counters_; }
-  const char* last_error() const override { return error_.c_str(); }
+  const char* last_error() const override { return error_; }
   bool driver_stamps() const override { return driver_stamps_; }
   std::uint32_t bytes_per_line() const override { return bytes_per_line_; }
   std::uint32_t size_image() const override { return size_image_; }
 
  private:
+  // Messages go into a fixed buffer: a reopen attempt after start allocates nothing.
   void fail(const char* call, int err) {
-    error_ = "camera " + opt_.device + ": " + call + ": " + std::strerror(err);
+    std::snprintf(error_, sizeof error_, "camera %s: %s: %s", opt_.device.c_str(), call, std::strerror(err));
   }
-  void refuse(const std::string& what) { error_ = "camera " + opt_.device + ": " + what; }
+  __attribute__((format(printf, 2, 3))) void refuse(const char* fmt, ...) {
+    const int n = std::snprintf(error_, sizeof error_, "camera %s: ", opt_.device.c_str());
+    if (n < 0 || static_cast<std::size_t>(n) >= sizeof error_) return;
+    va_list ap;
+    va_start(ap, fmt);
+    std::vsnprintf(error_ + n, sizeof error_ - static_cast<std::size_t>(n), fmt, ap);
+    va_end(ap);
+  }
 
   static void sleep_us(std::uint64_t us) {
     timespec ts{static_cast<time_t>(us / 1000000u), static_cast<long>((us % 1000000u) * 1000u)};
@@ -205,12 +215,13 @@ class V4l2CameraImpl final : public V4l2Camera {
   OpenResult negotiate_and_stream() {
     v4l2_capability cap{};
     if (xioctl(fd_, VIDIOC_QUERYCAP, &cap) < 0) {
-      fail("VIDIOC_QUERYCAP", errno);
-      return errno == ENOTTY ? OpenResult::kRefused : OpenResult::kFailed;
+      const int e = errno;
+      fail("VIDIOC_QUERYCAP", e);
+      return e == ENOTTY ? OpenResult::kRefused : OpenResult::kFailed;
     }
     const std::uint32_t caps = (cap.capabilities & V4L2_CAP_DEVICE_CAPS) != 0 ? cap.device_caps : cap.capabilities;
     if ((caps & V4L2_CAP_VIDEO_CAPTURE) == 0) {
-      refuse(std::string("is not a video capture device (driver ") + reinterpret_cast<const char*>(cap.driver) + ")");
+      refuse("is not a video capture device (driver %.16s)", reinterpret_cast<const char*>(cap.driver));
       return OpenResult::kRefused;
     }
     if ((caps & V4L2_CAP_STREAMING) == 0) {
@@ -224,24 +235,25 @@ class V4l2CameraImpl final : public V4l2Camera {
     f.fmt.pix.pixelformat = fourcc(opt_.format);
     f.fmt.pix.field = V4L2_FIELD_NONE;
     if (xioctl(fd_, VIDIOC_S_FMT, &f) < 0) {
-      fail("VIDIOC_S_FMT", errno);
-      return errno == EBUSY ? OpenResult::kFailed : OpenResult::kRefused;
+      const int e = errno;
+      fail("VIDIOC_S_FMT", e);
+      return e == EBUSY ? OpenResult::kFailed : OpenResult::kRefused;
     }
     if (f.fmt.pix.pixelformat != fourcc(opt_.format)) {
-      refuse("VIDIOC_S_FMT: asked for " + fourcc_name(fourcc(opt_.format)) + ", the device gives " +
-             fourcc_name(f.fmt.pix.pixelformat) + " (camera.device.format)");
+      char want[5], got[5];
+      refuse("VIDIOC_S_FMT: asked for %s, the device gives %s (camera.device.format)",
+             fourcc_name(fourcc(opt_.format), want), fourcc_name(f.fmt.pix.pixelformat, got));
       return OpenResult::kRefused;
     }
     if (f.fmt.pix.width != opt_.width_px || f.fmt.pix.height != opt_.height_px) {
-      refuse("VIDIOC_S_FMT: asked for " + std::to_string(opt_.width_px) + "x" + std::to_string(opt_.height_px) +
-             ", the device gives " + std::to_string(f.fmt.pix.width) + "x" + std::to_string(f.fmt.pix.height) +
-             " (camera.device.width_px / height_px)");
+      refuse("VIDIOC_S_FMT: asked for %ux%u, the device gives %ux%u (camera.device.width_px / height_px)",
+             opt_.width_px, opt_.height_px, f.fmt.pix.width, f.fmt.pix.height);
       return OpenResult::kRefused;
     }
     const std::uint32_t bpp = opt_.format == CameraPixelFormat::kGrey ? 1u : 2u;
     bytes_per_line_ = f.fmt.pix.bytesperline != 0 ? f.fmt.pix.bytesperline : opt_.width_px * bpp;
     if (bytes_per_line_ < opt_.width_px * bpp) {
-      refuse("VIDIOC_S_FMT: bytesperline " + std::to_string(bytes_per_line_) + " is less than a row of pixels");
+      refuse("VIDIOC_S_FMT: bytesperline %u is less than a row of pixels", bytes_per_line_);
       return OpenResult::kRefused;
     }
     // The bytes a complete frame fills: rows of bytesperline, the last one needing only its pixels.
@@ -262,11 +274,12 @@ class V4l2CameraImpl final : public V4l2Camera {
     rb.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     rb.memory = V4L2_MEMORY_MMAP;
     if (xioctl(fd_, VIDIOC_REQBUFS, &rb) < 0) {
-      fail("VIDIOC_REQBUFS", errno);
-      return errno == EINVAL ? OpenResult::kRefused : OpenResult::kFailed;
+      const int e = errno;
+      fail("VIDIOC_REQBUFS", e);
+      return e == EINVAL ? OpenResult::kRefused : OpenResult::kFailed;
     }
     if (rb.count < 2) {
-      refuse("VIDIOC_REQBUFS: the driver granted " + std::to_string(rb.count) + " buffer(s), streaming needs 2");
+      refuse("VIDIOC_REQBUFS: the driver granted %u buffer(s), streaming needs 2", rb.count);
       return OpenResult::kFailed;
     }
     nbuf_ = std::min<std::uint32_t>(rb.count, kMaxV4l2Buffers);
@@ -290,8 +303,7 @@ class V4l2CameraImpl final : public V4l2Camera {
       }
       maps_[i] = {a, b.length};
       if (b.length < size_image_) {
-        refuse("VIDIOC_QUERYBUF: buffer " + std::to_string(i) + " holds " + std::to_string(b.length) +
-               " bytes, a frame needs " + std::to_string(size_image_));
+        refuse("VIDIOC_QUERYBUF: buffer %u holds %u bytes, a frame needs %u", i, b.length, size_image_);
         return OpenResult::kRefused;
       }
     }
@@ -312,7 +324,7 @@ class V4l2CameraImpl final : public V4l2Camera {
     }
     streaming_ = true;
     seq_.reset();
-    error_.clear();
+    error_[0] = '\0';
     if (was_connected_) ++counters_.reconnects;
     was_connected_ = true;
     delay_ms_ = opt_.reconnect_min_ms;
@@ -366,7 +378,7 @@ class V4l2CameraImpl final : public V4l2Camera {
   std::uint64_t next_open_us_ = 0;
   v4l2_detail::SequenceTracker seq_;
   hal::CameraFrameCounters counters_{};
-  std::string error_;
+  char error_[256] = "";
 };
 
 }  // namespace
