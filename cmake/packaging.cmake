@@ -1,4 +1,4 @@
-# Debian packages (issue #5): `cpack -G DEB` in a build tree gives dockcore_<version>_<arch>.deb with dockd, dockctl,
+# Debian packages: `cpack -G DEB` in a build tree gives dockcore_<version>_<arch>.deb with dockd, dockctl,
 # dock-decode, the systemd unit and the example config (their install() rules live beside the targets; dock-decode's
 # is here because tools/ has no other installable program). Architecture follows the compiler: amd64 from the
 # default preset, arm64 from the aarch64 preset, armhf from armhf.

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -68,12 +69,32 @@ int main(int argc, char** argv) {
   app.add_subcommand("stop", "stop whatever runs (cancel; clears a fault)");
   auto* status = app.add_subcommand("status", "print dockd's status (one JSON line)");
   status->add_flag("--follow,-f", follow, "subscribe and print the status stream until interrupted");
+  auto* test =
+      app.add_subcommand("test", "recognition-only test mode: report the dock estimate, never move ('stop' ends it)");
+  test->add_option("--dock", dock_id, "dock id (default: dockd's default dock)")->check(CLI::Range(0, 65535));
   auto* teach = app.add_subcommand("teach", "robot placed on the charger by hand: store the dock's docked-pose target");
   teach->add_option("--dock", dock_id, "dock id")->check(CLI::Range(0, 65535));
   teach->add_option("--scans", scans, "scans to average (default: dockd's [state] teach_scans)")->check(CLI::Range(1, 1000));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    // An unknown option or word where the subcommand belongs: name it, and for a word the valid subcommands (CLI11
+    // would only say that a subcommand is required).
+    const std::vector<std::string> rest = app.remaining();
+    if (app.get_subcommands().empty() && !rest.empty() && rest.front().rfind('-', 0) == 0) {
+      std::fprintf(stderr, "dockctl: unknown option '%s'\nRun with --help for more information.\n",
+                   rest.front().c_str());
+      return 2;
+    }
+    if (app.get_subcommands().empty() && !rest.empty()) {
+      std::string valid;
+      for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+        valid += (valid.empty() ? "" : ", ") + sub->get_name();
+      }
+      std::fprintf(stderr, "dockctl: unknown subcommand '%s' (valid: %s)\nRun with --help for more information.\n",
+                   rest.front().c_str(), valid.c_str());
+      return 2;
+    }
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }

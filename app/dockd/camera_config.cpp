@@ -1,4 +1,4 @@
-#include "camera_config.hpp"
+#include "camera_config_keys.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -7,8 +7,8 @@
 
 namespace dockd {
 
-using dockcore::drivers::toml_reader::Handlers;
-using dockcore::drivers::toml_reader::kDeg;
+using dockcore::params::toml_reader::Handlers;
+using dockcore::params::toml_reader::kDeg;
 
 void add_camera_device_keys(const ConfigReader& reader, Handlers& h, CameraDeviceConfig& config) {
   // The handlers run later, while parse_config_toml reads the file: they hold pointers to the reader and the config.

@@ -1,4 +1,5 @@
 #include "config.hpp"
+#include "camera_config_keys.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,9 +14,9 @@
 
 #include <toml++/toml.h>
 
-#include "dockcore/drivers/estimator_toml.hpp"
-#include "dockcore/drivers/profile_toml.hpp"
-#include "dockcore/drivers/toml_reader.hpp"
+#include "dockcore/params/param_toml.hpp"
+#include "dockcore/params/profile_toml.hpp"
+#include "dockcore/params/toml_reader.hpp"
 
 namespace dockd {
 
@@ -24,14 +25,14 @@ using dockcore::Vec2;
 
 namespace {
 
-using dockcore::drivers::toml_reader::dir_of;
-using dockcore::drivers::toml_reader::Handler;
-using dockcore::drivers::toml_reader::Handlers;
-using dockcore::drivers::toml_reader::kDeg;
-using dockcore::drivers::toml_reader::type_name;
+using dockcore::params::toml_reader::dir_of;
+using dockcore::params::toml_reader::Handler;
+using dockcore::params::toml_reader::Handlers;
+using dockcore::params::toml_reader::kDeg;
+using dockcore::params::toml_reader::type_name;
 /// Every key dispatched to a handler, unknown keys and bad values reported at their TOML source position (the same
 /// reader as dock-sim's scenarios).
-using Parser = dockcore::drivers::toml_reader::Reader<ConfigError>;
+using Parser = dockcore::params::toml_reader::Reader<ConfigError>;
 
 /// Reads a regular file of at most `max_bytes` into `out`. False + reason otherwise: a FIFO, a device (/dev/zero)
 /// or an oversized file must not block dockd or grow its memory without bound.
@@ -68,8 +69,7 @@ bool read_bounded(const std::string& path, std::size_t max_bytes, std::string& o
 /// robot's own structure (FootprintParams::self_sectors, at most kMaxSelfSectors). Bounds in [-180, 180]; from > to
 /// wraps through 180 (a sector behind the lidar). Stored through wrap_angle, the core's (-pi, pi] convention, so
 /// -180 is the same bearing as 180. A sector whose bounds name one bearing ([10, 10], [-180, 180]) is refused: it
-/// holds no beam in practice, and [-180, 180] reads as "all round", which would hide every obstacle inside the body
-/// again (the filter b426c4c removed).
+/// holds no beam in practice, and [-180, 180] reads as "all round", which would hide every obstacle inside the body.
 void self_sectors(const Parser& p, const toml::node& n, dockcore::FootprintParams& f) {
   const std::string key = p.key();
   const toml::array* a = n.as_array();
@@ -112,8 +112,8 @@ dockcore::DockProfile load_profile(const Parser& p, const toml::node& at, const 
   std::string text, why;
   if (!read_bounded(path, kMaxProfileFileBytes, text, why)) p.fail(at.source(), "profile file " + path + ": " + why);
   try {
-    return dockcore::drivers::profile_toml::parse<ConfigError>(text, path,
-                                                               dockcore::drivers::profile_toml::name_from_path(path));
+    return dockcore::params::profile_toml::parse<ConfigError>(text, path,
+                                                               dockcore::params::profile_toml::name_from_path(path));
   } catch (const ConfigError& e) {
     const toml::source_position& w = at.source().begin;
     throw ConfigError(std::string(e.what()) + " (dock profile named at " + p.src() + ":" + std::to_string(w.line) +
@@ -167,22 +167,29 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   DockdConfig c;
   c.source = source_name;
   std::string lidar_protocol = "ld06", lidar_transport = "serial", can_protocol = "dockcore-v1";
-  std::string drive_kind = "differential", footprint_shape = "square", pad_side = "front";
+  std::string drive_kind = "differential", pad_side = "front";
   const toml::node* lidar_protocol_node = nullptr;
-  bool pad_reach_set = false, max_range_set = false;
+  // The core structs' keys, with their bounds, come from the parameter table (the same as dock-sim's scenarios).
+  namespace params = dockcore::params;
+  const params::ParamTargets targets{&c.drive,   &c.limits,  &c.footprint, &c.task,  &c.estimator,
+                                     &c.seed000, &c.seed004, &c.seed003,   &c.smooth};
+  auto table_keys = [&](const std::string& table, Handlers h) {
+    params::add_params(p, h, table, targets, params::kDockd);
+    return h;
+  };
   std::vector<const toml::node*> dock_profile_nodes;
   // Per dock: the [mounting] given in its entry, which replaces the profile's own (the same dock shape may stand
   // against a wall in one place and free in another).
   std::vector<std::pair<bool, dockcore::DockMounting>> dock_mountings;
   auto mounting_handler = [&](std::pair<bool, dockcore::DockMounting>* out, const std::string& path) {
     return [&p, out, path](const toml::node& v) {
-      *out = {true, dockcore::drivers::profile_toml::read_mounting(p, v, path)};
+      *out = {true, dockcore::params::profile_toml::read_mounting(p, v, path)};
     };
   };
 
   auto lidar = [&]() {
     auto& l = c.lidar;
-    return Handlers{
+    return table_keys("lidar", Handlers{
         {"protocol", [&](const toml::node& n) {
            lidar_protocol = p.choice(n, {"ld06", "rplidar", "lakibeam"});
            lidar_protocol_node = &n;
@@ -206,15 +213,8 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
         {"mount_x_m", p.real(&c.lidar_mount.x_m, -2, 2)},
         {"mount_y_m", p.real(&c.lidar_mount.y_m, -2, 2)},
         {"mount_yaw_deg", p.real_deg(&c.lidar_mount.yaw_rad, -180, 180)},
-        {"min_range_m", p.real(&c.estimator.min_range_m, 0, 10)},
-        {"max_range_m", [&](const toml::node& n) {
-           c.estimator.max_range_m = static_cast<Real>(p.number(n, 0.1, 100));
-           max_range_set = true;
-         }},
-        {"range_sigma_m", p.real(&c.estimator.range_sigma_m, 0.0001, 1)},
-    };
+    });
   };
-  (void)max_range_set;
 
   auto can = [&]() {
     return Handlers{
@@ -227,41 +227,15 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   };
 
   auto robot = [&]() {
-    auto& g = c.drive;
-    Handlers h{
+    Handlers h = table_keys("robot", Handlers{
         {"drive", [&](const toml::node& n) { drive_kind = p.choice(n, {"differential", "mecanum"}); }},
-        {"wheel_radius_m", p.real(&g.wheel_radius_m, 0.005, 1)},
-        {"track_m", p.real(&g.wheel_base_m, 0.02, 5)},
-        {"half_wheelbase_m", p.real(&g.lx_m, 0.01, 5)},
-        {"half_track_m", p.real(&g.ly_m, 0.01, 5)},
         {"pad_side", [&](const toml::node& n) { pad_side = p.choice(n, {"front", "rear"}); }},
-        {"pad_reach_m", [&](const toml::node& n) {
-           c.pad_reach_m = p.number(n, 0.01, 3);
-           pad_reach_set = true;
-         }},
-    };
-    h.emplace_back("limits", p.sub("robot.limits.", [&]() {
-      auto& l = c.limits;
-      return Handlers{{"max_vx_mps", p.real(&l.max_vx_mps, 0, 5)},
-                      {"max_vy_mps", p.real(&l.max_vy_mps, 0, 5)},
-                      {"max_wz_radps", p.real(&l.max_wz_radps, 0, 10)},
-                      {"max_wheel_radps", p.real(&l.max_wheel_radps, 0, 500)},
-                      {"max_linear_accel_mps2", p.real(&l.max_linear_accel_mps2, 0, 20)},
-                      {"max_angular_accel_radps2", p.real(&l.max_angular_accel_radps2, 0, 50)}};
-    }));
+    });
+    h.emplace_back("limits", params::param_sub(p, "robot.limits", targets, params::kDockd));
     h.emplace_back("footprint", p.sub("robot.footprint.", [&]() {
-      auto& f = c.footprint;
-      return Handlers{{"shape", [&](const toml::node& n) { footprint_shape = p.choice(n, {"square", "circle"}); }},
-                      {"half_length_m", p.real(&f.half_length_m, 0.01, 5)},
-                      {"half_width_m", p.real(&f.half_width_m, 0.01, 5)},
-                      {"radius_m", p.real(&f.radius_m, 0.01, 5)},
-                      {"check_length_m", p.real(&f.check_length_m, 0, 5)},
-                      {"check_width_m", p.real(&f.check_width_m, 0, 5)},
-                      {"circumscribed_radius_m", p.real(&f.circumscribed_radius_m, 0.01, 10)},
-                      {"self_margin_m", p.real(&f.self_margin_m, 0, 1)},
-                      {"self_sectors_deg", [&](const toml::node& n) { self_sectors(p, n, f); }},
-                      {"dock_margin_m", p.real(&f.dock_margin_m, 0, 1)},
-                      {"min_points", p.integ(&f.min_points, 1, 1000)}};
+      return table_keys("robot.footprint", Handlers{
+          {"self_sectors_deg", [&](const toml::node& n) { self_sectors(p, n, c.footprint); }},
+      });
     }));
     return h;
   };
@@ -298,68 +272,13 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   };
 
   auto controller = [&]() {
-    Handlers h{{"name", [&](const toml::node& n) { c.controller = p.choice(n, {"seed000", "seed004", "seed003", "smooth"}); }},
-               {"creep_speed_mps", [&](const toml::node& n) {
-                  const Real v = static_cast<Real>(p.number(n, 0.001, 1));
-                  c.seed000.common.creep_speed_mps = c.seed004.common.creep_speed_mps = v;
-                  c.seed003.common.creep_speed_mps = c.smooth.common.creep_speed_mps = v;
-                }},
-               {"stall_timeout_s", [&](const toml::node& n) {
-                  const Real v = static_cast<Real>(p.number(n, 0.1, 60));
-                  c.seed000.common.stall_timeout_s = c.seed004.common.stall_timeout_s = v;
-                  c.seed003.common.stall_timeout_s = c.smooth.common.stall_timeout_s = v;
-                }}};
-    h.emplace_back("smooth", p.sub("controller.smooth.", [&]() {
-      auto& s = c.smooth;
-      return Handlers{{"v_max_mps", p.real(&s.v_max_mps, 0.01, 2)},
-                      {"w_max_radps", p.real(&s.w_max_radps, 0.05, 5)},
-                      {"slowdown_radius_m", p.real(&s.slowdown_radius_m, 0, 3)},
-                      {"goal_projection_m", p.real(&s.goal_projection_m, 0, 1)},
-                      {"lineup_distance_m", p.real(&s.lineup_distance_m, 0, 2)}};
-    }));
-    h.emplace_back("seed000", p.sub("controller.seed000.", [&]() {
-      return Handlers{{"forward_speed_mps", p.real(&c.seed000.forward_speed_mps, 0.01, 2)}};
-    }));
-    h.emplace_back("seed004", p.sub("controller.seed004.", [&]() {
-      return Handlers{{"max_speed_mps", p.real(&c.seed004.max_speed_mps, 0.01, 2)}};
-    }));
-    h.emplace_back("seed003", p.sub("controller.seed003.", [&]() {
-      auto& s = c.seed003;
-      return Handlers{{"fx_px", p.real(&s.camera.fx_px, 1, 10000)},
-                      {"cx_px", p.real(&s.camera.cx_px, 0, 10000)},
-                      {"image_width_px", p.real(&s.camera.image_width_px, 1, 20000)},
-                      {"mount_x_m", p.real(&s.camera.mount.x_m, -2, 2)},
-                      {"mount_y_m", p.real(&s.camera.mount.y_m, -2, 2)},
-                      {"mount_yaw_deg", p.real_deg(&s.camera.mount.yaw_rad, -180, 180)}};
-    }));
+    Handlers h = table_keys("controller", Handlers{{"name", [&](const toml::node& n) {
+                                                      c.controller = p.choice(n, {"seed000", "seed004", "seed003", "smooth"});
+                                                    }}});
+    for (const char* name : {"smooth", "seed000", "seed004", "seed003"}) {
+      h.emplace_back(name, params::param_sub(p, std::string("controller.") + name, targets, params::kDockd));
+    }
     return h;
-  };
-
-  auto task = [&]() {
-    auto& t = c.task;
-    return Handlers{
-        {"detect_wait_s", p.real(&t.detect_wait_s, 0, 60)},
-        {"swing_amplitude_deg", p.real_deg(&t.swing_amplitude_rad, 0, 180)},
-        {"swing_speed_radps", p.real(&t.swing_speed_radps, 0.01, 3)},
-        {"max_swings", p.integ(&t.max_swings, 0, 20)},
-        {"target_lost_after_s", p.real(&t.target_lost_after_s, 0.05, 60)},
-        {"target_lost_timeout_s", p.real(&t.target_lost_timeout_s, 0.1, 600)},
-        {"obstacle_timeout_s", p.real(&t.obstacle_timeout_s, 0.1, 600)},
-        {"charge_current_threshold_a", p.real(&t.charge_current_threshold_a, 0, 200)},
-        {"charge_confirm_hold_s", p.real(&t.charge_confirm_hold_s, 0, 60)},
-        {"charge_confirm_timeout_s", p.real(&t.charge_confirm_timeout_s, 0.1, 600)},
-        {"contact_lost_debounce_s", p.real(&t.contact_lost_debounce_s, 0, 60)},
-        {"max_retries", p.integ(&t.max_retries, 0, 20)},
-        {"staging_distance_m", p.real(&t.staging_distance_m, 0.1, 10)},
-        {"fallback_backoff_m", p.real(&t.fallback_backoff_m, 0, 5)},
-        {"backoff_speed_mps", p.real(&t.backoff_speed_mps, 0.01, 1)},
-        {"backoff_timeout_s", p.real(&t.backoff_timeout_s, 1, 600)},
-        {"charge_off_timeout_s", p.real(&t.charge_off_timeout_s, 0.1, 60)},
-        {"task_timeout_s", p.real(&t.task_timeout_s, 1, 3600)},
-        {"check_distance_error_tolerance_m", p.real(&t.deviation.check_distance_error_tolerance_m, 0, 100)},
-        {"push_distance_tolerance_m", p.real(&t.deviation.push_distance_tolerance_m, 0, 100)},
-        {"check_angle_error_tolerance_deg", p.real_deg(&t.deviation.check_angle_error_tolerance_rad, 0, 180)},
-    };
   };
 
   auto host = [&]() {
@@ -460,13 +379,12 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
          for (const toml::node& e : *a) dock_entry(e);
        }},
       {"estimator", p.sub("estimator.", [&]() {
-         // The estimator's tuning, the same keys and bounds as dock-sim's scenarios; the range keys are in [lidar].
-         Handlers h;
-         dockcore::drivers::estimator_toml::add_keys(p, h, c.estimator, "estimator.");
-         return h;
+         // The estimator's tuning; its range keys are in [lidar].
+         return table_keys("estimator", Handlers{
+             {"segments", params::param_sub(p, "estimator.segments", targets, params::kDockd)}});
        })},
       {"controller", p.sub("controller.", controller)},
-      {"task", p.sub("task.", task)},
+      {"task", params::param_sub(p, "task", targets, params::kDockd)},
       {"host", p.sub("host.", host)},
       {"camera", p.sub("camera.", camera)},
       {"record", p.sub("record.", record)},
@@ -494,10 +412,12 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   c.drive.kind = drive_kind == "mecanum" ? dockcore::DriveKind::kMecanum : dockcore::DriveKind::kDifferential;
   c.can.drive = c.drive;
   c.pads_rear = pad_side == "rear";
-  c.footprint.shape = footprint_shape == "circle" ? dockcore::FootprintShape::kCircular : dockcore::FootprintShape::kSquare;
-  if (!pad_reach_set) {
-    c.pad_reach_m = footprint_shape == "circle" ? static_cast<double>(c.footprint.radius_m)
-                                                : static_cast<double>(c.footprint.half_length_m);
+  if (p.given("robot.pad_reach_m")) {
+    c.pad_reach_m = static_cast<double>(c.smooth.common.pad_reach_m);
+  } else {
+    c.pad_reach_m = c.footprint.shape == dockcore::FootprintShape::kCircular
+                        ? static_cast<double>(c.footprint.radius_m)
+                        : static_cast<double>(c.footprint.half_length_m);
   }
   const Real reach = static_cast<Real>(c.pad_reach_m);
   c.seed000.common.pad_reach_m = c.seed004.common.pad_reach_m = reach;

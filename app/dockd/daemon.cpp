@@ -80,6 +80,9 @@ void Daemon::build_core() {
   core_cfg_.task = cfg_.task;
   core_cfg_.footprint = cfg_.footprint;
   core_cfg_.lidar_mount = cfg_.lidar_mount;
+  core_cfg_.drive = cfg_.drive;
+  core_cfg_.limits = cfg_.limits;
+  core_cfg_.control_period_s = static_cast<Real>(kNominalTickUs) * static_cast<Real>(1e-6);
   // dockd's own watchdog (receive time, lidar_stale_ms) is the tight one; Dockcore's scan-stamp check is a backstop
   // that must not fire first (a scan's stamp is its first sample, a whole turn before delivery).
   core_cfg_.lidar_stale_s = static_cast<Real>(cfg_.lidar_stale_ms) * static_cast<Real>(1e-3) + static_cast<Real>(0.3);
@@ -187,7 +190,6 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
     return false;
   }
   io_.stderr_level = cfg_.log_level;
-  prev_cmd_ = dockcore::Twist2{};
   ++counters_.config_reloads;
   message = cfg_.source + ": config reloaded";
   log_reload(now_us, "applied", message, LogLevel::kWarn);
@@ -271,7 +273,7 @@ void Daemon::send_zero(std::uint64_t, int frames) {
   dockcore::hal::WheelCommand z;
   z.count = static_cast<std::uint8_t>(dockcore::drive_wheel_count(cfg_.drive.kind));
   for (int i = 0; i < frames; ++i) send_wheels(z);
-  prev_cmd_ = dockcore::Twist2{};
+  if (core_) core_->note_drive_stopped();
 }
 
 void Daemon::log_shutdown(std::uint64_t now_us, const char* reason) {
@@ -286,8 +288,18 @@ void Daemon::log_shutdown(std::uint64_t now_us, const char* reason) {
 
 // --- inputs ------------------------------------------------------------------------------------------------------
 
-void Daemon::poll_chassis(std::uint64_t) {
+void Daemon::poll_chassis(std::uint64_t now_us) {
   fb_ = io_.chassis->poll();
+  // Error frames on the bus (bus-off, controller error passive, no ACK, ...): one event per poll that saw new ones.
+  const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
+  if (cc.bus_errors > reported_bus_errors_) {
+    char f[96];
+    std::snprintf(f, sizeof f, "\"bus_errors\":%u,\"bus_off\":%u,\"new\":%u", cc.bus_errors, cc.bus_off,
+                  cc.bus_errors - reported_bus_errors_);
+    log_event(now_us, "can_error", f, cc.bus_off > reported_bus_off_ ? LogLevel::kError : LogLevel::kWarn);
+  }
+  reported_bus_errors_ = cc.bus_errors;
+  reported_bus_off_ = cc.bus_off;
   if (fb_.wheels_stamp_us == 0 || fb_.wheels_stamp_us == last_wheels_stamp_us_) return;
   dockcore::WheelSpeeds w;
   w.count = dockcore::drive_wheel_count(cfg_.drive.kind);
@@ -342,10 +354,10 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
     have_scan_ = true;
     last_scan_late_ = false;
     last_scan_parsed_us_ = now_us;
-    // A scan is stamped with its first sample: one scan alone cannot say when its turn ended. Taking its start for
-    // its end made the first scan after start-up look one turn old, so the watchdog tripped just before the second
-    // one arrived — a 185 flap that a host docking right away saw in the status (CI, motion_obstacle). The lidar
-    // counts as fresh from the second scan on, when the turn's length is known; the first one still feeds the core.
+    // A scan is stamped with its first sample: one scan alone cannot say when its turn ended (taking its start for its
+    // end would make the first scan after start-up look one turn old and trip the watchdog just before the second).
+    // The lidar counts as fresh from the second scan on, when the turn's length is known; the first one still feeds
+    // the core.
     if (scan_period_us_ != 0 && turn_end_us > last_scan_rx_us_) last_scan_rx_us_ = turn_end_us;
     const dockcore::DockEstimate& e = core_->on_scan(scan_->view(), stamp, odom_at(stamp));
     if (e.found) {
@@ -677,6 +689,7 @@ void Daemon::on_tick(std::uint64_t now_us) {
   const std::uint64_t fault_after = static_cast<std::uint64_t>(cfg_.watchdog_fault_after_ms) * 1000u;
   in.chassis_ok = !(chassis_stale_ && now_us - chassis_stale_since_us_ >= fault_after);
   in.lidar_ok = !(lidar_stale_ && now_us - lidar_stale_since_us_ >= fault_after);
+  in.hold = lidar_stale_ || chassis_stale_;
 
   // Watchdog resume: a command interrupted by a watchdog fault is re-issued once the data has been fresh for
   // kResumeHoldUs, at most kMaxResumes times per task (docs/dockd.md, "Watchdogs").
@@ -771,20 +784,11 @@ void Daemon::on_tick(std::uint64_t now_us) {
   }
   if (after == TaskState::kNotTasking || after == TaskState::kFinishTasking) running_cmd_ = HostCommandType::kNone;
 
-  // Motion: zero when a watchdog holds, whatever the task manager says (it faults on the same tick anyway).
-  dockcore::Twist2 cmd_twist{};
-  const bool hold = lidar_stale_ || chassis_stale_;
-  if (!hold) {
-    cmd_twist = dockcore::saturate_twist(cfg_.drive, cfg_.limits, out.cmd);
-    cmd_twist = dockcore::limit_acceleration(cfg_.limits, prev_cmd_, cmd_twist, static_cast<Real>(kNominalTickUs) * static_cast<Real>(1e-6));
-    // A zero twist (stop, fault, idle) is sent at once: the drive's own limits do the braking.
-    if (out.cmd.vx_mps == 0 && out.cmd.vy_mps == 0 && out.cmd.wz_radps == 0) cmd_twist = dockcore::Twist2{};
-  }
-  prev_cmd_ = cmd_twist;
-  const dockcore::WheelSpeeds ws = dockcore::twist_to_wheels(cfg_.drive, cmd_twist);
+  // Motion: Dockcore's shaped wheel speeds; zero while a watchdog holds (the task manager faults on the same tick
+  // anyway once the gap lasts).
   dockcore::hal::WheelCommand wc;
-  wc.count = static_cast<std::uint8_t>(ws.count);
-  for (std::size_t i = 0; i < ws.count && i < 4; ++i) wc.radps[i] = ws.radps[i];
+  wc.count = static_cast<std::uint8_t>(out.wheels.count);
+  for (std::size_t i = 0; i < out.wheels.count && i < 4; ++i) wc.radps[i] = out.wheels.radps[i];
   send_wheels(wc);
 
   const bool charge = out.status.charge_enable;
@@ -919,7 +923,7 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       static_cast<double>(fb_.battery_current_a), static_cast<double>(fb_.battery_voltage_v),
       static_cast<double>(fb_.soc), fb_.estop ? "true" : "false", lidar_stale_ ? "true" : "false",
       chassis_stale_ ? "true" : "false", static_cast<double>(odom_.x_m), static_cast<double>(odom_.y_m),
-      deg(odom_.yaw_rad), static_cast<double>(prev_cmd_.vx_mps), static_cast<double>(prev_cmd_.wz_radps),
+      deg(odom_.yaw_rad), static_cast<double>(core_->drive_cmd().vx_mps), static_cast<double>(core_->drive_cmd().wz_radps),
       teach_.active ? "true" : "false", state_.find(s.dock_id) != nullptr ? "true" : "false",
       static_cast<unsigned long long>(stats_.ticks), static_cast<unsigned long long>(stats_.worst_period_us),
       static_cast<unsigned long long>(stats_.overruns), static_cast<unsigned long long>(stats_.worst_work_us),

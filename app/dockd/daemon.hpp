@@ -256,7 +256,6 @@ class Daemon {
 
   // Output.
   dockcore::TickOutput last_out_{};
-  dockcore::Twist2 prev_cmd_{};
   dockcore::hal::WheelCommand last_wheels_{};
   bool charge_requested_ = false;
   std::uint32_t charge_refresh_ = 0;
@@ -264,6 +263,8 @@ class Daemon {
   dockcore::TaskStatus prev_status_{};
   bool prev_status_valid_ = false;
   bool prev_lidar_stale_ = true, prev_chassis_stale_ = true;
+  std::uint32_t reported_bus_errors_ = 0;  ///< The chassis link's bus_errors when the last can_error event went out.
+  std::uint32_t reported_bus_off_ = 0;     ///< Its bus_off then.
 
   TickStats stats_{};
   std::uint64_t prev_tick_us_ = 0;

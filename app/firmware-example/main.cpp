@@ -3,7 +3,8 @@
 //
 // The "lidar" is a canned scene: a `plate-v` dock at the world origin against a 4 m wall, rendered every 100 ms into a 720-beam scan
 // (LD06-like, 0.5 degree steps) by core's own ray caster (PlacedProfile::raycast) from wherever the robot is, plus a
-// fixed pseudo-random ±3 mm range noise. The "chassis" integrates the commanded twist exactly (ideal odometry) and
+// fixed pseudo-random ±3 mm range noise. The "chassis" integrates the twist Dockcore sends the drive (after its limits)
+// exactly (ideal odometry) and
 // closes the contacts when the pads reach the dock face within ±10 mm / ±2 degrees; current flows 0.5 s later.
 // The main loop runs the 50 Hz control tick. With DOCKCORE_FW_SEMIHOSTING the firmware prints its timeline through
 // Arm semihosting (qemu-system-arm -semihosting, or a debug probe) and exits with status 0 when charging was
@@ -121,6 +122,7 @@ volatile FirmwareResult g_result;
 int main() {
   builtin_profile("plate-v", g_profile);
   DockcoreConfig cfg;
+  cfg.control_period_s = static_cast<Real>(kTickUs) * static_cast<Real>(1e-6);
   if (!g_core.configure(g_profile, cfg)) return 1;
 
   // Start 1.3 m out, 0.2 m to the side, 12 degrees off the dock's axis, facing roughly towards it.
@@ -167,9 +169,9 @@ int main() {
       put(" ");
       put_fixed(out.status.dock_pose.y_m, 3);
       put(" m cmd vx ");
-      put_fixed(out.cmd.vx_mps, 3);
+      put_fixed(out.drive_cmd.vx_mps, 3);
       put(" m/s wz ");
-      put_fixed(out.cmd.wz_radps, 3);
+      put_fixed(out.drive_cmd.wz_radps, 3);
       put(" rad/s\n");
       last_state = out.status.state;
     }
@@ -181,7 +183,7 @@ int main() {
 
     // Ideal unicycle over one tick; the dock face stops the pads (no pressing through it).
     const Real dt = static_cast<Real>(kTickUs) * static_cast<Real>(1e-6);
-    Pose2 next = robot.compose(Pose2{out.cmd.vx_mps * dt, 0, out.cmd.wz_radps * dt});
+    Pose2 next = robot.compose(Pose2{out.drive_cmd.vx_mps * dt, 0, out.drive_cmd.wz_radps * dt});
     if (!(at_face && next.transform(kPadsBody).x() < pads.x())) robot = next;
   }
 

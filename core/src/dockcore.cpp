@@ -15,6 +15,7 @@ bool Dockcore::configure(const DockProfile& profile, const DockcoreConfig& confi
   confirmed_ref_set_ = false;
   last_estimate_ = DockEstimate{};
   prev_state_ = TaskState::kNotTasking;
+  prev_drive_cmd_ = Twist2{};
   return estimator_.configure(profile, config.estimator);
 }
 
@@ -115,7 +116,9 @@ TickOutput Dockcore::tick(const TickInput& in) {
   pending_count_ = 0;
 
   const TaskState before = tasks_.state();
-  TickOutput out = tasks_.tick(t);
+  TickOutput out;
+  static_cast<TaskOutput&>(out) = tasks_.tick(t);
+  shape(in.hold, &out);
   // A new dock task: forget the old dock (the robot may have been carried since), so the push test and the
   // controller start from this task's own detections. A resumed one keeps the pre-outage estimate for the push test.
   if (out.status.state == TaskState::kGetTaskingCmd && prev_state_ != TaskState::kGetTaskingCmd) {
@@ -149,6 +152,19 @@ TickOutput Dockcore::tick(const TickInput& in) {
   if (out.status.state == TaskState::kFault) push_ref_set_ = false;
   prev_state_ = out.status.state;
   return out;
+}
+
+void Dockcore::shape(bool hold, TickOutput* out) {
+  Twist2 c{};
+  const Twist2& want = out->cmd;
+  // A zero twist (stop, fault, idle) is sent at once: the drive's own limits do the braking.
+  if (!hold && !(want.vx_mps == 0 && want.vy_mps == 0 && want.wz_radps == 0)) {
+    c = saturate_twist(config_.drive, config_.limits, want);
+    c = limit_acceleration(config_.limits, prev_drive_cmd_, c, config_.control_period_s);
+  }
+  prev_drive_cmd_ = c;
+  out->drive_cmd = c;
+  out->wheels = twist_to_wheels(config_.drive, c);
 }
 
 }  // namespace dockcore

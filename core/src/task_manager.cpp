@@ -162,17 +162,23 @@ void TaskManager::handle_command(const TaskInput& in, TaskOutput& out) {
         r = CommandResult::kRejectedBusy;
       }
       break;
-    case HostCommandType::kTestMode:
-      if (state_ == TaskState::kTestMode) {
+    case HostCommandType::kTestMode: {
+      // The test runs on the dock it names: the status reports that id, like a docking's.
+      const std::uint16_t id = in.command.dock_id;
+      if (id >= 32 || ((params_.accepted_dock_ids >> id) & 1u) == 0) {
+        r = CommandResult::kRejectedDockId;
+      } else if (state_ == TaskState::kTestMode && id == dock_id_) {
         r = CommandResult::kAccepted;
       } else if (state_ == TaskState::kNotTasking || state_ == TaskState::kFault) {
         r = CommandResult::kAccepted;
         fault_ = FaultCode::kNone;
+        dock_id_ = id;
         enter(TaskState::kTestMode, in);
       } else {
         r = CommandResult::kRejectedBusy;
       }
       break;
+    }
     default:
       r = CommandResult::kRejectedUnknown;
       break;

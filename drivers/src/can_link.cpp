@@ -90,6 +90,7 @@ class CanLinkImpl final : public CanLink {
     const hal::CanBusCounters& b = bus_.counters();
     counters_.send_failures = b.send_failures;
     counters_.bus_errors = b.bus_errors;
+    counters_.bus_off = b.bus_off;
     counters_.rx_overflows = b.rx_overflows;
     return fb_;
   }

@@ -192,18 +192,11 @@ class SocketCanBusImpl final : public SocketCanBus {
         }
       }
       if (n != static_cast<ssize_t>(sizeof cf)) continue;  // CAN FD or truncated: not ours, ignored
-      if (cf.can_id & CAN_ERR_FLAG) {
+      const CanErrorReport err = decode_can_error_frame(cf.can_id, cf.data);
+      if (err.error_frame) {
         ++counters_.bus_errors;
-        if (cf.can_id & CAN_ERR_BUSOFF) {
-          ++counters_.bus_off;
-          error_ = "socketcan: bus-off";
-        } else if (cf.can_id & CAN_ERR_CRTL) {
-          error_ = "socketcan: controller problem (error warning/passive or overflow)";
-        } else if (cf.can_id & (CAN_ERR_PROT | CAN_ERR_BUSERROR)) {
-          error_ = "socketcan: protocol violation / bus error";
-        } else if (cf.can_id & (CAN_ERR_TRX | CAN_ERR_ACK)) {
-          error_ = "socketcan: transceiver problem or no ACK (nobody else on the bus?)";
-        }
+        if (err.bus_off) ++counters_.bus_off;
+        error_ = err.message;
         continue;
       }
       if (cf.can_id & CAN_RTR_FLAG) continue;  // remote requests carry no data: no v1/AgileX frame uses them
@@ -278,6 +271,41 @@ class SocketCanBusImpl final : public SocketCanBus {
 };
 
 }  // namespace
+
+CanErrorReport decode_can_error_frame(std::uint32_t can_id, const std::uint8_t* data) {
+  CanErrorReport r;
+  if ((can_id & CAN_ERR_FLAG) == 0) return r;
+  r.error_frame = true;
+  r.bus_off = (can_id & CAN_ERR_BUSOFF) != 0;
+  r.restarted = (can_id & CAN_ERR_RESTARTED) != 0;
+  const std::uint8_t ctrl = data != nullptr ? data[1] : static_cast<std::uint8_t>(0);
+  if (r.bus_off) {
+    r.message = "socketcan: bus-off (the controller left the bus)";
+  } else if (can_id & CAN_ERR_CRTL) {
+    if (ctrl & (CAN_ERR_CRTL_RX_PASSIVE | CAN_ERR_CRTL_TX_PASSIVE)) {
+      r.message = "socketcan: controller error passive";
+    } else if (ctrl & (CAN_ERR_CRTL_RX_WARNING | CAN_ERR_CRTL_TX_WARNING)) {
+      r.message = "socketcan: controller error warning";
+    } else if (ctrl & (CAN_ERR_CRTL_RX_OVERFLOW | CAN_ERR_CRTL_TX_OVERFLOW)) {
+      r.message = "socketcan: controller buffer overflow";
+    } else {
+      r.message = "socketcan: controller problem";
+    }
+  } else if (can_id & (CAN_ERR_PROT | CAN_ERR_BUSERROR)) {
+    r.message = "socketcan: protocol violation / bus error";
+  } else if (can_id & (CAN_ERR_TRX | CAN_ERR_ACK)) {
+    r.message = "socketcan: transceiver problem or no ACK (nobody else on the bus?)";
+  } else if (can_id & CAN_ERR_TX_TIMEOUT) {
+    r.message = "socketcan: transmit timeout";
+  } else if (can_id & CAN_ERR_LOSTARB) {
+    r.message = "socketcan: lost arbitration";
+  } else if (r.restarted) {
+    r.message = "socketcan: controller restarted after bus-off";
+  } else {
+    r.message = "socketcan: error frame";
+  }
+  return r;
+}
 
 std::unique_ptr<SocketCanBus> open_socketcan(const std::string& interface, const std::uint32_t* rx_ids,
                                              std::size_t rx_id_count, std::string& error) {

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """dock-decode on tests/data/can/docking_v1.log (made by tests/can/make_can_log.cpp with one injected counter jump on
 WheelFbA, one ChassisStatus gap, one CAN FD, one RTR and one malformed line): the summary must report exactly those.
-Also: --strict exits 1 on that log; the same log without the bad lines and with the jump frame removed... is not
-needed: a log cut to its first 0.5 s (before any injected fault) must pass --strict.
+Also: --strict exits 1 on that log; a log cut to its first 0.5 s (before any injected fault) passes --strict;
+command-line errors exit 2 and --help exits 0.
 usage: check_decode.py DOCK_DECODE LOG WORKDIR"""
 import json
 import os
@@ -49,6 +49,14 @@ with open(log) as f, open(clean, "w") as g:
         g.write(line)
 r = subprocess.run([exe, clean, "--strict", "--strict-gaps", "-q"], capture_output=True, text=True)
 expect(r.returncode == 0, "--strict on the clean first 0.5 s: %d\n%s" % (r.returncode, r.stdout))
+
+# Command-line errors exit 2 with CLI11's message (not CLI11's own codes 104-114); --help exits 0.
+for args, what in (([log, "--profile", "nope"], "bad --profile"), ([log, "--bogus"], "unknown option"),
+                   ([], "missing log"), ([log, "extra"], "extra positional")):
+    r = subprocess.run([exe] + args, capture_output=True, text=True)
+    expect(r.returncode == 2 and r.stderr.strip() != "", "%s: exit %d, stderr %r" % (what, r.returncode, r.stderr))
+r = subprocess.run([exe, "--help"], capture_output=True, text=True)
+expect(r.returncode == 0 and "--profile" in r.stdout, "--help: exit %d" % r.returncode)
 
 for f in fails:
     print("FAIL", f)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# dockd SIGHUP config reload (issue #6 §3, docs/dockd.md "Config reload"), as a process with the development-only
+# dockd SIGHUP config reload (docs/dockd.md "Config reload"), as a process with the development-only
 # fake CAN: a valid file (watchdog threshold, host allowlist) is applied (event config_reload applied, status
 # config_reloads 1); a file with a bad value is rejected with file:line:column in the event log and on stderr and the running
 # config stays (dockd keeps answering on its port, chassis_stale_ms unchanged); a restart-only change (host.port) is

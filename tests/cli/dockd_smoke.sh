@@ -2,7 +2,9 @@
 # dockd / dockctl process tests: config errors exit 2 with file:line:column; a CAN interface that cannot open
 # (this kernel has no CAN) exits 3 with a clear message; with the development-only fake CAN, dockd answers dockctl,
 # rejects an unknown dock id (dockctl exit 1), dockctl without a daemon exits 3, and SIGTERM ends dockd with exit 0
-# after zero-velocity wheel frames (checked in the session record's candump log).
+# after zero-velocity wheel frames (checked in the session record's candump log). dockctl: argument errors exit 2
+# (an unknown subcommand is named with the valid ones), --help exits 0; `dockctl test --dock 3` puts dockd into
+# TEST_MODE on dock 3 and the status reports dock 3 until `stop`.
 set -u
 DOCKD=$1 DOCKCTL=$2 WORK=$3
 rm -rf "$WORK" && mkdir -p "$WORK"
@@ -19,6 +21,24 @@ printf '[host]\nport = "x"\n' > "$WORK/badtype.toml"
 out=$("$DOCKD" --config "$WORK/badtype.toml" 2>&1); rc=$?
 [ $rc -eq 2 ] || fail "wrong type: exit $rc"; grep -q "badtype.toml:2:8: host.port must be an integer, not a string" <<<"$out" || fail "wrong type message: $out"
 "$DOCKD" --help >/dev/null || fail "--help"
+out=$("$DOCKD" --bogus 2>&1); rc=$?
+[ $rc -eq 2 ] || fail "dockd --bogus: exit $rc (want 2)"
+
+"$DOCKCTL" --help >/dev/null; rc=$?
+[ $rc -eq 0 ] || fail "dockctl --help: exit $rc"
+"$DOCKCTL" test --help | grep -q -- "--dock" || fail "dockctl test --help lists no --dock"
+out=$("$DOCKCTL" fly 2>&1); rc=$?
+[ $rc -eq 2 ] || fail "dockctl fly: exit $rc (want 2)"
+grep -q "unknown subcommand 'fly' (valid: dock, undock, stop, status, test, teach)" <<<"$out" || fail "dockctl fly: $out"
+out=$("$DOCKCTL" --bogus 2>&1); rc=$?
+[ $rc -eq 2 ] || fail "dockctl --bogus: exit $rc (want 2)"
+grep -q "unknown option '--bogus'" <<<"$out" || fail "dockctl --bogus: $out"
+out=$("$DOCKCTL" 2>&1); rc=$?
+[ $rc -eq 2 ] || fail "dockctl without a subcommand: exit $rc (want 2)"
+out=$("$DOCKCTL" dock --dock x 2>&1); rc=$?
+[ $rc -eq 2 ] || fail "dockctl dock --dock x: exit $rc (want 2)"
+out=$("$DOCKCTL" test --dock 70000 2>&1); rc=$?
+[ $rc -eq 2 ] || fail "dockctl test --dock 70000: exit $rc (want 2)"
 
 cat > "$WORK/base.toml" <<CFG
 [lidar]
@@ -31,6 +51,11 @@ port = $PORT
 dir = "$WORK/rec"
 [state]
 file = "$WORK/dockd.state"
+[[docks]]
+id = 0
+[[docks]]
+id = 3
+profile = "breakpoint"
 CFG
 sed 's/IFACE/can0/' "$WORK/base.toml" > "$WORK/can0.toml"
 out=$("$DOCKD" --config "$WORK/can0.toml" 2>&1); rc=$?
@@ -56,6 +81,15 @@ grep -q '"chassis_stale":true' "$WORK/status.json" || { kill $pid; fail "fake CA
 "$DOCKCTL" --port $PORT dock --dock 7 >"$WORK/dock7.json"; rc=$?
 [ $rc -eq 1 ] || { kill $pid; fail "unknown dock: dockctl exit $rc"; }
 grep -q '"error":"unknown_dock_id"' "$WORK/dock7.json" || { kill $pid; fail "unknown dock reply: $(cat "$WORK/dock7.json")"; }
+"$DOCKCTL" --port $PORT test --dock 3 >"$WORK/test3.json"; rc=$?
+[ $rc -eq 0 ] || { kill $pid; fail "test --dock 3: dockctl exit $rc: $(cat "$WORK/test3.json")"; }
+grep -q '"dock_id":3,"state":"TEST_MODE"' "$WORK/test3.json" || { kill $pid; fail "test reply: $(cat "$WORK/test3.json")"; }
+"$DOCKCTL" --port $PORT status >"$WORK/status3.json" || { kill $pid; fail "status in test mode"; }
+grep -q '"state":"TEST_MODE"' "$WORK/status3.json" || { kill $pid; fail "test mode status: $(cat "$WORK/status3.json")"; }
+grep -q '"dock_id":3,' "$WORK/status3.json" || { kill $pid; fail "a test on dock 3 must report dock 3: $(cat "$WORK/status3.json")"; }
+"$DOCKCTL" --port $PORT stop >/dev/null || { kill $pid; fail "stop after test"; }
+"$DOCKCTL" --port $PORT status >"$WORK/status4.json" || { kill $pid; fail "status after stop"; }
+grep -q '"state":"NOT_TASKING"' "$WORK/status4.json" || { kill $pid; fail "stop must end the test: $(cat "$WORK/status4.json")"; }
 before=$(wc -l < "$WORK/rec/can.log")
 kill -TERM $pid
 wait $pid; rc=$?

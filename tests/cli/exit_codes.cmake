@@ -3,6 +3,8 @@ cmake_minimum_required(VERSION 3.25)
 #  detect: 0 when the file was readable (malformed lines reported on stderr with their line numbers, then skipped),
 #          2 for a bad profile / bad argument / unreadable file.
 #  scene / profile: 2 for a bad profile (message with file:line:column for TOML errors).
+#  every command-line error CLI11 finds (unknown option or subcommand, bad value, out of a documented range, negative
+#  seed): 2 with its message; --help: 0.
 # Inputs: -DDOCKSIM=<dock-sim> -DDIR=<tests/cli> -DSCANS=<sample.jsonl> -DWORK=<scratch dir>
 foreach(v DOCKSIM DIR SCANS WORK)
   if(NOT DEFINED ${v})
@@ -48,6 +50,22 @@ expect_run(2 "bad_profile.toml:3:3: unknown key 'depth'" detect --scans "${SCANS
 expect_run(2 "bad_profile.toml:3:3: unknown key 'depth'" scene --profile "${DIR}/bad_profile.toml")
 expect_run(2 "unknown lidar" scene --lidar hokuyo)
 expect_run(2 "bad_profile.toml:3:3" profile --name "${DIR}/bad_profile.toml")
+
+# Command-line errors: exit 2 (never CLI11's own codes 104-114) with CLI11's message; --help exits 0.
+expect_run(0 "" --help)
+expect_run(0 "" scene --help)
+expect_run(2 "A subcommand is required")
+expect_run(2 "unknown subcommand 'fly' \\(valid: scene, profile, detect, perception, run, montecarlo, soak, features\\)" fly)
+expect_run(2 "--bogus" scene --bogus)
+expect_run(2 "unknown option '--bogus'" --bogus)
+expect_run(2 "--clutter" scene --clutter x)
+expect_run(2 "--clutter: Value 9 not in range 0 to 3" scene --clutter 9)
+expect_run(2 "--clutter: Value 4 not in range 0 to 3" perception --clutter 4)
+expect_run(2 "--look-alikes" scene --look-alikes -1)
+expect_run(2 "--seed: must be a non-negative integer" scene --seed -1)
+expect_run(2 "--seed: must be a non-negative integer" perception --seed -5)
+expect_run(2 "--seed: must be a non-negative integer" features --seed -1)
+expect_run(2 "--seed" detect --scans "${SCANS}" --seed 1)
 
 # With a mount the poses move into the robot frame: lidar 0.1 m ahead of the robot centre, turned 180°.
 expect_run(0 "" detect --scans "${SCANS}" --detector estimator)

@@ -1,10 +1,10 @@
 // fuzz-links: core drivers dockd_lib
-// dockd's config parser (issue #4 §6, #6 §5): arbitrary bytes as the TOML text of a config. Every input either
+// dockd's config parser: arbitrary bytes as the TOML text of a config. Every input either
 // throws dockd::ConfigError whose message starts with "fuzz.toml:<line>:<column>: " (1-based, matching line() and
 // column()) — the message --check-config, start-up and a SIGHUP reload print — or returns a config that passes
 // dockd's validation: a non-empty dock database of unique ids 0..31 matching the accepted-id mask, an existing
 // default dock, every profile accepted by the estimator, a bounded and well-formed allowlist, consistent ranges.
-// Any other exception, crash, leak or UB is a finding.
+// Any other exception, crash, leak or UB fails the target.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>

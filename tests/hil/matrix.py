@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Fault-injection matrix analysis (issue #6 §1), standard library only. Every time is CLOCK_REALTIME seconds: the
+"""Fault-injection matrix analysis, standard library only. Every time is CLOCK_REALTIME seconds: the
 candump log's stamps, chassis-sim's truth "wall" field and the case's inject log (`date +%s.%N`) share that clock.
 
   matrix.py row ROW_DIR --row NAME --fault EVENT [--limit-ms L] [--code C] [--clear EVENT] [--recover KIND]
@@ -207,8 +207,8 @@ def stall_ms(times, t0, t1):
 LIDAR_WATCHDOG_MARGIN_MS = 100
 CHASSIS_WATCHDOG_MARGIN_MS = 180
 # chassis-sim writes sim_lidar_late / sim_scan_skipped when it runs again after a stall: in a loaded HIL run
-# (2026-11-22, obstacle row) a 240 ms stall of the VM left dockd without scans and the event was stamped 36 ms after
-# the 185 it caused. A starved simulator's next loop runs within a tick or two once it is scheduled again.
+# (obstacle row) a 240 ms stall of the VM left dockd without scans and the event was stamped 36 ms after the 185 it
+# caused. A starved simulator's next loop runs within a tick or two once it is scheduled again.
 SIM_LATE_LOGGED_AFTER_S = 0.3
 
 

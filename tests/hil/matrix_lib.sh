@@ -1,4 +1,4 @@
-# Fault-injection matrix helpers (issue #6 §1), sourced by tests/hil/cases/matrix_*.sh after lib.sh. Each row gets a
+# Fault-injection matrix helpers, sourced by tests/hil/cases/matrix_*.sh after lib.sh. Each row gets a
 # fresh chassis-sim + dockd + candump with its logs in $OUT/<row>/ (candump.log, truth.jsonl, inject.log, record/,
 # dockd.log, chassis.log, status.json) and is judged from the candump stamps by tests/hil/matrix.py.
 #

@@ -147,7 +147,56 @@ TEST(CanLink, V1FeedbackPowerStatusAndBadFrames) {
   CHECK_FALSE(link->send_wheels(hal::WheelCommand{}));
   link->poll();
   LONGS_EQUAL(1, link->counters().bus_errors);
+  LONGS_EQUAL(1, link->counters().bus_off);
   LONGS_EQUAL(1, link->counters().send_failures);
+  bus.inject_error(false);
+  link->poll();
+  LONGS_EQUAL(2, link->counters().bus_errors);
+  LONGS_EQUAL(1, link->counters().bus_off);
+}
+
+// Error frames as the kernel (or `cansend vcan0 200000XX#...`) delivers them: id = CAN_ERR_FLAG | classes,
+// data[1] = controller state (linux/can/error.h).
+TEST(CanLink, ErrorFrameDecode) {
+  const std::uint8_t none[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  drivers::CanErrorReport r = drivers::decode_can_error_frame(0x123u, none);  // a data frame
+  CHECK_FALSE(r.error_frame);
+  CHECK_FALSE(r.bus_off);
+  STRCMP_EQUAL("", r.message);
+  r = drivers::decode_can_error_frame(0x80000123u, none);  // extended data frame (CAN_EFF_FLAG): not an error
+  CHECK_FALSE(r.error_frame);
+
+  r = drivers::decode_can_error_frame(0x20000040u, none);  // CAN_ERR_BUSOFF
+  CHECK(r.error_frame);
+  CHECK(r.bus_off);
+  CHECK_FALSE(r.restarted);
+  STRCMP_CONTAINS("bus-off", r.message);
+  r = drivers::decode_can_error_frame(0x20000044u, none);  // bus-off wins over the controller class
+  CHECK(r.bus_off);
+  STRCMP_CONTAINS("bus-off", r.message);
+
+  const std::uint8_t passive[8] = {0, 0x20, 0, 0, 0, 0, 0, 0};   // CAN_ERR_CRTL_TX_PASSIVE
+  const std::uint8_t warning[8] = {0, 0x04, 0, 0, 0, 0, 0, 0};   // CAN_ERR_CRTL_RX_WARNING
+  const std::uint8_t overflow[8] = {0, 0x01, 0, 0, 0, 0, 0, 0};  // CAN_ERR_CRTL_RX_OVERFLOW
+  r = drivers::decode_can_error_frame(0x20000004u, passive);     // CAN_ERR_CRTL
+  CHECK(r.error_frame);
+  CHECK_FALSE(r.bus_off);
+  STRCMP_EQUAL("socketcan: controller error passive", r.message);
+  STRCMP_EQUAL("socketcan: controller error warning", drivers::decode_can_error_frame(0x20000004u, warning).message);
+  STRCMP_EQUAL("socketcan: controller buffer overflow", drivers::decode_can_error_frame(0x20000004u, overflow).message);
+  STRCMP_EQUAL("socketcan: controller problem", drivers::decode_can_error_frame(0x20000004u, nullptr).message);
+
+  STRCMP_CONTAINS("bus error", drivers::decode_can_error_frame(0x20000080u, none).message);  // CAN_ERR_BUSERROR
+  STRCMP_CONTAINS("protocol", drivers::decode_can_error_frame(0x20000008u, none).message);   // CAN_ERR_PROT
+  STRCMP_CONTAINS("no ACK", drivers::decode_can_error_frame(0x20000020u, none).message);     // CAN_ERR_ACK
+  STRCMP_CONTAINS("transmit timeout", drivers::decode_can_error_frame(0x20000001u, none).message);
+  STRCMP_CONTAINS("lost arbitration", drivers::decode_can_error_frame(0x20000002u, none).message);
+  r = drivers::decode_can_error_frame(0x20000100u, none);  // CAN_ERR_RESTARTED
+  CHECK(r.error_frame);
+  CHECK(r.restarted);
+  CHECK_FALSE(r.bus_off);
+  STRCMP_CONTAINS("restarted", r.message);
+  STRCMP_EQUAL("socketcan: error frame", drivers::decode_can_error_frame(0x20000000u, none).message);
 }
 
 TEST(CanLink, HostCommandsSequenceRulesAndBoundedQueue) {

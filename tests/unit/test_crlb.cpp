@@ -9,7 +9,8 @@ using namespace dockcore;
 
 TEST_GROUP(Crlb){};
 
-// The reference figures for plate-v, LD06 (0.8°), σ 10 mm, head-on: ~4 mm / 0.95° at 0.5 m, ~6 mm / 1.4° at 1 m.
+// Reference figures of the specification for plate-v, LD06 (0.8°), σ 10 mm, head-on:
+// ~4 mm / 0.95° at 0.5 m, ~6 mm / 1.4° at 1 m.
 TEST(Crlb, PlateVMatchesReferenceFigures) {
   DockProfile p;
   builtin_profile("plate-v", p);

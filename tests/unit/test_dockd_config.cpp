@@ -82,7 +82,7 @@ TEST(DockdConfig, TargetCorrectionMovesTheEstimateOntoTheNominalPose) {
   }
 }
 
-// Issue #6 §5: every config input is bounded (docs/reliability.md, "Security").
+// every config input is bounded (docs/reliability.md, "Security").
 TEST(DockdConfig, InputCapsAreEnforcedWithPositions) {
   std::string allow = "[host]\nallowlist = [";
   for (std::size_t i = 0; i <= dockd::kMaxAllowlistEntries; ++i) allow += (i ? ", " : "") + std::string("\"10.0.0.1\"");
@@ -121,7 +121,7 @@ TEST(DockdConfig, InputCapsAreEnforcedWithPositions) {
   STRCMP_CONTAINS("appears twice", error_of(docks + "[[docks]]\nid = 0\n").c_str());
 }
 
-// Issue #6 §3: which keys a SIGHUP reload may change (docs/dockd.md, "Config reload").
+// which keys a SIGHUP reload may change (docs/dockd.md, "Config reload").
 TEST(DockdConfig, RestartOnlyChangesNameTheKeys) {
   const dockd::DockdConfig a = dockd::parse_config_toml("", "t.toml");
   // Runtime keys: no restart-only change.
@@ -166,7 +166,7 @@ TEST(DockdConfig, CrossKeyErrorsPointAtTheKey) {
                   error_of("[host]\nport = 7400\n[camera]\nenabled = true\nport = 7400\n").c_str());
 }
 
-// robot.footprint.self_sectors_deg -> FootprintParams::self_sectors (b426c4c: only configured sectors are the robot).
+// robot.footprint.self_sectors_deg -> FootprintParams::self_sectors (only configured sectors are the robot).
 TEST(DockdConfig, SelfSectorsAreParsedInRadians) {
   CHECK_EQUAL(0u, dockd::parse_config_toml("", "t.toml").footprint.self_sector_count);
   const dockd::DockdConfig c = dockd::parse_config_toml(

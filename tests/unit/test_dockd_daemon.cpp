@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -185,7 +186,29 @@ TEST(DockdDaemon, DocksChargesAndUndocksInSimulation) {
   CHECK(r.daemon->tick_stats().ticks > 100);
 }
 
-// A failed attempt says why in the event log (issue #6: CI saw a retry and nothing told its cause): the charger's
+// CAN error frames (counted by the bus, mirrored by the chassis link) reach the session record as can_error events:
+// one per poll that saw new ones, with the totals and how many are new; nothing else changes.
+TEST(DockdDaemon, CanErrorFramesAreLoggedWithTheirTotals) {
+  Rig r("canerr", false, 1.2, true);
+  for (int i = 0; i < 5; ++i) r.tick();
+  CHECK_TRUE(r.events("can_error").empty());
+  r.link.c.bus_errors = 3;  // e.g. error passive, bus error, bus-off
+  r.link.c.bus_off = 1;
+  r.tick();
+  std::string ev = r.events("can_error");
+  STRCMP_CONTAINS("\"bus_errors\":3,\"bus_off\":1,\"new\":3", ev.c_str());
+  for (int i = 0; i < 5; ++i) r.tick();  // nothing new: no further event
+  ev = r.events("can_error");
+  LONGS_EQUAL(1, static_cast<long>(std::count(ev.begin(), ev.end(), '\n')));
+  r.link.c.bus_errors = 5;
+  r.tick();
+  ev = r.events("can_error");
+  LONGS_EQUAL(2, static_cast<long>(std::count(ev.begin(), ev.end(), '\n')));
+  STRCMP_CONTAINS("\"bus_errors\":5,\"bus_off\":1,\"new\":2", ev.c_str());
+  CHECK(r.daemon->state() == TaskState::kNotTasking);
+}
+
+// A failed attempt says why in the event log (a retry names its cause): the charger's
 // relay stays open for the first attempt, so WAIT_FOR_CHARGE times out into RETRY with charge_not_confirmed; the
 // second attempt charges.
 TEST(DockdDaemon, RetryEventSaysWhyTheAttemptEnded) {
@@ -291,8 +314,8 @@ TEST(DockdDaemon, LidarStaleStopsWithinOneTickAndFaults) {
 TEST(DockdDaemon, LidarWatchdogDoesNotFlapAtStartUp) {
   // A real sensor's turn reaches dockd a turn and a bit after its first sample (the parser closes it on the next
   // turn's first point): here 130 ms. The first scan alone does not say when its turn ended; taken for ending at
-  // its first sample, it made the lidar fresh and then stale again just before the second scan (CI saw that 185 in
-  // the status of a docking commanded right after start-up). Once fresh, it must stay fresh.
+  // its first sample, it would make the lidar fresh and then stale again just before the second scan (a 185 in the
+  // status of a docking commanded right after start-up). Once fresh, it must stay fresh.
   Rig r("startup", false, 1.2, true);
   r.scan_lag_us = 130000;
   bool was_fresh = false;
@@ -337,8 +360,9 @@ TEST(DockdDaemon, ScansDeliveredLateDoNotKeepTheLidarFresh) {
 }
 
 TEST(DockdDaemon, CanHostCommandsTheTaskManagerRejectsAreCounted) {
-  // Issue #6 matrix: an unknown command code and an unknown dock id over CAN are rejected by the task manager; the
-  // status counter commands_rejected must count them as it counts UDP refusals, and nothing else changes.
+  // Fault matrix row host_bad_commands: an unknown command code and an unknown dock id over CAN are rejected by the
+  // task manager; the status counter commands_rejected must count them as it counts UDP refusals, and nothing else
+  // changes.
   Rig r("canrej");
   r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
   const std::uint32_t before = r.daemon->counters().commands_rejected;
@@ -461,7 +485,7 @@ TEST(DockdDaemon, TeachStoresTargetUsedByLaterDockings) {
   ::close(s);
 }
 
-// Issue #6 §3: SIGHUP config reload (docs/dockd.md, "Config reload").
+// SIGHUP config reload (docs/dockd.md, "Config reload").
 TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   Rig r("reload");
   CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
@@ -538,10 +562,10 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 90.0));
 }
 
-// Issue #6 HIL: dockd stalled ~0.9 s around a 0.5 m push and then dropped the late scans. The core's scan-age
-// backstop faulted 185, the watchdog resume re-issued the dock command once scans were fresh, the new task restarted
-// the filter at the pushed pose, and the robot docked from there. Pushed (sideways 0.5 m, or turned 40 deg about the
-// dock) during a gap of late scans, the resumed task must report the push (178/179) and not dock.
+// dockd stalls around a 0.5 m push and then drops the late scans: the core's scan-age backstop faults 185, the
+// watchdog resume re-issues the dock command once scans are fresh, and the new task restarts the filter at the pushed
+// pose. Pushed (sideways 0.5 m, or turned 40 deg about the dock) during a gap of late scans, the resumed task must
+// report the push (178/179) and not dock.
 TEST(DockdDaemon, PushDuringALateScanGapIsReportedAfterTheResume) {
   const double gaps_s[] = {0.6, 1.0, 2.0};
   for (const double gap_s : gaps_s) {

@@ -1,4 +1,4 @@
-// dockd's heap after start-up (issue #6 §2): the Daemon runs several dock -> charge -> undock cycles of a simulated
+// dockd's heap after start-up: the Daemon runs several dock -> charge -> undock cycles of a simulated
 // robot (the default scenario, as test_dockd_daemon.cpp) with its event log open, a CAN host, and a UDP host link
 // with a subscribed status stream and a status request per cycle; every malloc/calloc/realloc (operator new goes
 // through malloc) made inside Daemon::on_tick / on_host_readable is counted. After the first cycle (lazy first-use

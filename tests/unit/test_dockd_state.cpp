@@ -91,7 +91,7 @@ TEST(DockdState, Crc32MatchesTheStandardCheckValue) {
   CHECK_EQUAL(0xCBF43926u, dockd::crc32_ieee("123456789", 9));
 }
 
-// Issue #6 §5: an oversized state file is treated as corrupt without being read whole; the backup is used.
+// an oversized state file is treated as corrupt without being read whole; the backup is used.
 TEST(DockdState, OversizedFileIsCorruptAndTheBackupIsUsed) {
   dockd::StateData s;
   dockd::TaughtTarget t;

@@ -74,8 +74,8 @@ TEST(Safety, SquareForwardAreaStartsAtTheBodyFront) {
   }
 }
 
-// HIL finding (docs/reliability.md): a disc 1.5 cm beyond the front edge, inside the 2 cm self margin, was taken for
-// the robot and driven through. Only configured self sectors are the robot.
+// A disc 1.5 cm beyond the front edge, inside the 2 cm self margin, is an obstacle (HIL row motion_obstacle,
+// docs/reliability.md): only configured self sectors are the robot.
 TEST(Safety, ObstacleWithinTheSelfMarginOfTheBumperBlocks) {
   ObstacleChecker c;
   c.configure(square_footprint(), nullptr);

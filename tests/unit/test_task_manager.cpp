@@ -519,9 +519,9 @@ TEST(TaskManager, ObstacleStopsAndResumes) {
   LONGS_EQUAL(0, s->zero_violations);
 }
 
-// HIL finding (docs/reliability.md): a disc appearing 1.5 cm beyond the front edge (inside the old 2 cm self margin)
-// stopped the robot, then vanished as "the robot itself" and was driven through. It must hold the robot as long as
-// it is there, without a fault, and the approach continues once it is gone.
+// A disc appearing 1.5 cm beyond the front edge (inside the 2 cm self margin; HIL row motion_obstacle,
+// docs/reliability.md) must not vanish as "the robot itself": it holds the robot as long as it is there, without a
+// fault, and the approach continues once it is gone.
 TEST(TaskManager, ObstacleAtTheBumperHoldsTheRobotUntilItLeaves) {
   auto s = std::make_unique<Sim>();
   s->command(HostCommandType::kDock);
@@ -791,6 +791,33 @@ TEST(TaskManager, TestModeReportsTheDockAndNeverMoves) {
   LONGS_EQUAL(0, s->zero_violations);
 }
 
+TEST(TaskManager, TestModeReportsItsDockIdAndRefusesABadOne) {
+  auto s = std::make_unique<Sim>();
+  TaskOutput o = s->command(HostCommandType::kTestMode, 3);
+  CHECK(o.command_result == CommandResult::kAccepted);
+  CHECK(o.status.state == TaskState::kTestMode);
+  LONGS_EQUAL(3, o.status.dock_id);
+  s->run_for(0.5);
+  LONGS_EQUAL(3, s->out.status.dock_id);
+  o = s->command(HostCommandType::kTestMode, 3);  // again on the same dock: nothing changes
+  CHECK(o.command_result == CommandResult::kAccepted);
+  LONGS_EQUAL(3, o.status.dock_id);
+  o = s->command(HostCommandType::kTestMode, 5);  // another dock while testing: cancel first
+  CHECK(o.command_result == CommandResult::kRejectedBusy);
+  LONGS_EQUAL(3, o.status.dock_id);
+  s->command(HostCommandType::kCancel);
+  // An id the task manager does not accept is refused and changes nothing.
+  s->params.accepted_dock_ids = 0x0Fu;  // ids 0..3
+  s->reconfigure();
+  o = s->command(HostCommandType::kTestMode, 4);
+  CHECK(o.command_result == CommandResult::kRejectedDockId);
+  CHECK(o.status.state == TaskState::kNotTasking);
+  o = s->command(HostCommandType::kTestMode, 40);
+  CHECK(o.command_result == CommandResult::kRejectedDockId);
+  CHECK(o.status.state == TaskState::kNotTasking);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
 TEST(TaskManager, Deterministic) {
   auto run = [] {
     auto s = std::make_unique<Sim>();
@@ -908,11 +935,10 @@ TEST(Dockcore, NoScansMeansLidarStaleWhenMoving) {
   LONGS_EQUAL(185, static_cast<int>(o.status.fault));
 }
 
-// HIL finding (docs/reliability.md, "Push rows and lidar gaps"): right after a push the host's loop stalled, then
-// drained the lidar backlog — several scans through on_scan before the next tick (dockd: up to 4 per loop). The
-// filter gates the first two jumps and restarts at the pushed pose on the third (reinit_after 3); the push test saw
-// only the newest detection, against the restarted filter, and the robot docked on from the pushed pose. Every
-// detection must be tested against the filter as it was before that detection.
+// Right after a push the host's loop stalls, then drains the lidar backlog — several scans through on_scan before the
+// next tick (dockd: up to 4 per loop; docs/reliability.md). The filter gates the first two jumps and restarts at the
+// pushed pose on the third (reinit_after 3), so a test of the newest detection against the restarted filter would
+// see nothing. Every detection must be tested against the filter as it was before that detection.
 TEST(Dockcore, PushFollowedByAScanBacklogIsStillReported) {
   for (int turned = 0; turned <= 1; ++turned) {
     for (int backlog = 2; backlog <= 10; ++backlog) {
@@ -944,12 +970,12 @@ TEST(Dockcore, PushFollowedByAScanBacklogIsStillReported) {
   }
 }
 
-// HIL finding (docs/reliability.md, "A push after a filter restart"): on a loaded machine dockd matched a few scans to
-// odometry read late, so their detections sat 3-5 cm off the estimate and the filter gated them. A restart needs
-// reinit_after (3) gated detections in a row. When the push came after one or two of them, the first post-push
-// detection restarted the filter, and with three the filter had restarted just before the push. Either way the push
-// test then met a filter resting on one detection, which it may not test against, and the robot docked on from the
-// pushed pose with no 179. The last confirmed estimate must stay the reference until the filter is confirmed again.
+// On a loaded machine dockd can match a few scans to odometry read late, so their detections sit 3-5 cm off the
+// estimate and the filter gates them (docs/reliability.md, "A push right after a filter restart"). A restart needs
+// reinit_after (3) gated detections in a row. When the push comes after one or two of them, the first post-push
+// detection restarts the filter; with three the filter restarts just before the push. Either way the push test meets
+// a filter resting on one detection, which it may not test against. The last confirmed estimate must stay the
+// reference until the filter is confirmed again, so the push is reported (179).
 TEST(Dockcore, PushRightAfterGatedDetectionsIsStillReported) {
   for (int gated = 1; gated <= 3; ++gated) {
     const std::string what = std::to_string(gated) + " gated detection(s) before the push";
@@ -977,13 +1003,13 @@ TEST(Dockcore, PushRightAfterGatedDetectionsIsStillReported) {
   }
 }
 
-// HIL finding (issue #6): dockd stalled ~0.9 s around a 0.5 m push and then dropped the late scans, so the core got
-// no detection for ~1 s and then only post-push ones. Wheel odometry runs through a lidar gap, so the pre-gap estimate
-// carried by odometry is still the expectation: the push must be reported on the second agreeing post-gap detection
-// (178 sideways, 179 turned about the dock). When the ticks ran through the gap the scan-age backstop (185 after
-// lidar_stale_s) stops the robot first, and dockd's watchdog resume re-issues the dock command: the resumed task must
-// still report the push (it docked from the pushed pose: the new task had reset the filter and the push test had no
-// pre-push reference). `ticking`: the host kept ticking through the gap (dropped scans) or stalled (no ticks).
+// dockd stalls ~0.9 s around a 0.5 m push and then drops the late scans, so the core gets no detection for ~1 s and
+// then only post-push ones. Wheel odometry runs through a lidar gap, so the pre-gap estimate carried by odometry is
+// still the expectation: the push must be reported on the second agreeing post-gap detection (178 sideways, 179
+// turned about the dock). When the ticks run through the gap the scan-age backstop (185 after lidar_stale_s) stops the
+// robot first, and dockd's watchdog resume re-issues the dock command: the resumed task must still report the push
+// (the new task resets the filter, so the pre-push estimate is the only reference). `ticking`: the host kept ticking
+// through the gap (dropped scans) or stalled (no ticks).
 TEST(Dockcore, PushDuringALidarGapIsStillReported) {
   const double gaps_s[] = {0.6, 1.0, 2.0};
   for (int ticking = 0; ticking <= 1; ++ticking) {
@@ -1053,4 +1079,64 @@ TEST(Dockcore, PushDuringALidarGapIsStillReported) {
       }
     }
   }
+}
+
+TEST(Dockcore, DriveCommandIsSaturatedRateLimitedAndZeroedAtOnce) {
+  FacadeSim f;
+  DockcoreConfig cfg;
+  cfg.task.detect_wait_s = 0.3;
+  cfg.limits.max_vx_mps = 0.2;
+  cfg.limits.max_linear_accel_mps2 = 0.5;
+  cfg.limits.max_angular_accel_radps2 = 2.0;
+  cfg.control_period_s = 0.02;
+  CHECK(f.core->configure(f.w.profile, cfg));
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  bool moved = false;
+  Twist2 prev{};
+  for (int i = 0; i < 400 && f.core->task_manager().state() != TaskState::kFinishTasking; ++i) {
+    const TickOutput o = f.step();
+    const bool want_zero = o.cmd.vx_mps == 0 && o.cmd.vy_mps == 0 && o.cmd.wz_radps == 0;
+    if (want_zero) {
+      // A stop is sent at once, however fast the robot was going.
+      CHECK(o.drive_cmd.vx_mps == 0 && o.drive_cmd.wz_radps == 0);
+    } else {
+      moved = true;
+      CHECK(std::fabs(o.drive_cmd.vx_mps) <= 0.2 + 1e-9);
+      CHECK(std::fabs(o.drive_cmd.vx_mps - prev.vx_mps) <= 0.5 * 0.02 + 1e-9);
+      CHECK(std::fabs(o.drive_cmd.wz_radps - prev.wz_radps) <= 2.0 * 0.02 + 1e-9);
+    }
+    // The wheels realise exactly the shaped twist.
+    const WheelSpeeds w = twist_to_wheels(cfg.drive, o.drive_cmd);
+    LONGS_EQUAL(2, static_cast<long>(o.wheels.count));
+    REAL_EQUAL(w.radps[0], o.wheels.radps[0], 0);
+    REAL_EQUAL(w.radps[1], o.wheels.radps[1], 0);
+    prev = o.drive_cmd;
+  }
+  CHECK(moved);
+}
+
+TEST(Dockcore, HoldZeroesTheDriveAndTheRampRestartsFromRest) {
+  FacadeSim f;
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  TickOutput o;
+  for (int i = 0; i < 200; ++i) {
+    o = f.step();
+    if (o.drive_cmd.vx_mps != 0) break;
+  }
+  CHECK(o.drive_cmd.vx_mps != 0);
+  // A host hold: the task manager still wants to move, the drive gets zero.
+  TickInput in;
+  in.now_us = f.w.now_us;
+  in.odom_pose = f.w.odom;
+  in.hold = true;
+  const TickOutput held = f.core->tick(in);
+  CHECK(held.cmd.vx_mps != 0 || held.cmd.wz_radps != 0);
+  CHECK(held.drive_cmd.vx_mps == 0 && held.drive_cmd.wz_radps == 0);
+  CHECK(held.wheels.radps[0] == 0 && held.wheels.radps[1] == 0);
+  // Released: the acceleration limit ramps up from rest again.
+  in.hold = false;
+  in.now_us += 20000;
+  const TickOutput next = f.core->tick(in);
+  const DriveLimits lim = f.core->config().limits;
+  CHECK(std::fabs(next.drive_cmd.vx_mps) <= lim.max_linear_accel_mps2 * f.core->config().control_period_s + 1e-9);
 }

@@ -220,7 +220,7 @@ TEST(UdpCamera, SocketKeepsNewestValidTargetAndCountsGarbage) {
   CHECK_FALSE(cam->poll_target(t));
 }
 
-// Issue #6 §3/§5: the allowlist can change at runtime (config reload), checked as a whole and bounded.
+// the allowlist can change at runtime (config reload), checked as a whole and bounded.
 TEST(UdpHostLink, AllowlistReplacedAtRuntimeAllOrNothingAndBounded) {
   auto l = open_link();
   Peer stranger("127.0.0.2");

@@ -32,10 +32,13 @@ inline void add_lidar_out_options(CLI::App& app, LidarOutOptions& o) {
   app.add_option("--lidar-protocol", o.protocol, "ld06 | rplidar | lakibeam");
   app.add_option("--lidar-pty", o.pty_link, "Serial lidar on a pty; a symlink to it is made at this path");
   app.add_option("--lidar-udp", o.udp, "UDP lidar: send datagrams to HOST:PORT");
-  app.add_option("--lidar-corrupt", o.corrupt_fraction, "Fraction of lidar bytes with a flipped bit (0..1)");
+  app.add_option("--lidar-corrupt", o.corrupt_fraction, "Fraction of lidar bytes with a flipped bit (0..1)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--lidar-corrupt-packets", o.corrupt_packet_fraction,
-                 "Fraction of lidar packets with one flipped bit (0..1)");
-  app.add_option("--lidar-drop", o.drop_fraction, "Fraction of lidar packets not sent (0..1)");
+                 "Fraction of lidar packets with one flipped bit (0..1)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--lidar-drop", o.drop_fraction, "Fraction of lidar packets not sent (0..1)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--lidar-stall-at", o.stall_at_s, "Lidar stops sending this long after motion start (s)");
   app.add_option("--lidar-stall-for", o.stall_for_s, "... for this long (s)");
   app.add_option("--lidar-unplug-at", o.unplug_at_s, "Lidar pty closed this long after motion start (s)");

@@ -1,4 +1,4 @@
-// chassis-sim: the scripted chassis of dock-sim (docksim::Chassis, scenario files of issue #3) on a real CAN
+// chassis-sim: the scripted chassis of dock-sim (docksim::Chassis, scenario files) on a real CAN
 // interface, plus the lidar it carries (through dockcore_emu's LidarEmitter on a pty or UDP), in real time.
 //
 // It plays the robot base for dockd in the vcan HIL suite: consumes wheel command frames (dockcore CAN v1 or AgileX
@@ -29,6 +29,7 @@
 #include "dockcore/can_dockcore_v1.hpp"
 #include "dockcore/drivers/can_link.hpp"
 #include "docksim/chassis.hpp"
+#include "docksim/cli_checks.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenario.hpp"
@@ -540,7 +541,8 @@ int main(int argc, char** argv) {
   app.add_option("--chassis-base-id", o.chassis_base_id, "dockcore v1 chassis base id (default 0x100)");
   app.add_option("--host-base-id", o.host_base_id, "dockcore v1 host base id (default 0x180)");
   app.add_option("--start", o.start, "Start pose DISTANCE_M,BEARING_DEG,HEADING_DEG (default: drawn with --seed)");
-  app.add_option("--seed", o.seed, "Seed for the start pose and every noise source");
+  app.add_option("--seed", o.seed, "Seed for the start pose and every noise source")
+      ->check(docksim::non_negative_integer());
   app.add_option("--duration", o.duration_s, "Stop after this many seconds (0 = until SIGTERM)");
   app.add_option("--command-timeout", o.command_timeout_s, "Motors stop after this long without a wheel command (s)");
   app.add_option("--truth", o.truth_path, "Write the true state as JSON lines (10 Hz and at events)");

@@ -359,7 +359,11 @@ int main(int argc, char** argv) {
   app.add_flag("--json", as_json, "one JSON document (summary + timeline) instead of text");
   app.add_flag("-q,--quiet", quiet, "summary only, no timeline");
   app.add_option("--svg", svg, "plot commanded/measured velocities, task state and fault code to FILE");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;  // argument errors: CLI11's message, exit 2; --help: 0
+  }
 
   try {
     opt.chassis_base = parse_id(chassis_base);

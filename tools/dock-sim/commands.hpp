@@ -18,5 +18,7 @@ void register_montecarlo(CLI::App& app);
 void register_soak(CLI::App& app);
 /// `dock-sim features`: the estimator's decision features of labelled candidates, CSV (features.cpp).
 void register_features(CLI::App& app);
+/// `dock-sim params`: the parameter table as Markdown; regenerate or check the docs' key tables (params.cpp).
+void register_params(CLI::App& app);
 
 }  // namespace docksim_cli

@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "dockcore/dock_pose_estimator.hpp"
+#include "docksim/cli_checks.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/real_perception.hpp"
 #include "docksim/realdata.hpp"
@@ -143,7 +144,7 @@ void register_features(CLI::App& app) {
       "features", "Decision features of labelled candidates as CSV (simulated docks, real dock-less scans), for "
                   "tools/fit-evidence");
   sub->add_option("--positives", o->positives, "Simulated docking scenes (0: none)")->check(CLI::NonNegativeNumber);
-  sub->add_option("--seed", o->seed, "Seed of the simulated scenes");
+  sub->add_option("--seed", o->seed, "Seed of the simulated scenes")->check(docksim::non_negative_integer());
   sub->add_option("--realdata", o->realdata_dir,
                   "Real-data folder (default: $DOCKCORE_REALDATA, else <repo>/../shared/realdata)");
   sub->add_option("--recordings", *names, "Comma-separated real recordings for negatives (default: none)");

@@ -19,6 +19,7 @@
 #include "dockcore/dock_pose_filter.hpp"
 #include "dockcore/line_segments.hpp"
 #include "dockcore/vmarker_detector.hpp"
+#include "docksim/cli_checks.hpp"
 #include "docksim/crlb.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/profile_file.hpp"
@@ -213,7 +214,7 @@ json run_accuracy(const Options& o) {
   return out;
 }
 
-// ---------------------------------------------------------------- the targets
+// ---------------------------------------------------------------- the perception targets
 
 json run_targets(const Options& o) {
   json out;
@@ -901,7 +902,8 @@ void register_perception(CLI::App& app) {
       ->check(CLI::Range(1, 64));
   sub->add_option("--realdata", o->realdata_dir,
                   "Real-data folder (default: $DOCKCORE_REALDATA, else <repo>/../shared/realdata)");
-  sub->add_option("--real-limit", o->real_limit, "Real data: use only the first N scans of each recording (0 = all)");
+  sub->add_option("--real-limit", o->real_limit, "Real data: use only the first N scans of each recording (0 = all)")
+      ->check(docksim::non_negative_integer());
   auto real_names = std::make_shared<std::string>();
   sub->add_option("--real-recordings", *real_names, "Real data: comma-separated recording names (default: all)");
   sub->add_option("--composite-n", o->composite_per_cell,
@@ -911,8 +913,9 @@ void register_perception(CLI::App& app) {
   sub->add_option("--target-trials", o->target_trials, "Scenes in the target zone")->check(CLI::PositiveNumber);
   sub->add_option("--fp-scenes", o->fp_scenes, "Dock-less scenes per clutter kind")->check(CLI::PositiveNumber);
   sub->add_option("--filter-runs", o->filter_runs, "1 s filtered runs")->check(CLI::PositiveNumber);
-  sub->add_option("--clutter", o->clutter, "Clutter level of docking scenes (0-3)")->check(CLI::Range(0, 6));
-  sub->add_option("--seed", o->seed, "Seed: same seed, same scenes, same figures");
+  sub->add_option("--clutter", o->clutter, "Clutter level of docking scenes (0-3)")->check(CLI::Range(0, 3));
+  sub->add_option("--seed", o->seed, "Seed: same seed, same scenes, same figures")
+      ->check(docksim::non_negative_integer());
   sub->add_flag("--json", o->json_out, "Print one JSON document instead of tables");
   sub->add_flag("--cost", o->cost, "Measure cost per scan instead (use with callgrind for instruction counts)");
   sub->add_option("--points", o->points, "Cost: points per scan (full turn)")->check(CLI::Range(16, 4096));

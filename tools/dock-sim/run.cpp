@@ -16,6 +16,7 @@
 
 #include "commands.hpp"
 #include "dockcore/faults.hpp"
+#include "docksim/cli_checks.hpp"
 #include "docksim/scenario.hpp"
 #include "docksim/sim_run.hpp"
 #include "docksim/svg.hpp"
@@ -522,7 +523,9 @@ void register_run(CLI::App& app) {
       "bad arguments or a bad scenario file.");
   sub->add_option("scenario", o->scenario, "Scenario TOML file (docs/scenarios.md)")->required();
   sub->add_option("--controller", o->controller, "seed000, seed004, seed003 or smooth (default: the scenario's)");
-  CLI::Option* seed = sub->add_option("--seed", o->seed, "Seed: start pose and every noise stream (default: the scenario's)");
+  CLI::Option* seed =
+      sub->add_option("--seed", o->seed, "Seed: start pose and every noise stream (default: the scenario's)")
+          ->check(docksim::non_negative_integer());
   sub->add_option("--svg", o->svg, "Write trajectory, robot outline, dock and last scan as SVG to this file");
   sub->add_flag("--json", o->json, "Print one JSON object (outcome and timeline) instead of text");
   sub->add_option("--start", o->start, "Fixed start: DISTANCE_M BEARING_DEG HEADING_DEG (default: drawn from the "
@@ -545,7 +548,8 @@ void register_montecarlo(CLI::App& app) {
   sub->add_option("scenario", o->scenario, "Scenario TOML file (docs/scenarios.md)")->required();
   sub->add_option("--trials", o->trials, "Starts per controller")->capture_default_str();
   sub->add_option("--controller", o->controller, "seed000, seed004, seed003, smooth or all (default: the scenario's)");
-  CLI::Option* seed = sub->add_option("--seed", o->seed, "Base seed (default: the scenario's)");
+  CLI::Option* seed =
+      sub->add_option("--seed", o->seed, "Base seed (default: the scenario's)")->check(docksim::non_negative_integer());
   sub->add_option("--jobs", o->jobs, "Worker threads")->capture_default_str();
   sub->add_flag("--json", o->json, "Print JSON (summary and per-run outcomes) instead of the table");
   sub->add_option("--svg", o->svg,

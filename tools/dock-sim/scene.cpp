@@ -12,6 +12,7 @@
 
 #include "commands.hpp"
 #include "detectors.hpp"
+#include "docksim/cli_checks.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/profile_file.hpp"
 #include "docksim/rng.hpp"
@@ -504,9 +505,15 @@ void register_scene(CLI::App& app) {
   sub->add_option("--yaw", o->yaw_deg, "Dock rotation from facing the lidar head-on (deg, CCW)")
       ->capture_default_str();
   sub->add_option("--sigma", o->sigma_m, "Range noise 1-sigma (m); default: the lidar model's (LD06: 0.010)");
-  sub->add_option("--clutter", o->clutter, "Clutter level 0-3 (3, 6, 12 objects)")->capture_default_str();
-  sub->add_option("--look-alikes", o->look_alikes, "Dock look-alikes added to the clutter")->capture_default_str();
-  sub->add_option("--seed", o->seed, "Random seed (scene and noise)")->capture_default_str();
+  sub->add_option("--clutter", o->clutter, "Clutter level 0-3 (3, 6, 12 objects)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 3));
+  sub->add_option("--look-alikes", o->look_alikes, "Dock look-alikes added to the clutter")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--seed", o->seed, "Random seed (scene and noise)")
+      ->capture_default_str()
+      ->check(docksim::non_negative_integer());
   sub->add_option("--svg", o->svg, "Write the scene as SVG to this file");
   sub->add_option("--view", o->view_m, "SVG: show +-this many metres around the lidar (default: fit lidar and dock)");
   sub->add_flag("--json", o->json, "Print one JSON object instead of the table");

@@ -1,4 +1,4 @@
-// `dock-sim soak`: N consecutive dock -> charge -> undock cycles of ONE simulated robot (issue #6 §2).
+// `dock-sim soak`: N consecutive dock -> charge -> undock cycles of ONE simulated robot.
 //
 // Unlike montecarlo (independent runs), one Dockcore, one controller, one chassis, one lidar and one camera live for
 // the whole soak; simulated time, odometry, encoders, battery and every noise stream run on from cycle to cycle.
@@ -33,6 +33,7 @@
 #include "dockcore/kinematics.hpp"
 #include "docksim/camera_sim.hpp"
 #include "docksim/chassis.hpp"
+#include "docksim/cli_checks.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenario.hpp"
@@ -120,6 +121,9 @@ class SoakWorld {
     cfg.task = sc.task;
     cfg.footprint = sc.safety;
     cfg.lidar_mount = sc.lidar_mount;
+    cfg.drive = geom_;
+    cfg.limits = sc.limits;
+    cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
     configured_ = core_->configure(sc.profile, cfg);
     docksim::DockPlacement dp;
     dp.pose_world = sc.dock_pose;
@@ -168,7 +172,6 @@ class SoakWorld {
 
   /// One 5 ms step; true when it held a control tick.
   bool step(dockcore::HostCommandType cmd) {
-    const double dt = sc_.chassis.dt_s;
     const double t = t_s();
     const std::uint64_t now_us = static_cast<std::uint64_t>(std::llround(t * 1e6));
     const docksim::ChassisState& cs = chassis_.state();
@@ -217,12 +220,7 @@ class SoakWorld {
         AllocScope scope;
         last_ = core_->tick(in);
       }
-      const double tick_dt = dt * kStepsPerTick;
-      dockcore::Twist2 c = dockcore::saturate_twist(geom_, sc_.limits, last_.cmd);
-      c = dockcore::limit_acceleration(sc_.limits, prev_cmd_, c, static_cast<Real>(tick_dt));
-      if (last_.cmd.vx_mps == 0 && last_.cmd.vy_mps == 0 && last_.cmd.wz_radps == 0) c = dockcore::Twist2{};
-      prev_cmd_ = c;
-      const dockcore::WheelSpeeds w = dockcore::twist_to_wheels(geom_, c);
+      const dockcore::WheelSpeeds& w = last_.wheels;
       docksim::WheelRadps wr{};
       for (std::size_t i = 0; i < w.count && i < docksim::kMaxWheels; ++i) wr[i] = static_cast<double>(w.radps[i]);
       chassis_.command_wheels(wr);
@@ -258,7 +256,6 @@ class SoakWorld {
   std::uint64_t scans_dropped_ = 0;
   bool have_scan_ = false;
   dockcore::TickOutput last_{};
-  dockcore::Twist2 prev_cmd_{};
   double odom_err_m_ = 0;
 };
 
@@ -626,8 +623,10 @@ void register_soak(CLI::App& app) {
   sub->add_option("scenario", o->scenario, "Scenario TOML file without events (docs/scenarios.md)")->required();
   sub->add_option("--cycles", o->cycles, "Dock -> charge -> undock cycles")->capture_default_str();
   sub->add_option("--controller", o->controller, "seed000, seed004, seed003 or smooth (default: the scenario's)");
-  CLI::Option* seed = sub->add_option("--seed", o->seed, "Base seed: starts (montecarlo's trial seeds) and noise "
-                                                         "(default: the scenario's)");
+  CLI::Option* seed = sub->add_option("--seed", o->seed,
+                                      "Base seed: starts (montecarlo's trial seeds) and noise "
+                                      "(default: the scenario's)")
+                          ->check(docksim::non_negative_integer());
   sub->add_option("--charge-s", o->charge_s, "Time on the charger per cycle, s")->capture_default_str();
   sub->add_option("--gap-s", o->gap_s, "Idle time after the robot is carried to its start, s")->capture_default_str();
   sub->add_option("--settle-s", o->settle_s, "Idle time after an undock before the robot is carried, s")->capture_default_str();

@@ -13,6 +13,7 @@
 
 #include "dockcore/drivers/lidar_driver.hpp"
 #include "dockcore/lidar_rplidar.hpp"
+#include "docksim/cli_checks.hpp"
 #include "docksim/scan_io.hpp"
 
 using dockcore::drivers::LidarProtocol;
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
   app.add_flag("--csv", csv, "CSV rows scan,stamp_us,index,angle_rad,range_m,intensity instead of JSON lines");
   app.add_option("--record", record, "Save the raw bytes (datagrams) read to FILE");
   app.add_option("--json-counters", json_counters, "Write the counters as JSON to FILE ('-' = stdout, after the scans)");
-  app.add_option("--count", count, "Stop after N scans");
+  app.add_option("--count", count, "Stop after N scans")->check(docksim::non_negative_integer());
   app.add_option("--duration", duration, "Stop after S seconds (device / UDP)");
   app.add_option("--bench", bench, "--file: decode the capture N times without printing; report ns per byte");
   app.add_flag("--mid-stream", mid_stream, "rplidar --file: accept nodes without a scan descriptor");

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "dockcore/emu/lidar_emitter.hpp"
+#include "docksim/cli_checks.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenario.hpp"
@@ -44,13 +45,19 @@ int main(int argc, char** argv) {
   app.add_option("--pose", pose_text, "Robot pose X,Y,YAW_DEG in the world (default: 1 m in front of the dock, facing it)");
   app.add_option("--model", model_name, "Lidar model (default: the scenario's for ld06, rplidar-a1, industrial for lakibeam)");
   app.add_option("--rate-hz", rate_hz, "Scans per second (default: the model's rate)");
-  app.add_option("--corrupt", corrupt, "Fraction of bytes with a flipped bit")->capture_default_str();
-  app.add_option("--corrupt-packets", corrupt_packets, "Fraction of packets with one flipped bit")->capture_default_str();
-  app.add_option("--drop", drop, "Fraction of packets not sent")->capture_default_str();
+  app.add_option("--corrupt", corrupt, "Fraction of bytes with a flipped bit")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--corrupt-packets", corrupt_packets, "Fraction of packets with one flipped bit")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--drop", drop, "Fraction of packets not sent")->capture_default_str()->check(CLI::Range(0.0, 1.0));
   app.add_option("--stall-after", stall_after, "Stop sending after S seconds ...");
   app.add_option("--stall-for", stall_for, "... for S seconds");
   app.add_option("--duration", duration, "Stop after S seconds (0 = until SIGINT/SIGTERM)");
-  app.add_option("--seed", seed, "Seed of the lidar noise and the fault injection")->capture_default_str();
+  app.add_option("--seed", seed, "Seed of the lidar noise and the fault injection")
+      ->capture_default_str()
+      ->check(docksim::non_negative_integer());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

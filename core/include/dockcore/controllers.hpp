@@ -1,5 +1,5 @@
 #pragma once
-/// @file The four docking controllers (issue #3 §3): Seed000Controller ("seed000", rotate-then-drive), Seed004Controller
+/// @file The four docking controllers: Seed000Controller ("seed000", rotate-then-drive), Seed004Controller
 /// ("seed004", the nine-state alignment machine), Seed003Controller ("seed003", two-stage camera + lidar gaze docking)
 /// and SmoothController ("smooth", dockcore's default: Park–Kuipers graceful law onto a goal projected behind the
 /// dock). All are plain objects: fixed-size state, trivial constructors taking a Params struct, O(1) step(), zero
@@ -223,7 +223,7 @@ class Seed003Controller final : public DockingController {
 ///   v ≥ creep_speed (the deadband floor), ω = κ·v ≤ ω_max with v recomputed to keep κ.
 /// Never commands v ≤ 0 while running: one forward motion, no reversals, no in-place rotation (v is floored at
 /// min_turn_speed_mps when ω saturates). vy is always 0: the same law serves mecanum drives (a vy assist on the pads'
-/// lateral error was tried and destabilised the heading loop, see docs/controllers.md). backwards = true docks with
+/// lateral error destabilises the heading loop, see docs/controllers.md). backwards = true docks with
 /// rear pads: the law runs on the reversed robot frame and v is negated. In the last lineup_distance_m, once near the
 /// axis, LINEUP replaces the graceful curvature with an axis tracker (see the lineup_* fields and docs/controllers.md).
 struct SmoothParams {

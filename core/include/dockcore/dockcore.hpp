@@ -6,6 +6,10 @@
 /// - on_scan(): detection with the filter's prediction as the estimator's hint (tracking mode; global search when
 ///   the filter has no dock or the hint fails), then the filter update. The scan is copied so the tick can run the
 ///   obstacle check and give controllers (seed003) the latest ranges.
+/// - tick() also shapes the task manager's twist into what the drive is sent (TickOutput::drive_cmd, ::wheels):
+///   saturation keeping the path's curvature, the acceleration limit over one control period, a zero twist at once
+///   (stop, fault, idle: the drive's own limits brake), and the drive's inverse kinematics. Every caller (dockd, the
+///   simulator, the firmware) sends these, so the loop that is simulated is the one that runs.
 /// - tick(): the filtered dock seen from the current odometry pose, every raw detection since the previous tick (for
 ///   the push test; up to kMaxDetectionsPerTick, oldest first, each with the filter's expectation from just before
 ///   it was fused), the latest scan and the host's flags go to the TaskManager; its twist and status come back. The
@@ -28,6 +32,7 @@
 #include "dockcore/dock_pose_filter.hpp"
 #include "dockcore/dock_profile.hpp"
 #include "dockcore/geometry.hpp"
+#include "dockcore/kinematics.hpp"
 #include "dockcore/laser_scan.hpp"
 #include "dockcore/safety.hpp"
 #include "dockcore/task_manager.hpp"
@@ -41,6 +46,10 @@ struct DockcoreConfig {
   TaskParams task{};
   FootprintParams footprint{};
   Pose2 lidar_mount{};                               ///< Lidar in the robot frame.
+  DriveGeometry drive{};                             ///< Wheel arrangement, for the wheel speeds tick() returns.
+  DriveLimits limits{};                              ///< Velocity and acceleration limits tick() applies.
+  /// The control tick's nominal period, s: the acceleration limit's step. > 0.
+  Real control_period_s = static_cast<Real>(0.02);
   Real lidar_stale_s = static_cast<Real>(0.5);       ///< No scan for this long: lidar stale (fault 185 when moving).
   /// A resumed dock command (TickInput::resume) keeps the dock estimate from before the outage as the push test's
   /// reference when its last detection is at most this old at the resume (s). Wheel odometry runs through a lidar
@@ -65,9 +74,16 @@ struct TickInput {
   /// reported (178/179). Dockcore then keeps the pre-outage dock estimate (push_check_max_gap_s) as the push test's
   /// reference until a detection in ALIGN has agreed with it. False for every command a host or operator sends.
   bool resume = false;
+  /// The host holds the robot still this tick (its own watchdog saw a data gap the task manager is not yet told
+  /// of): drive_cmd and wheels are zero whatever the task manager wants.
+  bool hold = false;
 };
 
-using TickOutput = TaskOutput;
+/// The task manager's output plus what the drive is sent.
+struct TickOutput : TaskOutput {
+  Twist2 drive_cmd{};    ///< `cmd` saturated, acceleration-limited and zeroed as the file comment says.
+  WheelSpeeds wheels{};  ///< drive_cmd as wheel speeds of DockcoreConfig::drive (count from its kind).
+};
 
 class Dockcore {
  public:
@@ -81,7 +97,7 @@ class Dockcore {
   /// `odom_pose`: robot odometry pose at the scan time; `stamp_us`: scan time. Cost: the estimator's plus O(count).
   const DockEstimate& on_scan(const ScanView& scan, std::uint64_t stamp_us, const Pose2& odom_pose);
 
-  /// One control tick. Cost: TaskManager::tick.
+  /// One control tick: the task manager, then the output shaping (file comment). Cost: TaskManager::tick + O(1).
   TickOutput tick(const TickInput& in);
 
   const DockEstimate& last_estimate() const { return last_estimate_; }
@@ -89,10 +105,17 @@ class Dockcore {
   const DockPoseEstimator& estimator() const { return estimator_; }
   const TaskManager& task_manager() const { return tasks_; }
   const DockcoreConfig& config() const { return config_; }
+  /// The host sent the drive a zero command outside tick() (shutdown, a stop of its own): the next tick's
+  /// acceleration limit starts from rest. O(1).
+  void note_drive_stopped() { prev_drive_cmd_ = Twist2{}; }
+  /// drive_cmd of the last tick. O(1).
+  const Twist2& drive_cmd() const { return prev_drive_cmd_; }
   /// Detections that did not fit into one tick's list (more than kMaxDetectionsPerTick scans between two ticks).
   std::uint32_t detections_dropped() const { return pending_dropped_; }
 
  private:
+  /// Fills out->drive_cmd and out->wheels from out->cmd (file comment). O(1).
+  void shape(bool hold, TickOutput* out);
   DockcoreConfig config_{};
   DockPoseEstimator estimator_{};
   DockPoseFilter filter_{};
@@ -105,6 +128,7 @@ class Dockcore {
   std::uint8_t pending_count_ = 0;
   std::uint32_t pending_dropped_ = 0;  ///< Detections beyond kMaxDetectionsPerTick between two ticks (not tested).
   TaskState prev_state_ = TaskState::kNotTasking;
+  Twist2 prev_drive_cmd_{};  ///< drive_cmd of the previous tick: the acceleration limit's start.
   bool filter_confirmed_ = false;  ///< The filter fused a detection since its last (re)initialisation.
   /// The confirmed estimate from before the filter's most recent restart (this task), for a resumed command.
   bool restart_ref_set_ = false;

@@ -1,5 +1,5 @@
 #pragma once
-/// @file The docking task manager (issue #3 §4): host commands, detection search, alignment with any
+/// @file The docking task manager: host commands, detection search, alignment with any
 /// DockingController, obstacle and pose-deviation safety, charging confirmation with retries, undocking, faults.
 ///
 /// One tick (50 Hz in dockd) takes everything the robot knows now (TaskInput) and returns the body twist to command
@@ -45,7 +45,7 @@ enum class HostCommandType : std::uint8_t {
   kDock = 1,      ///< Dock at dock_id.
   kCancel = 2,    ///< Stop whatever runs; clears a fault.
   kUndock = 3,    ///< Leave the dock.
-  kTestMode = 4,  ///< Recognition only.
+  kTestMode = 4,  ///< Recognition only, on dock_id (reported in the status like a docking's).
 };
 
 /// A host command, delivered once (edge) on the tick it arrives.
@@ -60,7 +60,7 @@ enum class CommandResult : std::uint8_t {
   kAccepted = 1,
   kAlreadyDocked = 2,     ///< Dock while docked/charging: no motion; charging is (re)confirmed.
   kRejectedUnknown = 3,   ///< Unknown command code.
-  kRejectedDockId = 4,    ///< Dock id not accepted (>= 32 or not in accepted_dock_ids).
+  kRejectedDockId = 4,    ///< Dock/test dock id not accepted (>= 32 or not in accepted_dock_ids).
   kRejectedNotDocked = 5, ///< Undock while not on the contacts (and not resuming an interrupted undocking).
   kRejectedBusy = 6,      ///< Dock/test while a task runs, or undock while docking: cancel first.
 };

@@ -1,4 +1,4 @@
-# The base goes silent mid-approach (issue #4 §5): chassis-sim stops answering 2 s after motion starts, for 3 s.
+# The base goes silent mid-approach: chassis-sim stops answering 2 s after motion starts, for 3 s.
 # dockd must command zero at once, report fault 184 (chassis stale) on the bus, send no non-zero wheel command while
 # the base is silent, and finish the docking once the base answers again.
 make_dockd_config

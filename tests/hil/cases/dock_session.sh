@@ -1,4 +1,4 @@
-# A whole docking session on vcan0 (issue #4 §5): chassis-sim (robot base + LD06 on a pty), dockd, candump.
+# A whole docking session on vcan0: chassis-sim (robot base + LD06 on a pty), dockd, candump.
 # Run 1 is commanded with a CAN host command frame (cansend), run 2 with dockctl; both must reach charging
 # confirmed (FINISH_TASKING) and undock. Then SIGTERM: dockd exits 0 leaving zero on the bus. dock-decode must read the
 # candump log with zero counter/checksum errors, and the status frames must show the expected state sequence.

@@ -1,4 +1,4 @@
-# A degraded lidar line (issue #4 §5, see docs/hil.md for the bytes-vs-packets reading): 5 % of the LD06 packets
+# A degraded lidar line (see docs/hil.md for the bytes-vs-packets reading): 5 % of the LD06 packets
 # arrive with a flipped bit. Docking must still reach charging, and dockd's CRC counter must show the corruption.
 make_dockd_config
 start_candump

@@ -1,4 +1,4 @@
-# Fault-injection matrix, CAN rows (issue #6 §1; docs/reliability.md). Each row: fresh chassis-sim + dockd +
+# Fault-injection matrix, CAN rows (docs/reliability.md). Each row: fresh chassis-sim + dockd +
 # candump, a CAN dock command, the fault injected mid-approach (2.0 s after the first non-zero wheel command unless
 # said otherwise), judged by tests/hil/matrix.py from the candump stamps.
 source "$SRC/tests/hil/matrix_lib.sh"

@@ -1,4 +1,4 @@
-# Fault-injection matrix, host and process rows (issue #6 §1, §3; docs/reliability.md), judged on the host by
+# Fault-injection matrix, host and process rows (docs/reliability.md), judged on the host by
 # tests/hil/matrix.py from the candump stamps.
 source "$SRC/tests/hil/matrix_lib.sh"
 HF="$BUILD/tests/hil/hil_frames"

@@ -1,4 +1,4 @@
-# Fault-injection matrix, lidar rows (issue #6 §1; docs/reliability.md). Each row: fresh chassis-sim + dockd +
+# Fault-injection matrix, lidar rows (docs/reliability.md). Each row: fresh chassis-sim + dockd +
 # candump, a CAN dock command, the fault injected by chassis-sim on its motion clock (2.0 s after the first non-zero
 # wheel command: mid-approach, ALIGN), judged on the host by tests/hil/matrix.py from the candump stamps.
 # Fault time = the last good scan: chassis-sim's truth event lidar_last_good_scan, stamped (CLOCK_REALTIME) when the

@@ -1,4 +1,4 @@
-# Fault-injection matrix, motion rows (issue #6 §1; docs/reliability.md). Scenario events (tests/hil/scenarios/*.toml,
+# Fault-injection matrix, motion rows (docs/reliability.md). Scenario events (tests/hil/scenarios/*.toml,
 # chassis-sim's motion clock: 2.0 s after the first non-zero wheel command, mid-approach in ALIGN) or chassis-sim
 # options; fault time = chassis-sim's truth event; judged on the host by tests/hil/matrix.py from the candump stamps.
 source "$SRC/tests/hil/matrix_lib.sh"
@@ -25,7 +25,7 @@ post_request_off() {
 # sends) and the next turn's first one shows the wrap: the second post-push turn is parsed <= 300 ms after the push,
 # plus one 20 ms tick: 320 ms when the first two post-push detections both count. They do not always: in dock-sim
 # (these scenarios, seeds 1-200) the fault came on the 2nd post-push turn in 154/176 runs (angle/distance), the 3rd in
-# 39/21 and the 4th in 7/3 (docs/reliability.md), and CI saw 372 ms with dockd's loop on time. The limit allows
+# 39/21 and the 4th in 7/3 (docs/reliability.md), and a HIL run saw 372 ms with dockd's loop on time. The limit allows
 # those two more turns: 520 ms. If dockd's own loop stalled over 500 ms (target_lost_after) around the push, the
 # VM decided the row (the target is lost and reacquired at the pushed pose): its failed checks count as STARVED
 # (docs/reliability.md). Not a watchdog fault: no resume; the

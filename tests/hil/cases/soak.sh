@@ -1,4 +1,4 @@
-# Soak on vcan0 (issue #6 §2; docs/reliability.md "Soak"): one chassis-sim, one dockd, K dock -> charge -> undock
+# Soak on vcan0 (docs/reliability.md "Soak"): one chassis-sim, one dockd, K dock -> charge -> undock
 # cycles commanded with dockctl. K = 5 (CI); HIL_SOAK_CYCLES=50 for the long mode (then give run-case a timeout of
 # about 60 s per cycle: tests/hil/run-case soak BUILD '' 3600). chassis-sim keeps the robot where the undock left it,
 # so cycle 1 starts at 1.2 m and every later cycle at the staging distance (0.6 m straight out).

@@ -1,4 +1,4 @@
-# valgrind memcheck over dockd on the real vcan bus (issue #6 §4): dockd under memcheck with chassis-sim and its
+# valgrind memcheck over dockd on the real vcan bus: dockd under memcheck with chassis-sim and its
 # lidar, a dock command, ~20 s of running (under memcheck inside the TCG VM dockd is ~100x slower than native, so
 # it will trip its own watchdogs — that is fine: the point is every code path it runs, including faults), dockctl
 # status, SIGTERM. memcheck must report no errors and nothing definitely or indirectly lost.

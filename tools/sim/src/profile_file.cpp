@@ -9,7 +9,7 @@
 
 #include <toml++/toml.h>
 
-#include "dockcore/drivers/profile_toml.hpp"
+#include "dockcore/params/profile_toml.hpp"
 
 namespace docksim {
 namespace {
@@ -27,7 +27,7 @@ std::string fmt(double v) {
 
 DockProfile parse_profile_toml(const std::string& text, const std::string& source_name,
                                const std::string& default_name) {
-  return dockcore::drivers::profile_toml::parse<ProfileFileError>(text, source_name, default_name);
+  return dockcore::params::profile_toml::parse<ProfileFileError>(text, source_name, default_name);
 }
 
 DockProfile load_profile_file(const std::string& path) {
@@ -36,7 +36,7 @@ DockProfile load_profile_file(const std::string& path) {
   std::ostringstream ss;
   ss << in.rdbuf();
   if (in.bad()) throw ProfileFileError("cannot read profile file " + path);
-  return parse_profile_toml(ss.str(), path, dockcore::drivers::profile_toml::name_from_path(path));
+  return parse_profile_toml(ss.str(), path, dockcore::params::profile_toml::name_from_path(path));
 }
 
 DockProfile resolve_profile(const std::string& name_or_path) {

@@ -10,9 +10,9 @@
 
 #include <toml++/toml.h>
 
-#include "dockcore/drivers/estimator_toml.hpp"
-#include "dockcore/drivers/profile_toml.hpp"
-#include "dockcore/drivers/toml_reader.hpp"
+#include "dockcore/params/param_toml.hpp"
+#include "dockcore/params/profile_toml.hpp"
+#include "dockcore/params/toml_reader.hpp"
 
 #include "docksim/profile_file.hpp"
 
@@ -59,11 +59,11 @@ namespace {
 
 using dockcore::Real;
 using dockcore::Vec2;
-using dockcore::drivers::toml_reader::dir_of;
-using dockcore::drivers::toml_reader::Handler;
-using dockcore::drivers::toml_reader::Handlers;
-using dockcore::drivers::toml_reader::kDeg;
-using dockcore::drivers::toml_reader::type_name;
+using dockcore::params::toml_reader::dir_of;
+using dockcore::params::toml_reader::Handler;
+using dockcore::params::toml_reader::Handlers;
+using dockcore::params::toml_reader::kDeg;
+using dockcore::params::toml_reader::type_name;
 
 std::string stem_of(const std::string& path) {
   const std::size_t slash = path.find_last_of('/');
@@ -73,7 +73,7 @@ std::string stem_of(const std::string& path) {
 }
 
 /// The strict key reader (shared with dockd's config) plus the scenario's array forms.
-class Parser : public dockcore::drivers::toml_reader::Reader<ScenarioError> {
+class Parser : public dockcore::params::toml_reader::Reader<ScenarioError> {
  public:
   using Reader::Reader;
 
@@ -93,23 +93,7 @@ class Parser : public dockcore::drivers::toml_reader::Reader<ScenarioError> {
   }
 };
 
-constexpr double kBig = 1e6;
-
-void add_common(const Parser& p, Handlers& h, dockcore::DockingCommonParams* c, bool* pad_reach_set) {
-  h.emplace_back("pad_reach_m", [&p, c, pad_reach_set](const toml::node& n) {
-    c->pad_reach_m = static_cast<Real>(p.number(n, 0.0, 5.0));
-    *pad_reach_set = true;
-  });
-  h.emplace_back("creep_speed_mps", p.real(&c->creep_speed_mps, 0.0, 1.0));
-  h.emplace_back("stall_press_m", p.real(&c->stall_press_m, -0.1, 0.1));
-  h.emplace_back("stall_timeout_s", p.real(&c->stall_timeout_s, 0.0, kBig));
-}
-
 struct ParseState {
-  bool pad_reach_set = false;
-  bool seed003_holonomic_set = false;
-  bool smooth_backwards_set = false;
-  bool check_length_set = false, check_width_set = false;
   double motor_latency_s = -1;
   double lidar_sigma_m = -1, lidar_sigma_prop = -1, lidar_dropout = -1, lidar_jitter_rad = -1, lidar_rate_hz = -1,
          lidar_max_range_m = -1;
@@ -118,8 +102,6 @@ struct ParseState {
   const toml::node* lidar_model_node = nullptr;
   std::string profile = "plate-v";
   const toml::node* profile_node = nullptr;
-  std::string footprint_shape = "square";
-  double check_length_m = 0.3, check_width_m = 0.5;
   bool mounting_set = false;
   dockcore::DockMounting mounting{};
 };
@@ -188,9 +170,16 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   sc.source = source_name;
   sc.name = stem_of(source_name);
   ParseState st;
-  // Scenario defaults that differ from the libraries' own.
-  sc.limits.max_vx_mps = static_cast<Real>(0.4);
-  sc.limits.max_wz_radps = static_cast<Real>(1.0);
+  // dockcore's parameters: the keys, bounds and defaults of the parameter table, the same as dockd's config. The
+  // obstacle footprint's body is derived from the chassis below.
+  namespace params = dockcore::params;
+  const params::ParamTargets targets{nullptr,      &sc.limits,  &sc.safety,  &sc.task,  &sc.estimator,
+                                     &sc.seed000,  &sc.seed004, &sc.seed003, &sc.smooth};
+  params::apply_defaults(targets, params::kScenario);
+  auto table_keys = [&](const std::string& table, Handlers h) {
+    params::add_params(p, h, table, targets, params::kScenario);
+    return h;
+  };
 
   auto robot_handlers = [&]() {
     ChassisParams& c = sc.chassis;
@@ -198,34 +187,25 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
     h.emplace_back("kinematics", [&](const toml::node& n) {
       c.geometry.kind = p.choice(n, {"diff", "mecanum"}) == "mecanum" ? DriveKind::kMecanum : DriveKind::kDifferential;
     });
-    h.emplace_back("wheel_radius_m", p.num(&c.geometry.wheel_radius_m, 0.005, 1.0));
-    h.emplace_back("wheel_base_m", p.num(&c.geometry.wheel_base_m, 0.02, 5.0));
-    h.emplace_back("lx_m", p.num(&c.geometry.lx_m, 0.01, 5.0));
-    h.emplace_back("ly_m", p.num(&c.geometry.ly_m, 0.01, 5.0));
-    h.emplace_back("limits", p.sub("robot.limits.", [&]() {
-      dockcore::DriveLimits& l = sc.limits;
-      return Handlers{{"max_vx_mps", p.real(&l.max_vx_mps, 0, 10)},
-                      {"max_vy_mps", p.real(&l.max_vy_mps, 0, 10)},
-                      {"max_wz_radps", p.real(&l.max_wz_radps, 0, 20)},
-                      {"max_wheel_radps", p.real(&l.max_wheel_radps, 0, 1000)},
-                      {"max_linear_accel_mps2", p.real(&l.max_linear_accel_mps2, 0, 100)},
-                      {"max_angular_accel_radps2", p.real(&l.max_angular_accel_radps2, 0, 100)}};
-    }));
+    // The chassis' geometry, with the bounds of dockd's drive geometry keys.
+    h.emplace_back("wheel_radius_m", params::bounded_by(p, "robot", "wheel_radius_m", &c.geometry.wheel_radius_m));
+    h.emplace_back("wheel_base_m", params::bounded_by(p, "robot", "track_m", &c.geometry.wheel_base_m));
+    h.emplace_back("lx_m", params::bounded_by(p, "robot", "half_wheelbase_m", &c.geometry.lx_m));
+    h.emplace_back("ly_m", params::bounded_by(p, "robot", "half_track_m", &c.geometry.ly_m));
+    h.emplace_back("limits", params::param_sub(p, "robot.limits", targets, params::kScenario));
     h.emplace_back("footprint", p.sub("robot.footprint.", [&]() {
       FootprintParams& f = c.footprint;
-      return Handlers{
-          {"shape", [&](const toml::node& n) { st.footprint_shape = p.choice(n, {"square", "circle"}); }},
+      // The table's keys (shape, check area, margins) plus the chassis outline the obstacle check's body comes from.
+      return table_keys("robot.footprint", Handlers{
           {"length_m", p.num(&f.length_m, 0.05, 5.0)},
           {"width_m", p.num(&f.width_m, 0.05, 5.0)},
-          {"radius_m", p.num(&f.radius_m, 0.025, 2.5)},
+          {"radius_m", params::bounded_by(p, "robot.footprint", "radius_m", &f.radius_m)},
           {"centre_x_m", p.num(&f.centre_x_m, -2.0, 2.0)},
           {"pads", [&](const toml::node& n) {
              f.pad_side = p.choice(n, {"front", "rear"}) == "rear" ? PadSide::kRear : PadSide::kFront;
            }},
           {"pad_offset_y_m", p.num(&f.pad_offset_y_m, -1.0, 1.0)},
-          {"check_length_m", [&](const toml::node& n) { st.check_length_m = p.number(n, 0.0, 5.0); }},
-          {"check_width_m", [&](const toml::node& n) { st.check_width_m = p.number(n, 0.0, 5.0); }},
-      };
+      });
     }));
     h.emplace_back("lidar", p.sub("robot.lidar.", [&]() {
       return Handlers{{"x_m", p.real(&sc.lidar_mount.x_m, -2, 2)},
@@ -236,12 +216,13 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
       CameraSpec& cam = sc.camera;
       return Handlers{
           {"enabled", p.flag(&cam.enabled)},
-          {"fx_px", p.real(&cam.model.fx_px, 1, 1e5)},
-          {"cx_px", p.real(&cam.model.cx_px, 0, 1e5)},
-          {"width_px", p.real(&cam.model.image_width_px, 1, 1e5)},
-          {"x_m", p.real(&cam.model.mount.x_m, -2, 2)},
-          {"y_m", p.real(&cam.model.mount.y_m, -2, 2)},
-          {"yaw_deg", p.real_deg(&cam.model.mount.yaw_rad, -180, 180)},
+          // The camera seed 003 steers by: the bounds of dockd's [controller.seed003] camera keys.
+          {"fx_px", params::bounded_by(p, "controller.seed003", "fx_px", &cam.model.fx_px)},
+          {"cx_px", params::bounded_by(p, "controller.seed003", "cx_px", &cam.model.cx_px)},
+          {"width_px", params::bounded_by(p, "controller.seed003", "image_width_px", &cam.model.image_width_px)},
+          {"x_m", params::bounded_by(p, "controller.seed003", "mount_x_m", &cam.model.mount.x_m)},
+          {"y_m", params::bounded_by(p, "controller.seed003", "mount_y_m", &cam.model.mount.y_m)},
+          {"yaw_deg", params::bounded_by(p, "controller.seed003", "mount_yaw_deg", &cam.model.mount.yaw_rad)},
           {"rate_hz", p.num(&cam.rate_hz, 0.1, 1000)},
           {"latency_s", p.num(&cam.latency_s, 0, 5)},
           {"sigma_px", p.num(&cam.sigma_px, 0, 1000)},
@@ -284,7 +265,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         {"angular_jitter_deg", [&](const toml::node& n) { st.lidar_jitter_rad = p.number(n, 0, 10) * kDeg; }},
         {"mixed_pixels", [&](const toml::node& n) { st.mixed_pixels = p.boolean(n) ? 1 : 0; }},
         {"rate_hz", [&](const toml::node& n) { st.lidar_rate_hz = p.number(n, 0.5, 100); }},
-        {"max_range_m", [&](const toml::node& n) { st.lidar_max_range_m = p.number(n, 0.5, 100); }},
+        // The sensor's range, under the name of dockd's [lidar] range key: it takes that key's bounds.
+        {"max_range_m", params::bounded_by(p, "lidar", "max_range_m", &st.lidar_max_range_m)},
         {"latency_s", p.num(&sc.scan_latency_s, 0, 2)},
     };
   };
@@ -302,7 +284,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         {"wall_glass", p.flag(&sc.wall_glass)},
         {"wall_half_length_m", p.num(&sc.wall_half_length_m, 0.1, 100)},
         {"mounting", [&](const toml::node& n) {
-           st.mounting = dockcore::drivers::profile_toml::read_mounting(p, n, "dock.mounting.");
+           st.mounting = dockcore::params::profile_toml::read_mounting(p, n, "dock.mounting.");
            st.mounting_set = true;
          }},
         {"furniture", [&](const toml::node& n) {
@@ -475,35 +457,6 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
     }
   };
 
-  auto task_handlers = [&]() {
-    dockcore::TaskParams& t = sc.task;
-    return Handlers{
-        {"detect_wait_s", p.real(&t.detect_wait_s, 0, 1e3)},
-        {"swing_amplitude_deg", p.real_deg(&t.swing_amplitude_rad, 0, 180)},
-        {"max_swings", [&](const toml::node& n) { t.max_swings = static_cast<std::uint8_t>(p.integer(n, 0, 255)); }},
-        {"target_lost_after_s", p.real(&t.target_lost_after_s, 0, 1e3)},
-        {"target_lost_timeout_s", p.real(&t.target_lost_timeout_s, 0, 1e3)},
-        {"obstacle_timeout_s", p.real(&t.obstacle_timeout_s, 0, 1e3)},
-        {"charge_confirm_timeout_s", p.real(&t.charge_confirm_timeout_s, 0, 1e3)},
-        {"max_retries", [&](const toml::node& n) { t.max_retries = static_cast<std::uint8_t>(p.integer(n, 0, 255)); }},
-        {"staging_distance_m", p.real(&t.staging_distance_m, 0, 10)},
-        {"task_timeout_s", p.real(&t.task_timeout_s, 0, 1e5)},
-        {"check_distance_error_tolerance_m", p.real(&t.deviation.check_distance_error_tolerance_m, 0, 100)},
-        {"push_distance_tolerance_m", p.real(&t.deviation.push_distance_tolerance_m, 0, 100)},
-        {"check_angle_error_tolerance_deg", p.real_deg(&t.deviation.check_angle_error_tolerance_rad, 0, 180)},
-    };
-  };
-
-  auto estimator_handlers = [&]() {
-    dockcore::EstimatorParams& e = sc.estimator;
-    Handlers h{{"max_range_m", p.real(&e.max_range_m, 0.1, 100)},
-               {"min_range_m", p.real(&e.min_range_m, 0, 10)},
-               {"range_sigma_m", p.real(&e.range_sigma_m, 0.0001, 1)}};
-    // The tuning keys dockd's [estimator] takes, with the same bounds.
-    dockcore::drivers::estimator_toml::add_keys(p, h, e, "estimator.");
-    return h;
-  };
-
   auto host_handlers = [&]() {
     HostSpec& h = sc.host;
     return Handlers{{"chassis_stale_s", p.num(&h.chassis_stale_s, 0.001, 100)},
@@ -512,94 +465,12 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   };
 
   auto controller_handlers = [&]() {
-    Handlers h{{"name", [&](const toml::node& n) { sc.controller = p.choice(n, controller_names()); }}};
-    // Common settings apply to all four controllers.
-    h.emplace_back("pad_reach_m", [&](const toml::node& n) {
-      const Real v = static_cast<Real>(p.number(n, 0, 5));
-      sc.seed000.common.pad_reach_m = sc.seed004.common.pad_reach_m = v;
-      sc.seed003.common.pad_reach_m = sc.smooth.common.pad_reach_m = v;
-      st.pad_reach_set = true;
-    });
-    h.emplace_back("creep_speed_mps", [&](const toml::node& n) {
-      const Real v = static_cast<Real>(p.number(n, 0, 1));
-      sc.seed000.common.creep_speed_mps = sc.seed004.common.creep_speed_mps = v;
-      sc.seed003.common.creep_speed_mps = sc.smooth.common.creep_speed_mps = v;
-    });
-    h.emplace_back("stall_timeout_s", [&](const toml::node& n) {
-      const Real v = static_cast<Real>(p.number(n, 0, 1e3));
-      sc.seed000.common.stall_timeout_s = sc.seed004.common.stall_timeout_s = v;
-      sc.seed003.common.stall_timeout_s = sc.smooth.common.stall_timeout_s = v;
-    });
-    h.emplace_back("seed000", p.sub("controller.seed000.", [&]() {
-      dockcore::Seed000Params& c = sc.seed000;
-      Handlers s;
-      add_common(p, s, &c.common, &st.pad_reach_set);
-      s.emplace_back("angle_threshold_rad", p.real(&c.angle_threshold_rad, 0, 3.2));
-      s.emplace_back("rotate_exit_rad", p.real(&c.rotate_exit_rad, 0, 3.2));
-      s.emplace_back("rotate_kp", p.real(&c.rotate_kp, 0, 100));
-      s.emplace_back("rotate_max_radps", p.real(&c.rotate_max_radps, 0, 20));
-      s.emplace_back("rotate_min_radps", p.real(&c.rotate_min_radps, 0, 20));
-      s.emplace_back("forward_speed_mps", p.real(&c.forward_speed_mps, 0, 5));
-      s.emplace_back("slowdown_distance_m", p.real(&c.slowdown_distance_m, 0, 10));
-      return s;
-    }));
-    h.emplace_back("seed004", p.sub("controller.seed004.", [&]() {
-      dockcore::Seed004Params& c = sc.seed004;
-      Handlers s;
-      add_common(p, s, &c.common, &st.pad_reach_set);
-      s.emplace_back("angle_tolerance_rad", p.real(&c.angle_tolerance_rad, 0, 3.2));
-      s.emplace_back("distance_tolerance_m", p.real(&c.distance_tolerance_m, 0, 10));
-      s.emplace_back("relative_distance_m", p.real(&c.relative_distance_m, 0, 10));
-      s.emplace_back("robot_distance_tolerance_m", p.real(&c.robot_distance_tolerance_m, -10, 10));
-      s.emplace_back("angle_kp", p.real(&c.angle_kp, 0, 100));
-      s.emplace_back("distance_kp", p.real(&c.distance_kp, 0, 100));
-      s.emplace_back("max_wz_radps", p.real(&c.max_wz_radps, 0, 20));
-      s.emplace_back("min_wz_radps", p.real(&c.min_wz_radps, 0, 20));
-      s.emplace_back("max_speed_mps", p.real(&c.max_speed_mps, 0, 5));
-      s.emplace_back("min_speed_mps", p.real(&c.min_speed_mps, 0, 5));
-      s.emplace_back("final_speed_mps", p.real(&c.final_speed_mps, 0, 5));
-      s.emplace_back("final_heading_kp", p.real(&c.final_heading_kp, 0, 100));
-      return s;
-    }));
-    h.emplace_back("seed003", p.sub("controller.seed003.", [&]() {
-      dockcore::Seed003Params& c = sc.seed003;
-      Handlers s;
-      add_common(p, s, &c.common, &st.pad_reach_set);
-      s.emplace_back("holonomic", [&](const toml::node& n) { c.holonomic = p.boolean(n); st.seed003_holonomic_set = true; });
-      s.emplace_back("window", [&](const toml::node& n) {
-        c.window = static_cast<std::size_t>(p.integer(n, 1, static_cast<std::int64_t>(dockcore::kSeed003MaxWindow)));
-      });
-      const std::pair<const char*, Real*> reals[] = {
-          {"ema_alpha", &c.ema_alpha}, {"stage_switch_m", &c.stage_switch_m}, {"stage1_kw", &c.stage1_kw},
-          {"stage1_max_wz_radps", &c.stage1_max_wz_radps}, {"stage1_kv", &c.stage1_kv},
-          {"stage1_target_m", &c.stage1_target_m}, {"stage1_max_vx_mps", &c.stage1_max_vx_mps},
-          {"goal_z_m", &c.goal_z_m}, {"z_kp", &c.z_kp}, {"z_kd", &c.z_kd}, {"z_max_mps", &c.z_max_mps},
-          {"x_kp", &c.x_kp}, {"x_kd", &c.x_kd}, {"x_max_mps", &c.x_max_mps}, {"u_kp", &c.u_kp}, {"u_kd", &c.u_kd},
-          {"u_max_radps", &c.u_max_radps}, {"seed_period_s", &c.seed_period_s}, {"success_z_m", &c.success_z_m},
-          {"success_x_m", &c.success_x_m}, {"success_u_px", &c.success_u_px}, {"success_hold_s", &c.success_hold_s},
-          {"blind_zone_m", &c.blind_zone_m}, {"target_timeout_s", &c.target_timeout_s},
-          {"final_speed_mps", &c.final_speed_mps}, {"final_max_travel_m", &c.final_max_travel_m}};
-      for (const auto& r : reals) s.emplace_back(r.first, p.real(r.second, 0, 1e4));
-      return s;
-    }));
-    h.emplace_back("smooth", p.sub("controller.smooth.", [&]() {
-      dockcore::SmoothParams& c = sc.smooth;
-      Handlers s;
-      add_common(p, s, &c.common, &st.pad_reach_set);
-      s.emplace_back("backwards", [&](const toml::node& n) { c.backwards = p.boolean(n); st.smooth_backwards_set = true; });
-      const std::pair<const char*, Real*> reals[] = {
-          {"k_phi", &c.k_phi}, {"k_delta", &c.k_delta}, {"beta", &c.beta}, {"lambda", &c.lambda},
-          {"v_max_mps", &c.v_max_mps}, {"w_max_radps", &c.w_max_radps}, {"slowdown_radius_m", &c.slowdown_radius_m},
-          {"max_decel_mps2", &c.max_decel_mps2}, {"goal_projection_m", &c.goal_projection_m},
-          {"min_turn_speed_mps", &c.min_turn_speed_mps}, {"lineup_distance_m", &c.lineup_distance_m},
-          {"lineup_engage_lateral_m", &c.lineup_engage_lateral_m},
-          {"lineup_engage_heading_rad", &c.lineup_engage_heading_rad}, {"lineup_hysteresis_m", &c.lineup_hysteresis_m},
-          {"lineup_margin_m", &c.lineup_margin_m}, {"lineup_horizon_min_m", &c.lineup_horizon_min_m},
-          {"lineup_lateral_horizon_min_m", &c.lineup_lateral_horizon_min_m},
-          {"lineup_max_curvature_inv_m", &c.lineup_max_curvature_inv_m}};
-      for (const auto& r : reals) s.emplace_back(r.first, p.real(r.second, 0, 1e4));
-      return s;
-    }));
+    Handlers h = table_keys("controller", Handlers{{"name", [&](const toml::node& n) {
+                                                      sc.controller = p.choice(n, controller_names());
+                                                    }}});
+    for (const std::string& name : controller_names()) {
+      h.emplace_back(name, params::param_sub(p, "controller." + name, targets, params::kScenario));
+    }
     return h;
   };
 
@@ -614,8 +485,11 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
       {"world", p.sub("world.", world_handlers)},
       {"start", p.sub("start.", start_handlers)},
       {"events", events_handler},
-      {"task", p.sub("task.", task_handlers)},
-      {"estimator", p.sub("estimator.", estimator_handlers)},
+      {"task", params::param_sub(p, "task", targets, params::kScenario)},
+      {"estimator", p.sub("estimator.", [&]() {
+         return table_keys("estimator", Handlers{
+             {"segments", params::param_sub(p, "estimator.segments", targets, params::kScenario)}});
+       })},
       {"host", p.sub("host.", host_handlers)},
       {"controller", p.sub("controller.", controller_handlers)},
   };
@@ -623,7 +497,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
 
   // --- Derived values and cross-checks ---
   ChassisParams& c = sc.chassis;
-  c.footprint.shape = st.footprint_shape == "circle" ? FootprintShape::kCircle : FootprintShape::kRectangle;
+  c.footprint.shape = sc.safety.shape == dockcore::FootprintShape::kCircular ? FootprintShape::kCircle
+                                                                             : FootprintShape::kRectangle;
   if (st.motor_latency_s >= 0) {
     c.motor.latency_steps = static_cast<std::size_t>(std::lround(st.motor_latency_s / c.dt_s));
   }
@@ -679,18 +554,18 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
     f.half_width_m = static_cast<Real>(c.footprint.width_m / 2);
     f.circumscribed_radius_m = static_cast<Real>(std::hypot(static_cast<double>(f.half_length_m), c.footprint.width_m / 2));
   }
-  f.check_length_m = static_cast<Real>(st.check_length_m);
-  f.check_width_m = static_cast<Real>(st.check_width_m);
 
   const bool mecanum = c.geometry.kind == DriveKind::kMecanum;
   const bool rear = c.footprint.pad_side == PadSide::kRear;
-  if (!st.pad_reach_set) {
+  bool pad_reach_set = p.given("controller.pad_reach_m");
+  for (const std::string& name : controller_names()) pad_reach_set |= p.given("controller." + name + ".pad_reach_m");
+  if (!pad_reach_set) {
     const Real reach = static_cast<Real>(pad_reach_of(c));
     sc.seed000.common.pad_reach_m = sc.seed004.common.pad_reach_m = reach;
     sc.seed003.common.pad_reach_m = sc.smooth.common.pad_reach_m = reach;
   }
-  if (!st.seed003_holonomic_set) sc.seed003.holonomic = mecanum;
-  if (!st.smooth_backwards_set) sc.smooth.backwards = rear;
+  if (!p.given("controller.seed003.holonomic")) sc.seed003.holonomic = mecanum;
+  if (!p.given("controller.smooth.backwards")) sc.smooth.backwards = rear;
   sc.seed003.camera = sc.camera.model;
   sc.task.max_vx_mps = sc.limits.max_vx_mps > 0 ? sc.limits.max_vx_mps : sc.task.max_vx_mps;
   sc.task.max_vy_mps = sc.limits.max_vy_mps > 0 ? sc.limits.max_vy_mps : sc.task.max_vy_mps;

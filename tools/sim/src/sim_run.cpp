@@ -247,6 +247,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   cfg.task = sc.task;
   cfg.footprint = sc.safety;
   cfg.lidar_mount = sc.lidar_mount;
+  cfg.drive = core_drive_geometry(sc.chassis.geometry);
+  cfg.limits = sc.limits;
+  cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
   if (!core->configure(sc.profile, cfg)) throw ScenarioError("dock profile has no segments");
 
   Chassis chassis(sc.chassis, mix64(seed ^ 0x43484153ull));
@@ -263,7 +266,6 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
 
   const dockcore::DriveGeometry geom = core_drive_geometry(sc.chassis.geometry);
   const double dt = sc.chassis.dt_s;
-  const double tick_dt = dt * kStepsPerTick;
 
   // World state driven by events.
   const World world_with_dock = scenario_world(sc, true);
@@ -303,7 +305,6 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   const bool disc = sc.chassis.footprint.shape == FootprintShape::kCircle;
 
   // Host state.
-  dockcore::Twist2 prev_cmd{};
   dockcore::TaskState prev_state = dockcore::TaskState::kNotTasking;
   std::uint8_t prev_phase = 255;
   dockcore::FaultCode prev_fault = dockcore::FaultCode::kNone;
@@ -448,13 +449,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       in.chassis_ok = t - last_responding_t <= sc.host.chassis_stale_s;
       const dockcore::TickOutput o = core->tick(in);
 
-      // Kinematics: saturation keeping curvature, then the acceleration limit, then wheel speeds.
-      dockcore::Twist2 cmd = dockcore::saturate_twist(geom, sc.limits, o.cmd);
-      cmd = dockcore::limit_acceleration(sc.limits, prev_cmd, cmd, static_cast<Real>(tick_dt));
-      // A zero twist (stop, fault, idle) is sent at once: the drive's own lag and limits do the braking.
-      if (o.cmd.vx_mps == 0 && o.cmd.vy_mps == 0 && o.cmd.wz_radps == 0) cmd = dockcore::Twist2{};
-      prev_cmd = cmd;
-      const dockcore::WheelSpeeds w = dockcore::twist_to_wheels(geom, cmd);
+      const dockcore::WheelSpeeds& w = o.wheels;
       WheelRadps wr{};
       for (std::size_t i = 0; i < w.count && i < kMaxWheels; ++i) wr[i] = dd(w.radps[i]);
       chassis.command_wheels(wr);
@@ -511,7 +506,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       out.retries = s.retries;
 
       // Metrics on the command actually sent.
-      const double vx = dd(cmd.vx_mps);
+      const double vx = dd(o.drive_cmd.vx_mps);
       const int sgn = vx > 1e-3 ? 1 : (vx < -1e-3 ? -1 : 0);
       if (sgn != 0) {
         if (last_vx_sign != 0 && sgn != last_vx_sign) ++out.reversals;
@@ -529,7 +524,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
         out.min_clearance_m = std::min(out.min_clearance_m, clearance(poly, disc, centre, sc.chassis.footprint.radius_m, obs));
       }
       if (opt.record_trajectory && t + 1e-9 >= next_traj_t) {
-        run.trajectory.push_back(TrajectorySample{t, cs.true_pose, dd(prev_cmd.vx_mps), static_cast<std::uint8_t>(prev_state)});
+        run.trajectory.push_back(TrajectorySample{t, cs.true_pose, dd(core->drive_cmd().vx_mps), static_cast<std::uint8_t>(prev_state)});
         next_traj_t += opt.trajectory_period_s;
       }
     }

@@ -36,6 +36,19 @@ class SocketCanBus : public hal::CanBus {
   virtual const char* last_error() const = 0;
 };
 
+/// What one SocketCAN error frame says (linux/can/error.h): the error classes in its id, the controller state in
+/// data[1].
+struct CanErrorReport {
+  bool error_frame = false;  ///< The id has CAN_ERR_FLAG. False: a data or remote frame; nothing else is set.
+  bool bus_off = false;      ///< CAN_ERR_BUSOFF: the controller has gone bus-off (counted in bus_off).
+  bool restarted = false;    ///< CAN_ERR_RESTARTED: the controller is back on the bus after bus-off.
+  const char* message = "";  ///< One line for last_error(), "socketcan: ..."; static storage, never null.
+};
+
+/// Decodes one received frame's raw `can_id` (flags included) and its 8 data bytes (`data` may be null: no
+/// controller detail). The driver counts every error frame in bus_errors and a bus-off also in bus_off. Pure, O(1).
+CanErrorReport decode_can_error_frame(std::uint32_t can_id, const std::uint8_t* data);
+
 /// Opens `interface` (e.g. "can0", "vcan0"). Receive filter: exactly `rx_ids` (standard 11-bit ids; empty = all).
 /// nullptr + message in `error` when the socket cannot be created (EAFNOSUPPORT: kernel without CAN) or the
 /// interface does not exist.

@@ -36,6 +36,7 @@ struct ChassisCounters {
   std::uint32_t bad_frames = 0;        ///< Wrong length, checksum or rolling counter.
   std::uint32_t send_failures = 0;     ///< ENOBUFS and friends.
   std::uint32_t bus_errors = 0;        ///< Error frames (bus-off, controller problems).
+  std::uint32_t bus_off = 0;           ///< Bus-off events among bus_errors.
   std::uint32_t rx_overflows = 0;      ///< Frames the kernel dropped (SO_RXQ_OVFL).
 };
 

@@ -20,7 +20,7 @@
 // (crossing itself, too small, or unable to fix x, y or yaw, e.g. a flat plate) — is an error whose message starts
 // with "<source>:<line>:<column>: " (1-based, from the TOML source region of the offending key or value; a crossing
 // points at the later segment's first point, the other outline verdicts at the points array).
-// The parser is dockcore/drivers/profile_toml.hpp, which dockd's config uses for the same files.
+// The parser is dockcore/params/profile_toml.hpp, which dockd's config uses for the same files.
 // Host-side: errors are exceptions (ProfileFileError).
 #include <stdexcept>
 #include <string>

@@ -22,10 +22,10 @@
 #include <toml++/toml.h>
 
 #include "dockcore/dock_profile.hpp"
-#include "dockcore/drivers/toml_reader.hpp"
+#include "dockcore/params/toml_reader.hpp"
 #include "dockcore/profile_check.hpp"
 
-namespace dockcore::drivers::profile_toml {
+namespace dockcore::params::profile_toml {
 
 /// A profile file's default name: `path` without its directory and ".toml".
 inline std::string name_from_path(const std::string& path) {
@@ -227,4 +227,4 @@ DockProfile parse(const std::string& text, const std::string& source, const std:
   return out;
 }
 
-}  // namespace dockcore::drivers::profile_toml
+}  // namespace dockcore::params::profile_toml

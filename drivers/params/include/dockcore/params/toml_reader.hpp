@@ -21,7 +21,7 @@
 
 #include "dockcore/geometry.hpp"
 
-namespace dockcore::drivers::toml_reader {
+namespace dockcore::params::toml_reader {
 
 inline constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
@@ -179,6 +179,8 @@ class Reader {
   /// The key being read ("section.key"), for messages of custom handlers.
   const std::string& key() const { return key_; }
   const std::string& src() const { return src_; }
+  /// Whether `key` ("section.key") was given in the text read so far.
+  bool given(const std::string& key) const { return where_.find(key) != where_.end(); }
   /// Where `key` ("section.key") was given; `fallback` when it was not (cross-key errors point at the key).
   toml::source_region where(const std::string& key, const toml::source_region& fallback) const {
     const auto it = where_.find(key);
@@ -191,4 +193,4 @@ class Reader {
   mutable std::map<std::string, toml::source_region> where_;
 };
 
-}  // namespace dockcore::drivers::toml_reader
+}  // namespace dockcore::params::toml_reader

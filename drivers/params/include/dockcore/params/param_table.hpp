@@ -1,0 +1,103 @@
+#pragma once
+/// @file The parameter table: every parameter of dockcore's core structs that a file can set — drive limits,
+/// obstacle footprint, task manager, estimator, controllers — declared once with its key, unit, bounds and meaning;
+/// its default is the core struct's. dockd's config (app/dockd/config.cpp) and dock-sim's scenarios
+/// (tools/sim/src/scenario.cpp) both read these keys through the table (param_toml.hpp), so one key accepts the same
+/// values in both; the key tables of docs/dockd.md and docs/scenarios.md are generated from it
+/// (`dock-sim params`). A scenario adds only its world and the robot's physics.
+/// Host-side start-up code: heap and exceptions are fine here (never in core).
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "dockcore/controllers.hpp"
+#include "dockcore/dock_pose_estimator.hpp"
+#include "dockcore/kinematics.hpp"
+#include "dockcore/safety.hpp"
+#include "dockcore/task_manager.hpp"
+
+namespace dockcore::params {
+
+/// How a value is written in the file and stored.
+enum class ParamType : std::uint8_t {
+  kReal,     ///< A number (an integer is accepted), stored as Real.
+  kDegrees,  ///< A number in degrees in the file, stored in radians.
+  kInteger,  ///< An integer.
+  kBool,     ///< true / false.
+  kChoice,   ///< One of ParamSpec::choices; the setter gets its index.
+};
+
+/// Which files take a parameter (bit set).
+enum ParamUse : std::uint8_t {
+  kDockd = 1,     ///< dockd's config.
+  kScenario = 2,  ///< dock-sim's scenarios.
+  kBoth = 3,
+};
+
+/// The core parameter structs one file fills. A pointer may be null only for structs no key of that file sets.
+struct ParamTargets {
+  DriveGeometry* drive = nullptr;
+  DriveLimits* limits = nullptr;
+  FootprintParams* footprint = nullptr;
+  TaskParams* task = nullptr;
+  EstimatorParams* estimator = nullptr;
+  Seed000Params* seed000 = nullptr;
+  Seed004Params* seed004 = nullptr;
+  Seed003Params* seed003 = nullptr;
+  SmoothParams* smooth = nullptr;
+};
+
+/// One parameter.
+struct ParamSpec {
+  const char* table;    ///< TOML table it sits in ("task", "robot.limits", "estimator.segments").
+  const char* key;      ///< Key within that table.
+  const char* unit;     ///< "m", "s", "rad/s", "°", "–", ...
+  ParamType type;       ///< How it is written in the file and stored.
+  double min;           ///< Smallest accepted value, in file units (kReal, kDegrees, kInteger).
+  double max;           ///< Largest accepted value, in file units.
+  std::uint8_t use;     ///< ParamUse bits.
+  const char* meaning;  ///< One line for the docs (Markdown).
+  /// The value in file units (degrees for kDegrees, the choice's index for kChoice). O(1).
+  double (*get)(const ParamTargets&);
+  /// Stores a checked value given in file units (degrees for kDegrees, the index for kChoice). O(1).
+  void (*set)(const ParamTargets&, double);
+  const char* choices = nullptr;       ///< kChoice: the words, '|'-separated, in index order.
+  const char* dockd_table = nullptr;   ///< dockd's table when it differs from `table` (the range keys: "lidar").
+  const char* default_text = nullptr;  ///< The docs' default when it is not the struct's value ("from the footprint").
+  /// dock-sim's scenarios start from this value instead of the struct's (NaN: the struct's). The simulated
+  /// default robot drives at 0.4 m/s.
+  double scenario_default = __builtin_nan("");
+};
+
+/// Every parameter, in docs order. `count` receives the number of entries. O(1).
+const ParamSpec* param_table(std::size_t& count);
+
+/// The table `s` sits in for `use` (kDockd or kScenario). O(1).
+const char* table_of(const ParamSpec& s, ParamUse use);
+
+/// The entry with `table` (as seen by `use`) and `key`, or nullptr. O(table size).
+const ParamSpec* find_param(const std::string& table, const std::string& key, ParamUse use);
+
+/// The words of a kChoice entry (empty for other types). O(choices length).
+std::string choice_word(const ParamSpec& s, std::size_t index);
+/// The number of words of a kChoice entry. O(choices length).
+std::size_t choice_count(const ParamSpec& s);
+
+/// Sets every entry of `use` that has a scenario_default (kScenario only) in `t`. O(table size).
+void apply_defaults(const ParamTargets& t, ParamUse use);
+
+/// The Markdown table (header, separator, one row per key) of the entries of `table` that `use` takes: key, unit,
+/// default (from default-constructed core structs, or the scenario default), accepted range, meaning.
+/// Empty when no entry matches. O(table size).
+std::string markdown_table(const std::string& table, ParamUse use);
+
+/// Regenerates every marked block of a Markdown document. A block is
+///   <!-- params dockd task -->   (or "scenario"; the table name)
+///   ...
+///   <!-- /params -->
+/// and its lines between the markers become markdown_table(table, use). Returns the new text; sets `error` (and
+/// returns the text unchanged) for a malformed marker or an unknown table. O(text size + table size).
+std::string update_param_blocks(const std::string& text, std::string& error);
+
+}  // namespace dockcore::params
