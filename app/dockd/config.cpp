@@ -1,4 +1,5 @@
 #include "config.hpp"
+#include "camera_config_keys.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -308,11 +309,13 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
 
   auto camera = [&]() {
     auto& k = c.camera;
-    return Handlers{{"enabled", p.flag(&c.camera_enabled)},
-                    {"bind", p.str(&k.bind_address)},
-                    {"port", p.integ(&k.port, 1, 65535)},
-                    {"target_id", p.integ(&k.target_id, -1, 65535)},
-                    {"max_age_ms", p.integ(&k.max_age_ms, 10, 10000)}};
+    Handlers h{{"enabled", p.flag(&c.camera_enabled)},
+               {"bind", p.str(&k.bind_address)},
+               {"port", p.integ(&k.port, 1, 65535)},
+               {"target_id", p.integ(&k.target_id, -1, 65535)},
+               {"max_age_ms", p.integ(&k.max_age_ms, 10, 10000)}};
+    add_camera_device_keys(p, h, c.camera_device);  // dockd's own capture and detector (camera_config.cpp)
+    return h;
   };
 
   auto record = [&]() {
@@ -429,6 +432,8 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
     p.fail(p.where("camera.port", root.source()), "camera.port must differ from host.port");
   }
 
+  finish_camera_device(p, root.source(), c);  // after [controller]: it sets seed003's camera model
+
   if (c.docks.empty()) {
     DockEntry d;
     c.docks.push_back(d);
@@ -507,6 +512,7 @@ std::vector<std::string> restart_only_changes(const DockdConfig& a, const DockdC
   check(a.camera.port == b.camera.port, "camera.port");
   check(a.camera.target_id == b.camera.target_id, "camera.target_id");
   check(a.camera.max_age_ms == b.camera.max_age_ms, "camera.max_age_ms");
+  camera_device_restart_changes(a.camera_device, b.camera_device, out);
   check(a.record_dir == b.record_dir, "record.dir");
   check(a.record_max_bytes == b.record_max_bytes, "record.max_bytes");
   check(a.record_max_files == b.record_max_files, "record.max_files");

@@ -21,6 +21,7 @@
 #include "dockcore/drivers/lidar_driver.hpp"
 #include "dockcore/drivers/udp_camera.hpp"
 #include "dockcore/drivers/udp_host_link.hpp"
+#include "camera_config.hpp"
 
 namespace dockd {
 
@@ -92,8 +93,11 @@ struct DockdConfig {
   dockcore::drivers::UdpHostLinkOptions host{};
 
   // [camera]
-  bool camera_enabled = false;
+  bool camera_enabled = false;  ///< The UDP datagram input (external detectors).
   dockcore::drivers::UdpCameraOptions camera{};
+  /// [camera.device], [camera.intrinsics], [camera.mount], [camera.tag]: dockd's own capture and detector
+  /// (camera_config.hpp, docs/camera.md). target_id and max_age_ms above apply to it too.
+  CameraDeviceConfig camera_device{};
 
   // [record]
   std::string record_dir;                      ///< "" = no session record.

@@ -368,9 +368,18 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
 }
 
 void Daemon::poll_camera(std::uint64_t) {
-  if (io_.camera == nullptr) return;
-  dockcore::CameraTarget t;
-  if (io_.camera->poll_target(t)) camera_ = t;
+  // Both sources feed the same target; when both have a new one, the newer image wins.
+  dockcore::CameraTarget best;
+  bool have = false;
+  for (dockcore::hal::CameraTargetSource* src : {io_.camera, io_.camera_own}) {
+    if (src == nullptr) continue;
+    dockcore::CameraTarget t;
+    if (src->poll_target(t) && (!have || t.stamp_us >= best.stamp_us)) {
+      best = t;
+      have = true;
+    }
+  }
+  if (have) camera_ = best;
 }
 
 bool Daemon::enqueue(const PendingCommand& c) {
@@ -931,7 +940,20 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       e.found ? "none" : dockcore::to_string(e.reject), static_cast<double>(core_->filter().evidence_nats()),
       core_->filter().confirmed() ? "true" : "false");
   if (n < 0 || static_cast<std::size_t>(n) >= size) return 0;
-  return static_cast<std::size_t>(n);
+  std::size_t len = static_cast<std::size_t>(n);
+  // The own camera's fields go before the closing brace when they fit; otherwise the status goes without them.
+  if (io_.camera_status != nullptr) {
+    const std::size_t k = io_.camera_status(io_.camera_status_ctx, buf + len - 1, size - len);
+    if (k > 0) {
+      len += k - 1;
+      buf[len++] = '}';
+      buf[len] = '\0';
+    } else {
+      buf[len - 1] = '}';
+      buf[len] = '\0';
+    }
+  }
+  return len;
 }
 
 }  // namespace dockd

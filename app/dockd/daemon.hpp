@@ -40,7 +40,13 @@ struct DaemonIo {
   dockcore::hal::ChassisLink* chassis = nullptr;
   dockcore::hal::HostLink* can_host = nullptr;           ///< CAN host command / status frames.
   dockcore::drivers::UdpHostLink* udp_host = nullptr;    ///< JSON requests and the status stream.
-  dockcore::hal::CameraTargetSource* camera = nullptr;
+  dockcore::hal::CameraTargetSource* camera = nullptr;      ///< The UDP camera datagram (external detectors).
+  dockcore::hal::CameraTargetSource* camera_own = nullptr;  ///< dockd's own capture + detector (docs/camera.md).
+  /// Optional: writes the own camera's status fields (",\"camera_frames\":…", no heap, never blocking) into `buf`
+  /// (`size` bytes with the NUL) and returns their length; 0 when they do not fit (the status then goes without
+  /// them). `ctx` is camera_status_ctx.
+  std::size_t (*camera_status)(const void* ctx, char* buf, std::size_t size) = nullptr;
+  const void* camera_status_ctx = nullptr;
   const dockcore::hal::Clock* clock = nullptr;
   RotatingLog* event_log = nullptr;                      ///< JSON-lines event log (may be closed).
   /// Optional: the CAN link behind can_host, for its host_commands_rejected() (replays, out-of-order) in the status.
@@ -101,6 +107,8 @@ class Daemon {
   void on_chassis_readable(std::uint64_t now_us);
   void on_host_readable(std::uint64_t now_us);
   void on_camera_readable(std::uint64_t now_us);
+  /// The camera target the controllers get: the newest from the camera sources (invalid until one arrived).
+  const dockcore::CameraTarget& camera_target() const { return camera_; }
 
   /// Stop path (SIGTERM/SIGINT, fatal errors, end of tests): sends `frames` zero wheel commands back to back
   /// (main spaces them one tick apart by calling this once per frame) and logs the reason once. O(frames).

@@ -34,6 +34,10 @@
 #include "dockcore/drivers/can_link.hpp"
 #include "dockcore/drivers/lidar_driver.hpp"
 #include "dockcore/drivers/udp_camera.hpp"
+#ifdef DOCKD_HAVE_VISION
+#include "dockcore/drivers/camera_pipeline.hpp"
+#include "dockcore/drivers/v4l2_camera.hpp"
+#endif
 #include "dockcore/drivers/udp_host_link.hpp"
 
 namespace {
@@ -156,7 +160,30 @@ void notify(const char* what) {
 #endif
 }
 
-enum Tag : std::uint64_t { kTimer = 1, kSignal, kLidar, kCan, kHost, kCamera };
+enum Tag : std::uint64_t { kTimer = 1, kSignal, kLidar, kCan, kHost, kCamera, kCameraOwn };
+
+#ifdef DOCKD_HAVE_VISION
+/// The own camera's status fields (DaemonIo::camera_status): capture counters and the id of the target tag seen in
+/// the last frame (-1: none).
+/// A snapshot copy; never blocks, no heap.
+std::size_t own_camera_status(const void* ctx, char* buf, std::size_t size) {
+  const auto* p = static_cast<const dockcore::drivers::CameraPipeline*>(ctx);
+  const dockcore::drivers::CameraPipelineStats s = p->stats();
+  // Compact: the status is about 1.2 kB of the 1400-byte reply (kMaxHostReply); camera-check reports the rest.
+  const int n = std::snprintf(
+      buf, size,
+      ",\"camera_connected\":%s,\"camera_frames\":%llu,\"camera_dropped\":%llu,\"camera_late\":%llu,"
+      "\"camera_corrupt\":%llu,\"camera_reconnects\":%u,\"camera_tag_id\":%d",
+      s.connected ? "true" : "false", static_cast<unsigned long long>(s.capture.frames),
+      static_cast<unsigned long long>(s.capture.dropped), static_cast<unsigned long long>(s.capture.late),
+      static_cast<unsigned long long>(s.capture.corrupt), s.capture.reconnects, s.have_tag ? s.last_tag.id : -1);
+  if (n < 0 || static_cast<std::size_t>(n) >= size) {
+    buf[0] = '\0';
+    return 0;
+  }
+  return static_cast<std::size_t>(n);
+}
+#endif
 
 struct Registration {
   int fd = -1;
@@ -211,9 +238,17 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (check_only) {
-    std::printf("%s: valid (%zu dock(s), controller %s, CAN %s %s, lidar %s)\n", config_path.c_str(), cfg.docks.size(),
-                cfg.controller.c_str(), cfg.can_interface.c_str(), dockcore::drivers::to_string(cfg.can.protocol),
-                dockcore::drivers::to_string(cfg.lidar.protocol));
+    std::string cam;
+    if (cfg.camera_device.enabled) {
+      const auto& d = cfg.camera_device;
+      cam = ", camera " + d.capture.device + " " + std::to_string(d.capture.width_px) + "x" +
+            std::to_string(d.capture.height_px) + " " + dockcore::drivers::to_string(d.capture.format) + " " +
+            d.tag.family;
+    }
+    std::printf("%s: valid (%zu dock(s), controller %s, CAN %s %s, lidar %s%s)\n", config_path.c_str(),
+                cfg.docks.size(), cfg.controller.c_str(), cfg.can_interface.c_str(),
+                dockcore::drivers::to_string(cfg.can.protocol), dockcore::drivers::to_string(cfg.lidar.protocol),
+                cam.c_str());
     return 0;
   }
 
@@ -291,6 +326,44 @@ int main(int argc, char** argv) {
     }
   }
 
+  // dockd's own camera (docs/camera.md): V4L2 capture and the AprilTag detector on their own thread (created here,
+  // after the signals were blocked, so it inherits the mask), feeding the same camera target as the datagram.
+#ifdef DOCKD_HAVE_VISION
+  std::unique_ptr<dockcore::drivers::TagDetector> tag_detector;
+  std::unique_ptr<dockcore::drivers::V4l2Camera> v4l2;
+  std::unique_ptr<dockcore::drivers::CameraPipeline> camera_own;
+  if (cfg.camera_device.enabled) {
+    tag_detector = dockcore::drivers::TagDetector::create(cfg.camera_device.tag, err);
+    if (!tag_detector) {
+      std::fprintf(stderr, "%s: camera.tag: %s\n", config_path.c_str(), err.c_str());
+      return 2;
+    }
+    v4l2 = dockcore::drivers::open_v4l2_camera(cfg.camera_device.capture, err);
+    if (!v4l2) {
+      std::fprintf(stderr, "dockd: %s\n", err.c_str());
+      return 3;
+    }
+    if (!v4l2->connected()) {
+      std::fprintf(stderr, "dockd: %s; retrying\n", v4l2->last_error());
+    }
+    dockcore::drivers::CameraPipelineOptions po;
+    po.target_id = cfg.camera.target_id;
+    po.max_age_ms = cfg.camera.max_age_ms;
+    po.full_confidence_margin = cfg.camera_device.full_confidence_margin;
+    camera_own = dockcore::drivers::CameraPipeline::start(*v4l2, *tag_detector, po, err);
+    if (!camera_own) {
+      std::fprintf(stderr, "dockd: %s\n", err.c_str());
+      return 3;
+    }
+  }
+#else
+  if (cfg.camera_device.enabled) {
+    std::fprintf(stderr, "%s: [camera.device]: this dockd was built without libapriltag (tools/setup-deps installs "
+                         "libapriltag-dev)\n", config_path.c_str());
+    return 2;
+  }
+#endif
+
   MonotonicClock clock;
   dockd::DaemonIo io;
   io.lidar = lidar.get();
@@ -298,6 +371,13 @@ int main(int argc, char** argv) {
   io.can_host = can.get();
   io.udp_host = host.get();
   io.camera = camera.get();
+#ifdef DOCKD_HAVE_VISION
+  io.camera_own = camera_own.get();
+  if (camera_own) {
+    io.camera_status = own_camera_status;
+    io.camera_status_ctx = camera_own.get();
+  }
+#endif
   io.clock = &clock;
   io.event_log = &event_log;
   io.can_link = can.get();
@@ -335,6 +415,10 @@ int main(int argc, char** argv) {
             epoll_set(ep, r_can, bus.fd(), kCan) && epoll_set(ep, r_lidar, lidar->fd(), kLidar);
   if (host) ok = ok && epoll_set(ep, r_host, host->fd(), kHost);
   if (camera) ok = ok && epoll_set(ep, r_cam, camera->fd(), kCamera);
+#ifdef DOCKD_HAVE_VISION
+  Registration r_cam_own;
+  if (camera_own) ok = ok && epoll_set(ep, r_cam_own, camera_own->fd(), kCameraOwn);
+#endif
   if (!ok) {
     std::fprintf(stderr, "dockd: epoll_ctl: %s\n", std::strerror(errno));
     daemon->send_zero(mono_us(), 5);
@@ -406,7 +490,8 @@ int main(int argc, char** argv) {
         case kLidar: daemon->on_lidar_readable(now); break;
         case kCan: daemon->on_chassis_readable(now); break;
         case kHost: daemon->on_host_readable(now); break;
-        case kCamera: daemon->on_camera_readable(now); break;
+        case kCamera:
+        case kCameraOwn: daemon->on_camera_readable(now); break;
         default: break;
       }
     }

@@ -1,0 +1,130 @@
+// dockd's two camera sources (the UDP datagram and its own camera, docs/camera.md) feeding one camera target, and
+// the own camera's status fields: appended when they fit, left out — never the status lost — when they do not.
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "dockd_sim_rig.hpp"
+
+#include "CppUTest/TestHarness.h"
+
+namespace {
+
+struct FakeTargets final : dockcore::hal::CameraTargetSource {
+  bool has = false;
+  dockcore::CameraTarget next{};
+  void put(double u, std::uint64_t stamp_us) {
+    next.valid = true;
+    next.u_px = static_cast<dockcore::Real>(u);
+    next.v_px = 240;
+    next.confidence = 1;
+    next.stamp_us = stamp_us;
+    has = true;
+  }
+  bool poll_target(dockcore::CameraTarget& out) override {
+    if (!has) return false;
+    out = next;
+    has = false;
+    return true;
+  }
+  int fd() const override { return -1; }
+};
+
+std::size_t fields(const void* ctx, char* buf, std::size_t size) {
+  const int n = std::snprintf(buf, size, "%s", static_cast<const char*>(ctx));
+  if (n < 0 || static_cast<std::size_t>(n) >= size) {
+    buf[0] = '\0';
+    return 0;
+  }
+  return static_cast<std::size_t>(n);
+}
+
+struct CameraRig {
+  docksim::Scenario sc = docksim::load_scenario_file(dockd_test::default_scenario_path());
+  dockd::DockdConfig cfg = dockd_test::scenario_config(sc);
+  dockd_test::SimClock clock;
+  std::unique_ptr<docksim::Chassis> chassis;
+  dockd_test::SimChassis link;
+  dockd_test::SimLidar lidar;
+  FakeTargets udp, own;
+  std::unique_ptr<dockd::Daemon> daemon;
+  std::string state_file = "/tmp/dockd_test_camera_" + std::to_string(::getpid());
+
+  explicit CameraRig(const char* status_fields) {
+    cfg.state_file = state_file;
+    chassis = dockd_test::scenario_chassis(sc, link, clock);
+    dockd::DaemonIo io;
+    io.lidar = &lidar;
+    io.chassis = &link;
+    io.clock = &clock;
+    io.camera = &udp;
+    io.camera_own = &own;
+    io.stderr_level = dockd::LogLevel::kError;
+    if (status_fields != nullptr) {
+      io.camera_status = fields;
+      io.camera_status_ctx = status_fields;
+    }
+    daemon = std::make_unique<dockd::Daemon>(cfg, io);
+    std::string err;
+    CHECK_TRUE_TEXT(daemon->start(err), err.c_str());
+  }
+  ~CameraRig() {
+    daemon.reset();
+    std::remove(state_file.c_str());
+    std::remove((state_file + ".bak").c_str());
+  }
+};
+
+}  // namespace
+
+// The scenario parser's static name table is built on first use; build it before CppUTest's per-test leak check
+// (as test_dockd_daemon.cpp does).
+static const bool kNamesWarm = !docksim::controller_names().empty();
+
+TEST_GROUP(DockdCamera){};
+
+TEST(DockdCamera, EitherSourceFeedsTheTargetAndTheNewerImageWins) {
+  CameraRig r(nullptr);
+  CHECK_FALSE(r.daemon->camera_target().valid);
+  r.own.put(300, 1000);
+  r.daemon->on_camera_readable(2000);
+  CHECK(r.daemon->camera_target().valid);
+  DOUBLES_EQUAL(300, static_cast<double>(r.daemon->camera_target().u_px), 0);
+  r.udp.put(310, 1500);
+  r.daemon->on_camera_readable(2100);
+  DOUBLES_EQUAL(310, static_cast<double>(r.daemon->camera_target().u_px), 0);
+  // Both new at once: the newer image, whichever source.
+  r.udp.put(320, 3000);
+  r.own.put(330, 3500);
+  r.daemon->on_camera_readable(4000);
+  DOUBLES_EQUAL(330, static_cast<double>(r.daemon->camera_target().u_px), 0);
+  r.udp.put(340, 5500);
+  r.own.put(350, 5000);
+  r.daemon->on_camera_readable(6000);
+  DOUBLES_EQUAL(340, static_cast<double>(r.daemon->camera_target().u_px), 0);
+}
+
+TEST(DockdCamera, StatusCarriesTheCameraFieldsWhenTheyFit) {
+  CameraRig r(",\"camera_connected\":true,\"camera_frames\":42");
+  char st[dockcore::drivers::kMaxHostReply];
+  const std::size_t len = r.daemon->status_json(st, sizeof st, 0);
+  CHECK(len > 0);
+  CHECK_EQUAL(std::strlen(st), len);
+  STRCMP_CONTAINS(",\"camera_connected\":true,\"camera_frames\":42}", st);
+  CHECK_EQUAL('{', st[0]);
+}
+
+TEST(DockdCamera, StatusWithoutTheCameraFieldsWhenTheyDoNotFit) {
+  const std::string huge = ",\"camera_x\":\"" + std::string(600, 'x') + "\"";
+  CameraRig r(huge.c_str());
+  char st[dockcore::drivers::kMaxHostReply];
+  const std::size_t len = r.daemon->status_json(st, sizeof st, 0);
+  CHECK(len > 0);
+  CHECK_EQUAL(std::strlen(st), len);
+  CHECK_EQUAL('}', st[len - 1]);
+  CHECK(std::strstr(st, "camera_x") == nullptr);
+  STRCMP_CONTAINS("\"dock_confirmed\":", st);
+}
