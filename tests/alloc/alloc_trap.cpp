@@ -1,5 +1,5 @@
 // Runs core's per-scan work with every heap entry point counted; any allocation after set-up is a failure.
-// Interposes malloc/calloc/realloc/free (glibc's __libc_* do the work), which also catches operator new.
+// Counts through tests/support/malloc_count.hpp (malloc/calloc/realloc interposed), which also catches operator new.
 #include <cstddef>
 #include <cstdio>
 #include <cmath>
@@ -16,32 +16,10 @@
 #include "dockcore/vmarker_detector.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/scenes.hpp"
+#include "../support/malloc_count.hpp"
 
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void __libc_free(void*);
-}
-
-namespace {
-volatile bool g_armed = false;
-volatile std::size_t g_allocs = 0;
-}  // namespace
-
-extern "C" void* malloc(std::size_t n) {
-  if (g_armed) g_allocs = g_allocs + 1;
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(std::size_t a, std::size_t b) {
-  if (g_armed) g_allocs = g_allocs + 1;
-  return __libc_calloc(a, b);
-}
-extern "C" void* realloc(void* p, std::size_t n) {
-  if (g_armed) g_allocs = g_allocs + 1;
-  return __libc_realloc(p, n);
-}
-extern "C" void free(void* p) { __libc_free(p); }
+using dockcore_test::g_allocs;
+using dockcore_test::g_armed;
 
 using namespace dockcore;
 

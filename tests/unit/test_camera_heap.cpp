@@ -1,38 +1,16 @@
 // The V4L2 driver's heap after start-up: retrying a device that is not there (open attempts with back-off, each
-// failure written into last_error()) calls malloc/calloc/realloc zero times. The calls are counted by interposing
-// them (as test_dockd_heap.cpp does); not built in sanitizer builds, whose runtime owns malloc.
+// failure written into last_error()) calls malloc/calloc/realloc zero times. The calls are counted by
+// tests/support/malloc_count.hpp; not built in sanitizer builds, whose runtime owns malloc.
 #include <cstddef>
 #include <string>
 
 #include "dockcore/drivers/v4l2_camera.hpp"
+#include "../support/malloc_count.hpp"
 
 #include "CppUTest/TestHarness.h"
 
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void __libc_free(void*);
-}
-
-namespace {
-volatile bool g_armed = false;
-volatile std::size_t g_allocs = 0;
-}  // namespace
-
-extern "C" void* malloc(std::size_t n) {
-  if (g_armed) g_allocs = g_allocs + 1;
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(std::size_t a, std::size_t b) {
-  if (g_armed) g_allocs = g_allocs + 1;
-  return __libc_calloc(a, b);
-}
-extern "C" void* realloc(void* p, std::size_t n) {
-  if (g_armed) g_allocs = g_allocs + 1;
-  return __libc_realloc(p, n);
-}
-extern "C" void free(void* p) { __libc_free(p); }
+using dockcore_test::g_allocs;
+using dockcore_test::g_armed;
 
 TEST_GROUP(V4l2Heap){};
 

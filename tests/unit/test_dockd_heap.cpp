@@ -22,35 +22,13 @@
 #include "dockcore/drivers/udp_host_link.hpp"
 #include "dockd_sim_rig.hpp"
 #include "docksim/rng.hpp"
+#include "../support/malloc_count.hpp"
 #include "session_record.hpp"
 
 #include "CppUTest/TestHarness.h"
 
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void __libc_free(void*);
-}
-
-namespace {
-volatile bool g_armed = false;
-volatile std::size_t g_allocs = 0;
-}  // namespace
-
-extern "C" void* malloc(std::size_t n) {
-  if (g_armed) g_allocs = g_allocs + 1;
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(std::size_t a, std::size_t b) {
-  if (g_armed) g_allocs = g_allocs + 1;
-  return __libc_calloc(a, b);
-}
-extern "C" void* realloc(void* p, std::size_t n) {
-  if (g_armed) g_allocs = g_allocs + 1;
-  return __libc_realloc(p, n);
-}
-extern "C" void free(void* p) { __libc_free(p); }
+using dockcore_test::g_allocs;
+using dockcore_test::g_armed;
 
 using dockcore::TaskState;
 
