@@ -15,6 +15,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "dockcore/cli/parse_errors.hpp"
+
 namespace {
 
 std::uint64_t mono_ms() {
@@ -78,25 +80,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // An unknown option or word where the subcommand belongs: name it, and for a word the valid subcommands (CLI11
-    // would only say that a subcommand is required).
-    const std::vector<std::string> rest = app.remaining();
-    if (app.get_subcommands().empty() && !rest.empty() && rest.front().rfind('-', 0) == 0) {
-      std::fprintf(stderr, "dockctl: unknown option '%s'\nRun with --help for more information.\n",
-                   rest.front().c_str());
-      return 2;
-    }
-    if (app.get_subcommands().empty() && !rest.empty()) {
-      std::string valid;
-      for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
-        valid += (valid.empty() ? "" : ", ") + sub->get_name();
-      }
-      std::fprintf(stderr, "dockctl: unknown subcommand '%s' (valid: %s)\nRun with --help for more information.\n",
-                   rest.front().c_str(), valid.c_str());
-      return 2;
-    }
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
+    return dockcore::cli::exit_for_parse_error(app, e, "dockctl");
   }
 
   Link l;

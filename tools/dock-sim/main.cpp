@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "dockcore/cli/parse_errors.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"dock-sim: simulate lidar docking scenes, run dockcore's detectors on them, measure them"};
@@ -23,24 +24,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::RuntimeError& e) {
     return e.get_exit_code();  // a subcommand's result, already reported by it
   } catch (const CLI::ParseError& e) {
-    // An unknown option or word where the subcommand belongs: name it, and for a word the valid subcommands (CLI11
-    // would only say that a subcommand is required).
-    const std::vector<std::string> rest = app.remaining();
-    if (app.get_subcommands().empty() && !rest.empty() && rest.front().rfind('-', 0) == 0) {
-      std::fprintf(stderr, "dock-sim: unknown option '%s'\nRun with --help for more information.\n",
-                   rest.front().c_str());
-      return 2;
-    }
-    if (app.get_subcommands().empty() && !rest.empty()) {
-      std::string valid;
-      for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
-        valid += (valid.empty() ? "" : ", ") + sub->get_name();
-      }
-      std::fprintf(stderr, "dock-sim: unknown subcommand '%s' (valid: %s)\nRun with --help for more information.\n",
-                   rest.front().c_str(), valid.c_str());
-      return 2;
-    }
-    return app.exit(e) == 0 ? 0 : 2;
+    return dockcore::cli::exit_for_parse_error(app, e, "dock-sim");
   }
   return 0;
 }
