@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <csetjmp>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -30,21 +31,17 @@ inline void on_jpeg_error(j_common_ptr c) {
 }
 }  // namespace detail
 
-/// True + `out` filled, or false + `error` ("FILE: why").
-inline bool decode_jpeg_grey(const std::string& path, GreyImage& out, std::string& error) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) {
-    error = path + ": cannot open";
-    return false;
-  }
+namespace detail {
+/// The decode itself. libjpeg reports errors by longjmp back into this frame, so it holds no C++ object of its own
+/// (a string built here could be clobbered): the caller owns the file and turns `message` into its error.
+inline bool decode_jpeg_grey_file(std::FILE* f, GreyImage& out, char (&message)[JMSG_LENGTH_MAX]) {
   jpeg_decompress_struct cinfo{};
-  detail::JpegError err{};
+  JpegError err{};
   cinfo.err = jpeg_std_error(&err.mgr);
-  err.mgr.error_exit = detail::on_jpeg_error;
+  err.mgr.error_exit = on_jpeg_error;
   if (setjmp(err.jump) != 0) {
-    error = path + ": " + err.message;
+    std::memcpy(message, err.message, sizeof message);
     jpeg_destroy_decompress(&cinfo);
-    std::fclose(f);
     return false;
   }
   jpeg_create_decompress(&cinfo);
@@ -61,8 +58,22 @@ inline bool decode_jpeg_grey(const std::string& path, GreyImage& out, std::strin
   }
   jpeg_finish_decompress(&cinfo);
   jpeg_destroy_decompress(&cinfo);
-  std::fclose(f);
   return true;
+}
+}  // namespace detail
+
+/// True + `out` filled, or false + `error` ("FILE: why").
+inline bool decode_jpeg_grey(const std::string& path, GreyImage& out, std::string& error) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) {
+    error = path + ": cannot open";
+    return false;
+  }
+  char message[JMSG_LENGTH_MAX] = {};
+  const bool ok = detail::decode_jpeg_grey_file(f, out, message);
+  std::fclose(f);
+  if (!ok) error = path + ": " + message;
+  return ok;
 }
 
 }  // namespace camera_check
