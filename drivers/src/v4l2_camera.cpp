@@ -71,6 +71,15 @@ int xioctl(int fd, unsigned long request, void* arg) {
   return r;
 }
 
+/// A descriptor of mmap capture buffer `index` (DQBUF fills the index in).
+v4l2_buffer mmap_capture_buffer(std::uint32_t index) {
+  v4l2_buffer b{};
+  b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  b.memory = V4L2_MEMORY_MMAP;
+  b.index = index;
+  return b;
+}
+
 std::uint32_t fourcc(CameraPixelFormat f) { return f == CameraPixelFormat::kGrey ? V4L2_PIX_FMT_GREY : V4L2_PIX_FMT_YUYV; }
 
 /// The four characters of a FourCC code, NUL-terminated, in `out`.
@@ -135,9 +144,7 @@ class V4l2CameraImpl final : public V4l2Camera {
         lose("poll", (p.revents & POLLNVAL) != 0 ? EBADF : ENODEV);
         continue;
       }
-      v4l2_buffer b{};
-      b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-      b.memory = V4L2_MEMORY_MMAP;
+      v4l2_buffer b = mmap_capture_buffer(0);
       if (xioctl(fd_, VIDIOC_DQBUF, &b) < 0) {
         if (errno == EAGAIN) {
           if (mono_us() >= deadline) return hal::CameraFrameStatus::kTimeout;
@@ -284,10 +291,7 @@ class V4l2CameraImpl final : public V4l2Camera {
     }
     nbuf_ = std::min<std::uint32_t>(rb.count, kMaxV4l2Buffers);
     for (std::uint32_t i = 0; i < nbuf_; ++i) {
-      v4l2_buffer b{};
-      b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-      b.memory = V4L2_MEMORY_MMAP;
-      b.index = i;
+      v4l2_buffer b = mmap_capture_buffer(i);
       if (xioctl(fd_, VIDIOC_QUERYBUF, &b) < 0) {
         fail("VIDIOC_QUERYBUF", errno);
         return OpenResult::kFailed;
@@ -308,10 +312,7 @@ class V4l2CameraImpl final : public V4l2Camera {
       }
     }
     for (std::uint32_t i = 0; i < nbuf_; ++i) {
-      v4l2_buffer b{};
-      b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-      b.memory = V4L2_MEMORY_MMAP;
-      b.index = i;
+      v4l2_buffer b = mmap_capture_buffer(i);
       if (xioctl(fd_, VIDIOC_QBUF, &b) < 0) {
         fail("VIDIOC_QBUF", errno);
         return OpenResult::kFailed;
