@@ -15,6 +15,16 @@ constexpr Real kOverhangM = static_cast<Real>(0.002);
 // Smallest |cos(incidence)| used to turn a point-to-line residual into a range residual.
 constexpr Real kMinCosIncidence = static_cast<Real>(0.2);
 
+// Registration stops when its last step was shorter than this many standard deviations of the pose estimate.
+constexpr Real kStopSigmas = static_cast<Real>(0.2);
+
+// Registration keeps the previous iteration's beams and association when its last step moved no point of the dock by
+// more than this; after a larger step it takes the span's beams and searches every segment again.
+constexpr Real kReuseStepM = static_cast<Real>(0.02);
+
+// Association with no segment yet (assoc_seg_).
+constexpr std::uint8_t kNoSegment = 0xFF;
+
 // Gauss-Newton iterations that use Huber weights before switching to Tukey's biweight.
 constexpr std::uint8_t kHuberIterations = 3;
 
@@ -76,6 +86,23 @@ Real min_eigen_sym3(const Mat3& a) {
   rr = rr < -1 ? R(-1) : (rr > 1 ? R(1) : rr);
   const Real phi = std::acos(rr) / 3;
   return q + 2 * p * std::cos(phi + R(2.0943951023931957));
+}
+
+// Distance between segments [a, b] and [c, d] that do not cross: the least of the four end-to-segment distances.
+Real segment_distance(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  auto point_segment = [](const Vec2& p, const Vec2& u, const Vec2& v) {
+    const Vec2 uv = v - u;
+    Real t = (p - u).dot(uv) / uv.squaredNorm();
+    t = t < 0 ? R(0) : (t > 1 ? R(1) : t);
+    return (p - u - t * uv).norm();
+  };
+  const Real d1 = point_segment(a, c, d);
+  const Real d2 = point_segment(b, c, d);
+  const Real d3 = point_segment(c, a, b);
+  const Real d4 = point_segment(d, a, b);
+  const Real m12 = d1 < d2 ? d1 : d2;
+  const Real m34 = d3 < d4 ? d3 : d4;
+  return m12 < m34 ? m12 : m34;
 }
 
 Real dist2(const Pose2& a, const Pose2& b) {
@@ -168,6 +195,32 @@ bool DockPoseEstimator::configure(const DockProfile& profile, const EstimatorPar
     const Real r = profile.vertices_m[i].norm();
     profile_radius_m_ = r > profile_radius_m_ ? r : profile_radius_m_;
   }
+  // Where registration may keep a beam on its previous segment without searching the others (see
+  // PlacedProfile::projects_well_inside): a long segment whose joints turn by at most 120°, for points closer to its
+  // line than half its clearance from every segment it does not join.
+  const std::size_t ns = profile.segment_count();
+  for (std::size_t i = 0; i < ns; ++i) {
+    const Vec2& a = profile.vertices_m[i];
+    const Vec2& b = profile.vertices_m[i + 1];
+    const Vec2 d = (b - a) / (b - a).norm();
+    bool joints_ok = true;
+    if (i > 0) {
+      const Vec2 prev = (a - profile.vertices_m[i - 1]).normalized();
+      joints_ok = joints_ok && prev.dot(d) >= R(-0.5);  // turn of at most 120°
+    }
+    if (i + 1 < ns) {
+      const Vec2 next = (profile.vertices_m[i + 2] - b).normalized();
+      joints_ok = joints_ok && d.dot(next) >= R(-0.5);
+    }
+    Real clearance = std::numeric_limits<Real>::infinity();
+    for (std::size_t j = 0; j < ns; ++j) {
+      if (j + 1 >= i && j <= i + 1) continue;  // itself and the segments it joins
+      const Real dj = segment_distance(a, b, profile.vertices_m[j], profile.vertices_m[j + 1]);
+      clearance = dj < clearance ? dj : clearance;
+    }
+    const bool long_enough = (b - a).norm() >= params.min_feature_length_m;
+    shortcut_max_m_[i] = joints_ok && long_enough ? clearance / 2 : R(0);
+  }
   configured_ = true;
   return true;
 }
@@ -181,13 +234,16 @@ bool DockPoseEstimator::load_scan(const ScanView& scan) {
   angle_min_rad_ = scan.angle_min_rad;
   angle_inc_rad_ = scan.angle_increment_rad;
   wraps_ = scan.wraps();
+  ranges_m_ = scan.ranges_m;
+  valid_beams_counted_ = false;
+  // A lidar's scans keep their geometry from turn to turn: the beam directions are computed again only when it
+  // changes, so a tracking scan reads just the beams near the dock.
+  if (dir_beams_ == beams_ && dir_angle_min_rad_ == angle_min_rad_ && dir_angle_inc_rad_ == angle_inc_rad_) return true;
   // Beam directions by rotating a unit vector: one sin/cos pair per 64 beams instead of one per beam. The
   // periodic re-seed bounds the recurrence's rounding drift (matters for the float build).
   const Real ci = std::cos(angle_inc_rad_);
   const Real si = std::sin(angle_inc_rad_);
   Vec2 d(0, 0);
-  points_.clear();
-  valid_beams_ = 0;
   for (std::size_t i = 0; i < beams_; ++i) {
     if ((i & 63u) == 0) {
       const Real a = scan.angle_rad(i);
@@ -196,22 +252,31 @@ bool DockPoseEstimator::load_scan(const ScanView& scan) {
       d = Vec2(ci * d.x() - si * d.y(), si * d.x() + ci * d.y());
     }
     dir_[i] = d;
-    const Real r = scan.ranges_m[i];
-    const bool ok = is_valid_range(r) && r >= params_.min_range_m && r <= params_.max_range_m;
-    range_m_[i] = ok ? r : 0;
-    valid_beams_ += ok ? 1u : 0u;
   }
+  dir_beams_ = beams_;
+  dir_angle_min_rad_ = angle_min_rad_;
+  dir_angle_inc_rad_ = angle_inc_rad_;
   return true;
+}
+
+std::size_t DockPoseEstimator::valid_beams() {
+  if (!valid_beams_counted_) {
+    valid_beams_ = 0;
+    for (std::size_t i = 0; i < beams_; ++i) valid_beams_ += range_at(i) != 0 ? 1u : 0u;
+    valid_beams_counted_ = true;
+  }
+  return valid_beams_;
 }
 
 void DockPoseEstimator::build_points() {
   // Only the global search needs Cartesian points; tracking works on the beams directly.
   points_.clear();
   for (std::size_t i = 0; i < beams_; ++i) {
-    if (range_m_[i] == 0) continue;
+    const Real r = range_at(i);
+    if (r == 0) continue;
     ScanPoint sp;
-    sp.p_m = range_m_[i] * dir_[i];
-    sp.range_m = range_m_[i];
+    sp.p_m = r * dir_[i];
+    sp.range_m = r;
     sp.angle_rad = angle_min_rad_ + static_cast<Real>(i) * angle_inc_rad_;
     sp.index = static_cast<std::uint32_t>(i);
     points_.push_back(sp);
@@ -242,7 +307,7 @@ void DockPoseEstimator::wall_behind(const Pose2& pose, long first, std::size_t k
       const Real near_m = (back_c - gap_lo) / denom;
       const Real far_m = (back_c - gap_hi) / denom;
       if (near_m <= 0) continue;
-      const Real m = range_m_[i];
+      const Real m = range_at(i);
       if (m != 0 && m < near_m - params_.free_space_m) continue;  // an occluder: neither for nor against
       ++*looked;
       if (m != 0 && m >= near_m - tol && m <= far_m + tol) ++*seen;
@@ -262,10 +327,9 @@ int DockPoseEstimator::continues_past_end(const Vec2& p) const {
   int result = 0;
   for (std::size_t j = 0; j < placed_.segments; ++j) {
     if (!placed_.visible[j]) continue;
-    const Vec2 d = placed_.v_m[j + 1] - placed_.v_m[j];
-    const Real len = d.norm();
+    const Real len = placed_.len_m[j];
     if (len < params_.min_feature_length_m) continue;
-    const Real u = (p - placed_.v_m[j]).dot(d) / len;
+    const Real u = (p - placed_.v_m[j]).dot(placed_.u[j]);
     const Real overhang = u < 0 ? -u : u - len;
     if (overhang < kExtensionMinM || overhang > kExtensionMaxM) continue;
     if (std::fabs(placed_.n[j].dot(p) - placed_.c_m[j]) <= params_.extension_band_m) return 2;
@@ -281,19 +345,6 @@ long DockPoseEstimator::first_beam(Real angle_rad) const {
   return static_cast<long>(std::floor(rel / angle_inc_rad_ + R(0.5)));
 }
 
-bool DockPoseEstimator::beam_at(long first, std::size_t k, std::size_t* index) const {
-  long i = first + static_cast<long>(k);
-  const long n = static_cast<long>(beams_);
-  if (wraps_) {
-    i %= n;
-    if (i < 0) i += n;
-  } else if (i < 0 || i >= n) {
-    return false;
-  }
-  *index = static_cast<std::size_t>(i);
-  return true;
-}
-
 DockPoseEstimator::Refined DockPoseEstimator::refine(const Pose2& initial) {
   Refined out{};
   out.pose = initial;
@@ -301,58 +352,58 @@ DockPoseEstimator::Refined DockPoseEstimator::refine(const Pose2& initial) {
   const Real k_huber = params_.huber_k * params_.range_sigma_m;
   const Real c_tukey = params_.tukey_c * params_.range_sigma_m;
   Pose2 pose = initial;
+  // The beams of the dock's span and the segment each was nearest to in the previous iteration. Once the steps are
+  // small (kReuseStepM) the span and the association barely change between iterations: each beam is then measured
+  // against its previous segment, and searched again among all segments only when it nears that segment's ends.
+  std::size_t n_assoc = 0;
+  Real last_step_m = std::numeric_limits<Real>::infinity();
   for (std::uint8_t it = 0; it < params_.max_iterations; ++it) {
     placed_.place(profile_, pose);
-    Real lo = 0;
-    Real hi = 0;
-    placed_.angular_span(&lo, &hi);
     const Real dist_m = std::sqrt(pose.x_m * pose.x_m + pose.y_m * pose.y_m);
     if (!(dist_m > params_.min_range_m) || dist_m > params_.max_range_m + profile_radius_m_) return out;
     // The association gate shrinks as the fit converges so neighbours of the dock stop pulling on it.
     const Real shrink = static_cast<Real>(1u << (it < 4 ? it : 4));
     const Real gate = params_.association_gate_m / shrink > params_.inlier_gate_m ? params_.association_gate_m / shrink
                                                                                    : params_.inlier_gate_m;
-    const Real margin = std::atan2(params_.association_gate_m, dist_m);
-    lo -= margin;
-    hi += margin;
-    const std::size_t n_beams = static_cast<std::size_t>((hi - lo) / angle_inc_rad_) + 2;
-    const long first = first_beam(lo);
-    Mat3 h = Mat3::Zero();
-    Vec3 g = Vec3::Zero();
-    std::uint16_t used = 0;
-    Real sum_sq = 0;
     const Vec2 t(pose.x_m, pose.y_m);
     const Vec2 nd(std::cos(pose.yaw_rad), std::sin(pose.yaw_rad));
-    for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
-      std::size_t i = 0;
-      if (!beam_at(first, k, &i)) continue;
-      const Real r = range_m_[i];
-      if (r == 0) continue;
-      const Vec2 p = r * dir_[i];
-      if (profile_.mounting.kind != DockMountKind::kFreeStanding) {
-        // Wall points beside the dock are explained by the wall, not by the dock's sides that meet it.
-        const Vec2 q(nd.dot(p - t), nd.x() * (p - t).y() - nd.y() * (p - t).x());
-        const Real gap_max_m = profile_.mounting.kind == DockMountKind::kWall ? profile_.mounting.wall_gap_max_m
-                                                                                : DockMounting{}.wall_gap_max_m;
-        if (std::fabs(q.y()) > half_width_m_ && q.x() < back_x_m_ + params_.inlier_gate_m &&
-            q.x() > back_x_m_ - gap_max_m - params_.inlier_gate_m) {
-          continue;
-        }
-      }
-      std::size_t seg = 0;
+    // The beams to fit: every return in the dock's span plus a margin, taken again early on and kept later, with
+    // wall points beside the dock left out (the wall explains them, not the dock's sides).
+    const bool reuse = last_step_m <= kReuseStepM && n_assoc > 0;
+    if (!reuse) n_assoc = span_beams(dist_m, t, nd);
+    // Normal equations, upper triangle (h is symmetric), as scalars so they stay in registers.
+    Real h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0, g0 = 0, g1 = 0, g2 = 0;
+    std::uint16_t used = 0;
+    Real sum_sq = 0;
+    for (std::size_t k = 0; k < n_assoc; ++k) {
+      const std::size_t i = assoc_beam_[k];
+      const Vec2 p = ranges_m_[i] * dir_[i];  // span_beams() kept only returns within range
+      std::size_t seg = assoc_seg_[k];
       Real dist = 0;
       Real e = 0;
       // A point beyond a segment's end (overhang) belongs to whatever adjoins the dock, e.g. the wall behind it.
       Real overhang = 0;
-      if (!placed_.nearest(p, &seg, &dist, &e, &overhang) || dist > gate || overhang > kOverhangM) continue;
+      // Against the previous segment first: while the point projects well inside it (clear of its corners and of
+      // the segments it does not join), its distance is the line distance.
+      if (seg != kNoSegment && placed_.visible[seg] && placed_.projects_well_inside(p, seg, shortcut_max_m_[seg], &e)) {
+        dist = std::fabs(e);
+      } else if (!placed_.nearest(p, &seg, &dist, &e, &overhang)) {
+        continue;
+      }
+      // Remembered even when refused now: a beam just outside the gate may come in at the next pose.
+      assoc_seg_[k] = static_cast<std::uint8_t>(seg);
+      if (dist > gate || overhang > kOverhangM) continue;
       const Vec2& n = placed_.n[seg];
       // Work in range units: the lidar's noise is along the beam, so a residual of e across the surface is a range
       // error of e / cos(incidence). Weighting by that is the maximum-likelihood fit (and what the Cramér–Rao bound
       // assumes); plain point-to-line would under-use oblique surfaces such as wings. Capped at 78° incidence.
       Real cos_inc = std::fabs(n.dot(dir_[i]));
       cos_inc = cos_inc > kMinCosIncidence ? cos_inc : kMinCosIncidence;
-      e /= cos_inc;
-      const Vec3 jac = Vec3(-n.x(), -n.y(), Vec2(-n.y(), n.x()).dot(p - t)) / cos_inc;
+      const Real inv_cos = 1 / cos_inc;
+      e *= inv_cos;
+      const Real jx = -n.x() * inv_cos;
+      const Real jy = -n.y() * inv_cos;
+      const Real jz = (n.x() * (p.y() - t.y()) - n.y() * (p.x() - t.x())) * inv_cos;
       const Real ae = std::fabs(e);
       // Huber while the pose is rough (convex, pulls in from afar); Tukey's biweight once it is close, so points
       // from depth edges (mixed pixels, jitter at a slot wall) stop pulling the fit at all.
@@ -364,11 +415,24 @@ DockPoseEstimator::Refined DockPoseEstimator::refine(const Pose2& initial) {
         w = (1 - u * u) * (1 - u * u);
       }
       if (w <= 0) continue;
-      h.noalias() += w * jac * jac.transpose();
-      g.noalias() += w * e * jac;
+      const Real wx = w * jx;
+      const Real wy = w * jy;
+      const Real wz = w * jz;
+      h00 += wx * jx;
+      h01 += wx * jy;
+      h02 += wx * jz;
+      h11 += wy * jy;
+      h12 += wy * jz;
+      h22 += wz * jz;
+      g0 += wx * e;
+      g1 += wy * e;
+      g2 += wz * e;
       sum_sq += e * e;
       ++used;
     }
+    Mat3 h;
+    h << h00, h01, h02, h01, h11, h12, h02, h12, h22;
+    const Vec3 g(g0, g1, g2);
     if (used < 3) return out;
     // A whisper of damping keeps a nearly degenerate view (one flat face) solvable; it does not bias a good fit.
     const Real damping = h.trace() * R(1e-9);
@@ -380,15 +444,53 @@ DockPoseEstimator::Refined DockPoseEstimator::refine(const Pose2& initial) {
     pose.x_m += delta.x();
     pose.y_m += delta.y();
     pose.yaw_rad = wrap_angle(pose.yaw_rad + delta.z());
+    last_step_m = std::fabs(delta.x()) + std::fabs(delta.y()) + profile_radius_m_ * std::fabs(delta.z());
     out.h = h;
     out.rms_m = std::sqrt(sum_sq / static_cast<Real>(used));
     out.iterations = static_cast<std::uint8_t>(it + 1);
-    // 0.1 mm and 0.006°: two orders below the noise, so further iterations only cost.
-    if (std::fabs(delta.x()) + std::fabs(delta.y()) < R(1e-4) && std::fabs(delta.z()) < R(1e-4)) break;
+    // Stop once the step is small against the estimate's own uncertainty: δᵀHδ / σ² is the step's squared
+    // Mahalanobis length under the covariance σ²H⁻¹ the fit reports, so a step below kStopSigmas of a standard
+    // deviation changes nothing the covariance can see. IRLS converges only linearly, so a fixed step size in
+    // metres would spend most iterations on digits below the noise.
+    const Real step_sq = delta.dot(h * delta);
+    if (step_sq < kStopSigmas * kStopSigmas * params_.range_sigma_m * params_.range_sigma_m) break;
   }
   out.pose = pose;
   out.ok = out.iterations > 0;
   return out;
+}
+
+std::size_t DockPoseEstimator::span_beams(Real dist_m, const Vec2& t, const Vec2& nd) {
+  Real lo = 0;
+  Real hi = 0;
+  placed_.angular_span(&lo, &hi);
+  const Real margin = std::atan2(params_.association_gate_m, dist_m);
+  lo -= margin;
+  hi += margin;
+  const std::size_t n_beams = static_cast<std::size_t>((hi - lo) / angle_inc_rad_) + 2;
+  const long first = first_beam(lo);
+  const bool wall_mounted = profile_.mounting.kind != DockMountKind::kFreeStanding;
+  const Real gap_max_m =
+      profile_.mounting.kind == DockMountKind::kWall ? profile_.mounting.wall_gap_max_m : DockMounting{}.wall_gap_max_m;
+  const Real band_hi = back_x_m_ + params_.inlier_gate_m;
+  const Real band_lo = back_x_m_ - gap_max_m - params_.inlier_gate_m;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
+    std::size_t i = 0;
+    if (!beam_at(first, k, &i)) continue;
+    const Real r = range_at(i);
+    if (r == 0) continue;
+    if (wall_mounted) {
+      const Vec2 pt = r * dir_[i] - t;
+      const Real qx = nd.dot(pt);
+      const Real qy = nd.x() * pt.y() - nd.y() * pt.x();
+      if (std::fabs(qy) > half_width_m_ && qx < band_hi && qx > band_lo) continue;
+    }
+    assoc_beam_[n] = static_cast<std::uint16_t>(i);
+    assoc_seg_[n] = kNoSegment;
+    ++n;
+  }
+  return n;
 }
 
 void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
@@ -409,6 +511,10 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
   const Real margin = std::atan2(kExtensionMaxM, dist_to_dock > R(0.05) ? dist_to_dock : R(0.05));
   const long first = first_beam(lo - margin);
   const std::size_t n_beams = static_cast<std::size_t>((hi - lo + 2 * margin) / angle_inc_rad_) + 2;
+  // Only beams within the dock's angular span (and a beam of slack for rounding) can hit it: the margin's beams are
+  // looked at for the edge cue alone.
+  const long k_ray_lo = static_cast<long>(std::floor(margin / angle_inc_rad_)) - 1;
+  const long k_ray_hi = static_cast<long>(std::ceil((hi - lo + margin) / angle_inc_rad_)) + 1;
   std::size_t k_first_hit = 0;
   std::size_t k_last_hit = 0;
   DecisionFeatures& f = r.evidence.features;
@@ -439,10 +545,12 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
   for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
     std::size_t i = 0;
     if (!beam_at(first, k, &i)) continue;
-    const Real m = range_m_[i];
+    const Real m = range_at(i);
     Real expected_m = 0;
     std::size_t seg = 0;
-    if (placed_.raycast(dir_[i], &expected_m, &seg)) {
+    bool on_dock = false;
+    const long kl = static_cast<long>(k);
+    if (kl >= k_ray_lo && kl <= k_ray_hi && placed_.raycast(dir_[i], &expected_m, &seg)) {
       // The surface length this beam covers: its spacing stretched by the incidence (capped as in the fit).
       Real cos_inc = std::fabs(placed_.n[seg].dot(dir_[i]));
       cos_inc = cos_inc > kMinCosIncidence ? cos_inc : kMinCosIncidence;
@@ -452,6 +560,7 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
       ++r.expected;
       const Real diff = m - expected_m;
       if (m != 0 && std::fabs(diff) <= gate) {
+        on_dock = true;
         ++r.inliers;
         ++seg_expected[seg];
         ++seg_inliers[seg];
@@ -475,7 +584,8 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
         }
       }
     }
-    if (m != 0 && !(check_band && wall_band(m * dir_[i]))) {
+    // An inlier lies on the dock (within the gate along its beam, so within it of the surface): no extension.
+    if (m != 0 && !on_dock && !(check_band && wall_band(m * dir_[i]))) {
       const int ext = continues_past_end(m * dir_[i]);
       if (ext == 1) f.stops += weight(m);
       if (ext == 2) {
@@ -557,6 +667,15 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
   r.ok = true;
 }
 
+void DockPoseEstimator::decide(Refined& r, const Pose2* hint) {
+  verify(r, hint);
+  if (r.ok && hint != nullptr && params_.hint_radius_m > 0 &&
+      dist2(r.pose, *hint) > params_.hint_radius_m * params_.hint_radius_m) {
+    r.ok = false;
+    r.reject = RejectReason::kFarFromHint;
+  }
+}
+
 Real DockPoseEstimator::prescore(const Pose2& pose) {
   placed_.place(profile_, pose);
   Real lo = 0;
@@ -573,7 +692,7 @@ Real DockPoseEstimator::prescore(const Pose2& pose) {
     Real expected_m = 0;
     std::size_t seg = 0;
     if (!placed_.raycast(dir_[i], &expected_m, &seg)) continue;
-    const Real m = range_m_[i];
+    const Real m = range_at(i);
     if (m != 0 && std::fabs(m - expected_m) <= gate) {
       score += 1;
     } else if (m == 0 || m > expected_m) {
@@ -774,13 +893,23 @@ DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lida
     est.status = EstimateStatus::kBadScan;
     return est;
   }
-  if (valid_beams_ < params_.min_inliers) {
-    est.status = EstimateStatus::kNoPoints;
-    return est;
-  }
   const Pose2 mount_inv = lidar_mount.inverse();
   Pose2 hint_lidar{};
   if (hint != nullptr) hint_lidar = mount_inv.compose(*hint);
+  // The hint is refined before the scan's returns are counted: when it verifies, at least min_inliers beams are
+  // valid, so tracking never reads the beams away from the dock. Otherwise it is accounted for below, after the
+  // same no-points test a hint-less scan gets.
+  Refined hinted{};
+  if (hint != nullptr) {
+    hinted = refine(hint_lidar);
+    decide(hinted, &hint_lidar);
+  }
+  const bool hint_holds = hint != nullptr && hinted.ok &&
+                          dist2(hinted.pose, hint_lidar) <= params_.hint_gate_m * params_.hint_gate_m;
+  if (!hint_holds && valid_beams() < params_.min_inliers) {
+    est.status = EstimateStatus::kNoPoints;
+    return est;
+  }
 
   Refined best{};
   best.ok = false;
@@ -788,15 +917,10 @@ DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lida
   bool have_refused = false;
   bool best_from_hint = false;
   Real best_key = 0;
-  auto consider = [&](Refined& r, bool from_hint) {
+  // Accounts for a decided candidate and keeps the best.
+  auto consider = [&](const Refined& r, bool from_hint) {
     ++counters_.candidates;
     ++est.candidates;
-    verify(r, hint != nullptr ? &hint_lidar : nullptr);
-    if (r.ok && hint != nullptr && params_.hint_radius_m > 0 &&
-        dist2(r.pose, hint_lidar) > params_.hint_radius_m * params_.hint_radius_m) {
-      r.ok = false;
-      r.reject = RejectReason::kFarFromHint;
-    }
     if (!r.ok) {
       ++counters_.rejected;
       ++counters_.rejected_by[static_cast<std::size_t>(r.reject)];
@@ -827,13 +951,9 @@ DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lida
     }
   };
 
-  if (hint != nullptr) {
-    Refined r = refine(hint_lidar);
-    consider(r, true);
-  }
+  if (hint != nullptr) consider(hinted, true);
   // Tracking: a hint that verifies and stays near the hint ends the search; a global search runs otherwise.
-  const bool tracked = best.ok && dist2(best.pose, hint_lidar) <= params_.hint_gate_m * params_.hint_gate_m;
-  if (!tracked) {
+  if (!hint_holds) {
     const std::size_t n = generate_candidates();
     std::size_t done = 0;
     Pose2 verified_poses[8];
@@ -846,6 +966,7 @@ DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lida
       }
       if (duplicate) continue;
       Refined r = refine(hyps_[k].pose);
+      decide(r, hint != nullptr ? &hint_lidar : nullptr);
       consider(r, false);
       if (r.ok && done < 8) verified_poses[done++] = r.pose;
     }

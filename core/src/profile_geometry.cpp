@@ -13,7 +13,11 @@ void PlacedProfile::place(const DockProfile& profile, const Pose2& dock_in_senso
   segments = profile.segment_count();
   for (std::size_t i = 0; i < segments; ++i) {
     const Vec2 d = v_m[i + 1] - v_m[i];
-    n[i] = Vec2(d.y(), -d.x()) / d.norm();
+    d_m[i] = d;
+    len_m[i] = d.norm();
+    inv_len_sq[i] = 1 / d.squaredNorm();
+    u[i] = d / len_m[i];
+    n[i] = Vec2(d.y(), -d.x()) / len_m[i];
     c_m[i] = n[i].dot(v_m[i]);
     // The sensor sits at the origin: it sees the outward side when n·(0 - v) > 0, i.e. c < 0.
     visible[i] = c_m[i] < 0;
@@ -21,20 +25,21 @@ void PlacedProfile::place(const DockProfile& profile, const Pose2& dock_in_senso
 }
 
 bool PlacedProfile::raycast(const Vec2& dir, Real* range_m, std::size_t* segment) const {
+  // The ray's line separates a segment's ends exactly when it crosses the segment: the side of each vertex is the
+  // sign of cross(dir, v). A visible segment faced from the front (n·dir < 0, c < 0) is then hit at t = c / (n·dir)
+  // > 0, so only crossed segments cost a division.
   bool hit = false;
   Real best = 0;
   std::size_t best_seg = 0;
+  Real side_a = dir.x() * v_m[0].y() - dir.y() * v_m[0].x();
   for (std::size_t i = 0; i < segments; ++i) {
-    if (!visible[i]) continue;
+    const Real side_b = dir.x() * v_m[i + 1].y() - dir.y() * v_m[i + 1].x();
+    const bool crosses = (side_a <= 0 && side_b >= 0) || (side_a >= 0 && side_b <= 0);
+    side_a = side_b;
+    if (!visible[i] || !crosses) continue;
     const Real denom = n[i].dot(dir);
     if (denom >= 0) continue;  // grazing or from behind
     const Real t = c_m[i] / denom;
-    if (t <= 0) continue;
-    const Vec2 p = t * dir;
-    // Inside the segment: the projection on its direction lies within [0, len].
-    const Vec2 d = v_m[i + 1] - v_m[i];
-    const Real u = (p - v_m[i]).dot(d);
-    if (u < 0 || u > d.squaredNorm()) continue;
     if (!hit || t < best) {
       hit = true;
       best = t;
@@ -53,34 +58,45 @@ bool PlacedProfile::nearest(const Vec2& p, std::size_t* segment, Real* distance_
   bool any = false;
   Real best_sq = 0;
   Real best_over = 0;
+  std::size_t best_seg = 0;
+  const Real px = p.x();
+  const Real py = p.y();
   for (std::size_t i = 0; i < segments; ++i) {
     if (!visible[i]) continue;
-    const Vec2 d = v_m[i + 1] - v_m[i];
-    const Vec2 w = p - v_m[i];
-    const Real u_raw = w.dot(d) / d.squaredNorm();
-    const Real u = u_raw < 0 ? 0 : (u_raw > 1 ? 1 : u_raw);
-    const Real dist_sq = (w - u * d).squaredNorm();
+    const Real wx = px - v_m[i].x();
+    const Real wy = py - v_m[i].y();
+    const Real dx = d_m[i].x();
+    const Real dy = d_m[i].y();
+    const Real u_raw = (wx * dx + wy * dy) * inv_len_sq[i];
+    const Real t = u_raw < 0 ? 0 : (u_raw > 1 ? 1 : u_raw);
+    const Real ex = wx - t * dx;
+    const Real ey = wy - t * dy;
+    const Real dist_sq = ex * ex + ey * ey;
     if (!any || dist_sq < best_sq) {
       any = true;
       best_sq = dist_sq;
-      best_over = std::fabs(u_raw - u) * d.norm();
-      *segment = i;
+      best_over = u_raw - t;
+      best_seg = i;
     }
   }
   if (any) {
+    *segment = best_seg;
     *distance_m = std::sqrt(best_sq);
-    *overhang_m = best_over;
-    *signed_line_distance_m = n[*segment].dot(p) - c_m[*segment];
+    *overhang_m = std::fabs(best_over) * len_m[best_seg];
+    *signed_line_distance_m = n[best_seg].dot(p) - c_m[best_seg];
   }
   return any;
 }
 
 void PlacedProfile::angular_span(Real* lo_rad, Real* hi_rad) const {
-  const Real ref = std::atan2(v_m[0].y(), v_m[0].x());
+  // Each vertex's bearing relative to the first, from the cross and dot products: already within (-pi, pi].
+  const Vec2& a = v_m[0];
+  const Real ref = std::atan2(a.y(), a.x());
   Real lo = 0;
   Real hi = 0;
   for (std::size_t i = 1; i <= segments; ++i) {
-    const Real rel = wrap_angle(std::atan2(v_m[i].y(), v_m[i].x()) - ref);
+    const Vec2& b = v_m[i];
+    const Real rel = std::atan2(a.x() * b.y() - a.y() * b.x(), a.x() * b.x() + a.y() * b.y());
     lo = rel < lo ? rel : lo;
     hi = rel > hi ? rel : hi;
   }

@@ -50,10 +50,13 @@ for d in ("estimator", "estimator-tracking", "breakpoint", "vmarker"):
         check(len(r["top_self"]) == 3 and r["top_self"][0]["share"] > 0.1, tag + "top functions")
         check(all(t["function"].startswith("dockcore::") or "::" not in t["function"] for t in r["top_self"]),
               tag + "top function outside core: %s" % [t["function"] for t in r["top_self"]])
-    # Collection really is per scan: twice the points, between 1.3x and 3x the instructions.
+    # Collection really is per scan: twice the points, between 1.3x and 3x the instructions. Tracking reads only
+    # the beams on the dock, and its fixed cost per iteration (placing the profile, trigonometry, the 3x3 solve) is
+    # a large share at 360 points: it must grow, less.
     if (d, 360) in rows and (d, 720) in rows:
         g = rows[(d, 720)]["instructions_per_scan"] / rows[(d, 360)]["instructions_per_scan"]
-        check(1.3 < g < 3.0, "%s: 360 -> 720 points grew %.2fx" % (d, g))
+        lo = 1.05 if d == "estimator-tracking" else 1.3
+        check(lo < g < 3.0, "%s: 360 -> 720 points grew %.2fx" % (d, g))
 for (d, n), r in rows.items():
     check(r["toggle_collect"] and all("(" in p for p in r["toggle_collect"]), "%s: toggle patterns %s" % (d, r["toggle_collect"]))
 check(rows[("breakpoint", 360)]["ratio_to_breakpoint"] == 1.0, "breakpoint ratio to itself")

@@ -235,3 +235,166 @@ TEST(DockPoseEstimator, DeterministicBitForBit) {
   CHECK_EQUAL(0, std::memcmp(&a.pose, &b.pose, sizeof a.pose));
   CHECK_EQUAL(0, std::memcmp(a.covariance.data(), b.covariance.data(), sizeof(Real) * 9));
 }
+
+TEST(DockPoseEstimator, HintOnEmptyScanIsStillNoPoints) {
+  // The hint is refined before the returns are counted; a scan without returns must still say so and count no
+  // candidate.
+  const DockProfile prof = profile("plate-v");
+  g_est.configure(prof, EstimatorParams{});
+  g_scan.reset(450, -kPi, deg_to_rad(0.8), 0);
+  const Pose2 hint = dockcore_test::pose(1.0, 0.0, kPi);
+  const DockEstimate e = g_est.estimate(g_scan.view(), Pose2{}, &hint);
+  CHECK_EQUAL(static_cast<int>(EstimateStatus::kNoPoints), static_cast<int>(e.status));
+  CHECK_EQUAL(0u, g_est.counters().candidates);
+}
+
+TEST(DockPoseEstimator, NewScanGeometryGivesWhatAFreshEstimatorGives) {
+  // Beam directions are kept from scan to scan while the geometry stays; a scan with another start angle, count or
+  // step must be read with its own directions, exactly as an estimator that never saw the first scan reads it.
+  static DockPoseEstimator fresh;
+  const DockProfile prof = profile("plate-v");
+  g_est.configure(prof, EstimatorParams{});
+  fresh.configure(prof, EstimatorParams{});
+  simulate(prof, 1.0, 0.2, 0.1, ld06(0.01), 5);
+  CHECK_TRUE(g_est.estimate(g_scan.view(), Pose2{}).found);
+  docksim::LidarModel other = ld06(0.01);
+  other.beams = 500;
+  other.angle_increment_rad = 2 * kPi / 500;
+  other.angle_min_rad = static_cast<Real>(-2.0);
+  const Truth t = simulate(prof, 1.2, -0.3, -0.2, other, 6);
+  const DockEstimate a = g_est.estimate(g_scan.view(), Pose2{});
+  const DockEstimate b = fresh.estimate(g_scan.view(), Pose2{});
+  check_close(t.dock_in_lidar, a, 0.03, deg_to_rad(4.0), "new geometry");
+  CHECK_EQUAL(0, std::memcmp(&a.pose, &b.pose, sizeof a.pose));
+  CHECK_EQUAL(a.inliers, b.inliers);
+  CHECK_EQUAL(0, std::memcmp(&a.evidence.total_nats, &b.evidence.total_nats, sizeof(Real)));
+}
+
+TEST(DockPoseEstimator, TrackingMatchesTheFirstScanOfAFreshEstimator) {
+  // A tracking scan after another scan of the same geometry: nothing of the earlier scan but its beam directions is
+  // reused, so the result equals a fresh estimator's on the same scan and hint.
+  static DockPoseEstimator fresh;
+  const DockProfile prof = profile("v-marker");
+  g_est.configure(prof, EstimatorParams{});
+  fresh.configure(prof, EstimatorParams{});
+  simulate(prof, 0.9, 0.1, 0.2, ld06(0.01), 8, 2);
+  const DockEstimate first = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_TRUE(first.found);
+  const Truth t = simulate(prof, 0.88, 0.11, 0.21, ld06(0.01), 9, 2);
+  const DockEstimate a = g_est.estimate(g_scan.view(), Pose2{}, &first.pose);
+  const DockEstimate b = fresh.estimate(g_scan.view(), Pose2{}, &first.pose);
+  check_close(t.dock_in_lidar, a, 0.02, deg_to_rad(4.0), "tracking");
+  CHECK_TRUE(a.from_hint);
+  CHECK_EQUAL(0, std::memcmp(&a.pose, &b.pose, sizeof a.pose));
+  CHECK_EQUAL(0, std::memcmp(a.covariance.data(), b.covariance.data(), sizeof(Real) * 9));
+}
+
+namespace {
+
+// The plain formulas the fast PlacedProfile queries must agree with: a division per segment, no precomputation.
+bool reference_raycast(const PlacedProfile& pp, const Vec2& dir, Real* range_m, std::size_t* segment) {
+  bool hit = false;
+  for (std::size_t i = 0; i < pp.segments; ++i) {
+    if (!pp.visible[i]) continue;
+    const Real denom = pp.n[i].dot(dir);
+    if (denom >= 0) continue;
+    const Real t = pp.c_m[i] / denom;
+    const Vec2 d = pp.v_m[i + 1] - pp.v_m[i];
+    const Real u = (t * dir - pp.v_m[i]).dot(d) / d.squaredNorm();
+    if (t <= 0 || u < 0 || u > 1) continue;
+    if (!hit || t < *range_m) {
+      hit = true;
+      *range_m = t;
+      *segment = i;
+    }
+  }
+  return hit;
+}
+
+Real reference_distance(const PlacedProfile& pp, const Vec2& p, std::size_t i) {
+  const Vec2 d = pp.v_m[i + 1] - pp.v_m[i];
+  Real u = (p - pp.v_m[i]).dot(d) / d.squaredNorm();
+  u = u < 0 ? 0 : (u > 1 ? 1 : u);
+  return (p - pp.v_m[i] - u * d).norm();
+}
+
+}  // namespace
+
+TEST(DockPoseEstimator, PlacedProfileQueriesAgreeWithThePlainFormulas) {
+  // Every built-in profile at many poses: the side-test ray cast, the division-free nearest segment, and the
+  // "projects well inside" shortcut the registration takes (the shortcut's segment is a nearest one), against the
+  // plain formulas. Rays within 1e-4 rad of a
+  // vertex are left out: there hit or miss is a matter of rounding in either formula.
+  docksim::Rng rng(11);
+  auto uniform = [&rng](double lo, double hi) { return static_cast<Real>(rng.uniform(lo, hi)); };
+  const double tol = dockcore_test::real_tol(1.0, 1e-9, 64);  // a few roundings on metre-sized values
+  static PlacedProfile pp;
+  int rays = 0;
+  int shortcuts = 0;
+  for (const char* name : {"plate-v", "v-marker", "breakpoint"}) {
+    const DockProfile prof = profile(name);
+    for (int trial = 0; trial < 200; ++trial) {
+      const Pose2 pose{uniform(0.3, 2.0), uniform(-1.0, 1.0), uniform(-kPi, kPi)};
+      pp.place(prof, pose);
+      // The shortcut's bound per segment, found independently: 0.45 of the least distance from sampled points of the
+      // segments it does not join (every built-in profile turns by 90° or less at its joints).
+      Real max_line[kMaxProfileVertices];
+      for (std::size_t i = 0; i < pp.segments; ++i) {
+        Real clearance = 1e9;
+        for (std::size_t j = 0; j < pp.segments; ++j) {
+          if (j + 1 >= i && j <= i + 1) continue;
+          for (int q = 0; q <= 200; ++q) {
+            const Vec2 sample = pp.v_m[j] + static_cast<Real>(q / 200.0) * (pp.v_m[j + 1] - pp.v_m[j]);
+            clearance = std::fmin(clearance, reference_distance(pp, sample, i));
+          }
+        }
+        max_line[i] = static_cast<Real>(0.45) * clearance;
+      }
+      const Real bearing = std::atan2(pose.y_m, pose.x_m);
+      for (int k = 0; k < 40; ++k) {
+        const Real a = bearing + uniform(-0.4, 0.4);
+        const Vec2 dir(std::cos(a), std::sin(a));
+        bool near_vertex = false;
+        for (std::size_t v = 0; v <= pp.segments; ++v) {
+          const Vec2& q = pp.v_m[v];
+          near_vertex = near_vertex || std::fabs(dir.x() * q.y() - dir.y() * q.x()) < 1e-4 * q.norm();
+        }
+        Real r_fast = 0;
+        Real r_ref = 0;
+        std::size_t s_fast = 0;
+        std::size_t s_ref = 0;
+        const bool h_fast = pp.raycast(dir, &r_fast, &s_fast);
+        const bool h_ref = reference_raycast(pp, dir, &r_ref, &s_ref);
+        if (!near_vertex) {
+          CHECK_EQUAL(h_ref, h_fast);
+          if (h_ref) {
+            ++rays;
+            DOUBLES_EQUAL(r_ref, r_fast, tol);
+          }
+        }
+        // A point near the dock (up to 5 cm off its surfaces).
+        const Real r = h_ref ? r_ref : std::sqrt(pose.x_m * pose.x_m + pose.y_m * pose.y_m);
+        const Vec2 p = r * dir + Vec2(uniform(-0.05, 0.05), uniform(-0.05, 0.05));
+        std::size_t seg = 0;
+        Real dist = 0;
+        Real line = 0;
+        Real over = 0;
+        if (!pp.nearest(p, &seg, &dist, &line, &over)) continue;
+        Real best = 1e9;
+        for (std::size_t i = 0; i < pp.segments; ++i) {
+          if (pp.visible[i]) best = std::fmin(best, reference_distance(pp, p, i));
+        }
+        DOUBLES_EQUAL(best, dist, tol);
+        for (std::size_t i = 0; i < pp.segments; ++i) {
+          Real e = 0;
+          if (!pp.visible[i] || !pp.projects_well_inside(p, i, max_line[i], &e)) continue;
+          ++shortcuts;
+          // The shortcut's segment is a nearest one and its line distance is the distance.
+          DOUBLES_EQUAL(best, std::fabs(e), tol);
+        }
+      }
+    }
+  }
+  CHECK_TRUE(rays > 1000);
+  CHECK_TRUE(shortcuts > 1000);
+}

@@ -199,19 +199,30 @@ TEST(SimRun, HostStallHoldsTheLastCommandUntilTheChassisTimeout) {
 // dock face off the contacts; the controller's stall timeout ends the attempt and one retry docks (the recovery the
 // HIL flood rows see on a starved machine; tests/hil/matrix.py retry_onsets).
 TEST(SimRun, HostStallNearTheDockIsRecoveredByARetry) {
-  docksim::Scenario sc = host_stall_scenario(0.5, 1.5, 0.5);
-  const docksim::StartPose start = docksim::start_from(sc, 0.516784, 13.077118 * kDeg, 20.577731 * kDeg);
-  docksim::SimOptions opt;
-  opt.start = &start;
-  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 1, opt);
-  CHECK_EQUAL(1, r.outcome.retries);
-  CHECK(r.outcome.faults.empty());
-  check_docked(r);
-  // Without the stall the same start docks at the first attempt.
-  sc.events.clear();
-  const docksim::SimRun calm = docksim::run_docking(sc, "smooth", 1, opt);
-  CHECK_EQUAL(0, calm.outcome.retries);
-  CHECK(calm.outcome.charging_confirmed);
+  // Starts near the dock where the stall makes the first attempt fail (found by a seeded search; which of them need
+  // the retry depends on the last digits of the estimates, so the test asks for at least one). Every stalled run
+  // must dock without a fault, and the same start without the stall at the first attempt.
+  const double starts[][3] = {{0.564008, 5.232658, 0.809468},   {0.462955, 11.967416, 16.662579},
+                              {0.540444, -13.332750, -20.059878}, {0.604031, -3.655949, 4.119862},
+                              {0.563534, -3.576531, 3.667025},  {0.516784, 13.077118, 20.577731}};
+  int retried = 0;
+  for (const auto& s : starts) {
+    docksim::Scenario sc = host_stall_scenario(0.5, 1.5, 0.5);
+    const docksim::StartPose start = docksim::start_from(sc, s[0], s[1] * kDeg, s[2] * kDeg);
+    docksim::SimOptions opt;
+    opt.start = &start;
+    const docksim::SimRun r = docksim::run_docking(sc, "smooth", 1, opt);
+    CHECK(r.outcome.faults.empty());
+    CHECK(r.outcome.retries <= 1);
+    CHECK(r.outcome.charging_confirmed);
+    if (r.outcome.retries == 1) check_docked(r);  // backing off and coming in again: at least 1.2 m travelled
+    retried += r.outcome.retries;
+    sc.events.clear();
+    const docksim::SimRun calm = docksim::run_docking(sc, "smooth", 1, opt);
+    CHECK_EQUAL(0, calm.outcome.retries);
+    CHECK(calm.outcome.charging_confirmed);
+  }
+  CHECK(retried >= 1);
 }
 
 TEST(SimRun, ChargingNeverStartsEndsInFault182) {

@@ -230,16 +230,47 @@ class DockPoseEstimator {
   };
   /// Copies a candidate's beam counts and evidence into an estimate (accepted or best refused). O(1).
   static void report(const Refined& r, DockEstimate* est);
+  /// Checks the scan's geometry and takes its ranges (by pointer, valid until estimate() returns); recomputes the
+  /// beam directions only when the geometry differs from the last scan's. O(1), or O(B) on a new geometry.
   bool load_scan(const ScanView& scan);
+  /// Range of beam i when it is a return within [min_range_m, max_range_m], else 0. O(1).
+  Real range_at(std::size_t i) const {
+    const Real r = ranges_m_[i];
+    return is_valid_range(r) && r >= params_.min_range_m && r <= params_.max_range_m ? r : 0;
+  }
+  /// Number of beams with range_at() != 0, counted once per scan on first use. O(B) the first time.
+  std::size_t valid_beams();
   /// Fills points_ from the loaded beams (global search only).
   void build_points();
   Refined refine(const Pose2& initial);
+  /// Fills the association list (assoc_beam_, no segment yet) with the returns in placed_'s angular span plus the
+  /// association gate's margin, leaving out wall points beside a mounted dock. `t`, `nd`: the dock's position and
+  /// x axis in the lidar frame, `dist_m` = |t|. Returns how many. O(beams in the span).
+  std::size_t span_beams(Real dist_m, const Vec2& t, const Vec2& nd);
   /// Scores a refined candidate (its evidence and counts) and decides. `hint` is the hint in the lidar frame or null.
   void verify(Refined& r, const Pose2* hint);
+  /// verify(), then the hint radius: the whole accept decision for one candidate, no counters touched.
+  void decide(Refined& r, const Pose2* hint);
   /// Signed index of the beam nearest angle_rad (may lie outside [0, beams) for a partial scan).
   long first_beam(Real angle_rad) const;
   /// Index of beam first+k, wrapped on full-turn scans; false when outside a partial scan.
-  bool beam_at(long first, std::size_t k, std::size_t* index) const;
+  bool beam_at(long first, std::size_t k, std::size_t* index) const {
+    long i = first + static_cast<long>(k);
+    const long n = static_cast<long>(beams_);
+    if (wraps_) {
+      // Spans start within a turn of the scan's ends: one add or subtract, the division only beyond that.
+      if (i < 0) i += n;
+      if (i >= n) i -= n;
+      if (i < 0 || i >= n) {
+        i %= n;
+        if (i < 0) i += n;
+      }
+    } else if (i < 0 || i >= n) {
+      return false;
+    }
+    *index = static_cast<std::size_t>(i);
+    return true;
+  }
   /// Fills hyps_ with ranked pose hypotheses from scan line segments and sliding-window line fits; returns how many
   /// to refine.
   std::size_t generate_candidates();
@@ -274,13 +305,20 @@ class DockPoseEstimator {
   Real profile_radius_m_ = 0;  // largest vertex distance from the dock origin
   Real back_x_m_ = 0;          // the profile's back plane: its smallest x
   Real half_width_m_ = 0;      // largest |y| of the profile
+  // Per segment: the largest line distance at which registration keeps a beam on it unsearched (0: never).
+  Real shortcut_max_m_[kMaxProfileVertices] = {};
   EstimatorCounters counters_{};
 
-  // Working buffers for the current scan, in the lidar frame. Beam i: unit direction and range (0 = none).
+  // The current scan, in the lidar frame: its ranges (the caller's), and beam i's unit direction, kept for the
+  // geometry it was computed for.
+  const Real* ranges_m_ = nullptr;
   Vec2 dir_[kMaxScanPoints];
-  Real range_m_[kMaxScanPoints];
+  std::size_t dir_beams_ = 0;
+  Real dir_angle_min_rad_ = 0;
+  Real dir_angle_inc_rad_ = 0;
   std::size_t beams_ = 0;
   std::size_t valid_beams_ = 0;
+  bool valid_beams_counted_ = false;
   Real angle_min_rad_ = 0;
   Real angle_inc_rad_ = 0;
   bool wraps_ = false;
@@ -288,6 +326,10 @@ class DockPoseEstimator {
   LineSegments segs_{};
   PlacedProfile placed_{};
   Hypothesis hyps_[kMaxHypotheses];
+  // Registration's beams: index and the profile segment each was nearest to in the last iteration.
+  static_assert(kMaxScanPoints <= 65536 && kMaxProfileVertices < 255, "association indices are 16 and 8 bits");
+  std::uint16_t assoc_beam_[kMaxScanPoints];
+  std::uint8_t assoc_seg_[kMaxScanPoints];
 };
 
 }  // namespace dockcore
