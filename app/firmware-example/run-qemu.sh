@@ -9,5 +9,6 @@ elf=$2
 [ -f "$elf" ] || { echo "$0: no such firmware: $elf" >&2; exit 2; }
 command -v qemu-system-arm >/dev/null 2>&1 || { echo "qemu-system-arm not installed: skipped"; exit 77; }
 qemu-system-arm -M help | grep -q "^$machine " || { echo "$0: qemu-system-arm has no machine $machine" >&2; exit 2; }
-exec timeout 240 qemu-system-arm -M "$machine" -nographic -monitor none -serial none \
+# -icount: virtual time advances 2^6 ns per instruction, so the firmware's SysTick cost counters count instructions.
+exec timeout 240 qemu-system-arm -M "$machine" -icount shift=6,align=off,sleep=off -nographic -monitor none -serial none \
   -semihosting-config enable=on,target=native -kernel "$elf"
