@@ -67,6 +67,13 @@ void put_fixed(Real v, int decimals) {
   buf[n] = '\0';
   put(buf);
 }
+void put_uint(std::uint64_t v) {  // exact for any count (put_fixed goes through Real)
+  char tmp[24];
+  int t = 23;
+  tmp[t] = '\0';
+  do { tmp[--t] = static_cast<char>('0' + v % 10); v /= 10; } while (v != 0);
+  put(tmp + t);
+}
 [[noreturn]] void exit_with(bool ok) {
   // SYS_EXIT with ADP_Stopped_ApplicationExit (qemu: status 0) or ADP_Stopped_RunTimeErrorUnknown (status 1).
   semihost(0x18, reinterpret_cast<const void*>(ok ? 0x20026u : 0x20023u));
@@ -75,6 +82,42 @@ void put_fixed(Real v, int decimals) {
 #else
 void put(const char*) {}
 void put_fixed(Real, int) {}
+#endif
+
+#if DOCKCORE_FW_SEMIHOSTING
+// Cost of each on_scan() and tick(), counted with SysTick (24-bit, processor clock, extended by its wrap interrupt)
+// and converted with a calibration loop of a known instruction count. Under qemu -icount (run-qemu.sh) virtual time
+// advances by the same amount for every instruction, so the result is the number of instructions executed; on
+// silicon SysTick counts cycles and the same figures are cycles in units of that loop's cost.
+volatile std::uint32_t& syst(std::uint32_t off) { return *reinterpret_cast<volatile std::uint32_t*>(0xE000E010u + off); }
+volatile std::uint32_t g_systick_wraps = 0;
+std::uint64_t systick_now() {  // ticks since start, monotonic
+  for (;;) {
+    const std::uint32_t w = g_systick_wraps;
+    const std::uint32_t v = syst(8) & 0xFFFFFFu;  // SYST_CVR counts down
+    if (w == g_systick_wraps) return (static_cast<std::uint64_t>(w) << 24) + (0xFFFFFFu - v);
+  }
+}
+void systick_start() {
+  syst(4) = 0xFFFFFFu;  // SYST_RVR
+  syst(8) = 0;          // SYST_CVR: any write clears it
+  syst(0) = 7;          // SYST_CSR: enable, wrap interrupt, processor clock
+}
+// Ticks of `iterations` turns of a 2-instruction loop (subs + bne), bracketed by the same reads as a measurement.
+std::uint64_t loop_ticks(std::uint32_t iterations) {
+  const std::uint64_t t0 = systick_now();
+  __asm volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(iterations) : : "cc");
+  return systick_now() - t0;
+}
+struct Cost {
+  std::uint64_t max = 0, sum = 0;
+  std::uint32_t n = 0, at = 0;  // calls, and which call was the worst (1-based)
+  void add(std::uint64_t v) {
+    ++n;
+    sum += v;
+    if (v > max) { max = v; at = n; }
+  }
+};
 #endif
 
 std::uint32_t g_rng = 0x2545F491u;
@@ -109,6 +152,12 @@ void render_scan(const Pose2& robot, std::uint64_t stamp_us) {
 
 }  // namespace
 
+#if DOCKCORE_FW_SEMIHOSTING
+extern "C" void SysTick_Handler() { g_systick_wraps = g_systick_wraps + 1; }
+extern "C" std::uint32_t __stack_limit__;
+extern "C" std::uint32_t __stack_top__;
+#endif
+
 // For a debugger when there is no semihosting: final state, fault, pads' errors at the end.
 struct FirmwareResult {
   std::uint8_t state;
@@ -134,12 +183,34 @@ int main() {
   bool contact = false;
   bool charged = false;
   put("firmware-example: dockcore on bare metal, smooth controller, plate-v dock\n");
+#if DOCKCORE_FW_SEMIHOSTING
+  // Stack high-water mark: paint the unused stack below this frame, find the lowest overwritten word at the end.
+  constexpr std::uint32_t kPaint = 0xA5C3E187u;
+  std::uint32_t* const stack_limit = &__stack_limit__;
+  for (std::uint32_t* w = stack_limit; w < static_cast<std::uint32_t*>(__builtin_frame_address(0)) - 16; ++w) *w = kPaint;
+  systick_start();
+  // Calibration: the difference of two loop lengths cancels the reads' own cost.
+  constexpr std::uint32_t kCalIterations = 100000;
+  const std::uint64_t cal_ticks = loop_ticks(kCalIterations + 1000) - loop_ticks(1000);  // 2 * kCalIterations insns
+  const std::uint64_t overhead = loop_ticks(1000) * 2 * kCalIterations / cal_ticks - 2000;  // reads' own cost
+  auto instructions = [&](std::uint64_t ticks) {
+    const std::uint64_t i = (ticks * 2 * kCalIterations + cal_ticks / 2) / cal_ticks;
+    return i > overhead ? i - overhead : 0;
+  };
+  Cost scan_cost, tick_cost;
+#endif
   unsigned k = 0;
   for (; k < kMaxTicks; ++k, now_us += kTickUs) {
     const Pose2 odom = odom_origin.inverse().compose(robot);
     if (k % kTicksPerScan == 0) {
       render_scan(robot, now_us);
+#if DOCKCORE_FW_SEMIHOSTING
+      const std::uint64_t t0 = systick_now();
       g_core.on_scan(g_scan.view(), now_us, odom);
+      scan_cost.add(instructions(systick_now() - t0));
+#else
+      g_core.on_scan(g_scan.view(), now_us, odom);
+#endif
     }
 
     const Vec2 pads = robot.transform(kPadsBody);
@@ -156,7 +227,13 @@ int main() {
     in.odom_pose = odom;
     in.contact = contact;
     in.charge_current_a = contact && now_us - contact_since_us >= 500000 ? static_cast<Real>(5) : 0;
+#if DOCKCORE_FW_SEMIHOSTING
+    const std::uint64_t t0 = systick_now();
     const TickOutput out = g_core.tick(in);
+    tick_cost.add(instructions(systick_now() - t0));
+#else
+    const TickOutput out = g_core.tick(in);
+#endif
 
     const bool progress = out.status.state == TaskState::kAlign && k % 50 == 0;  // once a second while driving
     if (out.status.state != last_state || progress) {
@@ -214,6 +291,30 @@ int main() {
     put("\n");
   }
 #if DOCKCORE_FW_SEMIHOSTING
+  // One line each, parsed by tools/size-report: worst and mean instructions per call, and which call was the worst.
+  const Cost* costs[2] = {&scan_cost, &tick_cost};
+  const char* names[2] = {"cost: on_scan instructions max ", "cost: tick instructions max "};
+  for (int c = 0; c < 2; ++c) {
+    put(names[c]);
+    put_uint(costs[c]->max);
+    put(" (call ");
+    put_uint(costs[c]->at);
+    put(") mean ");
+    put_uint(costs[c]->n ? costs[c]->sum / costs[c]->n : 0);
+    put(" calls ");
+    put_uint(costs[c]->n);
+    put("\n");
+  }
+  put("cost: calibration SysTick ticks per 1000 instructions ");
+  put_fixed(static_cast<Real>(cal_ticks) * static_cast<Real>(1000) / static_cast<Real>(2 * kCalIterations), 1);
+  put("\n");
+  std::uint32_t* w = stack_limit;
+  while (*w == kPaint) ++w;
+  put("stack: high-water ");
+  put_uint(reinterpret_cast<std::uintptr_t>(&__stack_top__) - reinterpret_cast<std::uintptr_t>(w));
+  put(" bytes of ");
+  put_uint(reinterpret_cast<std::uintptr_t>(&__stack_top__) - reinterpret_cast<std::uintptr_t>(stack_limit));
+  put(" reserved\n");
   exit_with(charged);
 #endif
   return charged ? 0 : 1;

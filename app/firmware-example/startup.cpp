@@ -18,6 +18,8 @@ extern InitFn __init_array_end[];
 int main();
 void Reset_Handler();
 void Default_Handler();
+// The firmware may define it (main.cpp does, to extend SysTick for its cost counters); otherwise it stops the core.
+void SysTick_Handler() __attribute__((weak, alias("Default_Handler")));
 
 // A pure virtual call can only be a bug; without this, libsupc++'s version drags in std::terminate and the
 // exception machinery.
@@ -46,7 +48,7 @@ extern "C" void Default_Handler() {
   for (;;) __asm volatile("bkpt 0");  // stops under a debugger; a locked-up core otherwise
 }
 
-// Cortex-M7 system exceptions; the device interrupts are not used by this example.
+// Cortex-M system exceptions (ARMv7-M: the same on M4 and M7); the device interrupts are not used by this example.
 using Vector = void (*)();
 __attribute__((section(".isr_vector"), used)) const Vector g_vectors[16] = {
     reinterpret_cast<Vector>(&__stack_top__),
@@ -61,5 +63,5 @@ __attribute__((section(".isr_vector"), used)) const Vector g_vectors[16] = {
     Default_Handler,  // DebugMonitor
     nullptr,
     Default_Handler,  // PendSV
-    Default_Handler,  // SysTick
+    SysTick_Handler,
 };
