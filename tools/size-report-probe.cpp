@@ -9,9 +9,13 @@
 
 #define DOCKCORE_SIZE(name, type) extern "C" { char size_of_##name[sizeof(type)]; }
 DOCKCORE_SIZE(Dockcore, dockcore::Dockcore)
+DOCKCORE_SIZE(Dockcore720, dockcore::DockcoreN<720>)
+DOCKCORE_SIZE(Dockcore1440, dockcore::DockcoreN<1440>)
 DOCKCORE_SIZE(DockPoseEstimator, dockcore::DockPoseEstimator)
+DOCKCORE_SIZE(DockPoseEstimator720, dockcore::DockPoseEstimatorN<720>)
 DOCKCORE_SIZE(DockPoseFilter, dockcore::DockPoseFilter)
 DOCKCORE_SIZE(TaskManager, dockcore::TaskManager)
 DOCKCORE_SIZE(LaserScan, dockcore::LaserScan)
+DOCKCORE_SIZE(LaserScan720, dockcore::LaserScanN<720>)
 DOCKCORE_SIZE(DockcoreConfig, dockcore::DockcoreConfig)
 DOCKCORE_SIZE(SmoothController, dockcore::SmoothController)

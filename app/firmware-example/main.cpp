@@ -31,9 +31,9 @@ const Real kWallX_m = static_cast<Real>(-0.08);        // wall behind the dock, 
 const Real kWallHalfLength_m = static_cast<Real>(2.0);  // ... from y = -2 m to +2 m
 const Vec2 kPadsBody(static_cast<Real>(0.37), 0);  // charging pads: centre of the front edge (default footprint)
 
-// Everything large is static: Dockcore alone is hundreds of KiB (see docs/performance.md), far beyond any stack.
+// Everything large is static: even sized for 720 beams Dockcore is tens of KiB (docs/architecture.md), beyond any stack.
 SmoothController g_controller;
-Dockcore g_core(g_controller);
+DockcoreN<kBeams> g_core(g_controller);  // sized for the 720-beam lidar, not core's largest
 LaserScanN<kBeams> g_scan;
 DockProfile g_profile;
 PlacedProfile g_placed;

@@ -179,7 +179,7 @@ EstimatorParams estimator_params_for_noise(Real range_sigma_m) {
   return p;
 }
 
-bool DockPoseEstimator::configure(const DockProfile& profile, const EstimatorParams& params) {
+bool DockPoseEstimatorBase::configure(const DockProfile& profile, const EstimatorParams& params) {
   counters_ = EstimatorCounters{};
   configured_ = false;
   if (profile.segment_count() < 1) return false;
@@ -225,8 +225,8 @@ bool DockPoseEstimator::configure(const DockProfile& profile, const EstimatorPar
   return true;
 }
 
-bool DockPoseEstimator::load_scan(const ScanView& scan) {
-  if (scan.count == 0 || scan.count > kMaxScanPoints || scan.ranges_m == nullptr || !(scan.angle_increment_rad > 0) ||
+bool DockPoseEstimatorBase::load_scan(const ScanView& scan) {
+  if (scan.count == 0 || scan.count > capacity_ || scan.ranges_m == nullptr || !(scan.angle_increment_rad > 0) ||
       !std::isfinite(scan.angle_min_rad) || static_cast<Real>(scan.count) * scan.angle_increment_rad > kTwoPi + scan.angle_increment_rad) {
     return false;
   }
@@ -259,7 +259,7 @@ bool DockPoseEstimator::load_scan(const ScanView& scan) {
   return true;
 }
 
-std::size_t DockPoseEstimator::valid_beams() {
+std::size_t DockPoseEstimatorBase::valid_beams() {
   if (!valid_beams_counted_) {
     valid_beams_ = 0;
     for (std::size_t i = 0; i < beams_; ++i) valid_beams_ += range_at(i) != 0 ? 1u : 0u;
@@ -268,7 +268,7 @@ std::size_t DockPoseEstimator::valid_beams() {
   return valid_beams_;
 }
 
-void DockPoseEstimator::build_points() {
+void DockPoseEstimatorBase::build_points() {
   // Only the global search needs Cartesian points; tracking works on the beams directly.
   points_.clear();
   for (std::size_t i = 0; i < beams_; ++i) {
@@ -283,7 +283,7 @@ void DockPoseEstimator::build_points() {
   }
 }
 
-void DockPoseEstimator::wall_behind(const Pose2& pose, long first, std::size_t k_first_hit, std::size_t k_last_hit,
+void DockPoseEstimatorBase::wall_behind(const Pose2& pose, long first, std::size_t k_first_hit, std::size_t k_last_hit,
                                     std::uint16_t* seen, std::uint16_t* looked) const {
   // The wall lies behind the dock's back plane (dock frame x = back_x_m_) by the mounting's gap: beams just past
   // either end of the dock meet it there. Beams blocked well in front of it (an occluder) say nothing.
@@ -315,7 +315,7 @@ void DockPoseEstimator::wall_behind(const Pose2& pose, long first, std::size_t k
   }
 }
 
-int DockPoseEstimator::continues_past_end(const Vec2& p) const {
+int DockPoseEstimatorBase::continues_past_end(const Vec2& p) const {
   // A point on the dock itself (e.g. the breakpoint dock's end blocks, in line with its face) is not an extension.
   std::size_t near_seg = 0;
   Real near_dist = 0;
@@ -338,14 +338,14 @@ int DockPoseEstimator::continues_past_end(const Vec2& p) const {
   return result;
 }
 
-long DockPoseEstimator::first_beam(Real angle_rad) const {
+long DockPoseEstimatorBase::first_beam(Real angle_rad) const {
   // Express the angle within ±pi of the scan's centre so a non-wrapping scan gets the unambiguous index.
   const Real half_span = static_cast<Real>(beams_) * angle_inc_rad_ * R(0.5);
   const Real rel = wrap_angle(angle_rad - angle_min_rad_ - half_span) + half_span;
   return static_cast<long>(std::floor(rel / angle_inc_rad_ + R(0.5)));
 }
 
-DockPoseEstimator::Refined DockPoseEstimator::refine(const Pose2& initial) {
+DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initial) {
   Refined out{};
   out.pose = initial;
   out.ok = false;
@@ -460,7 +460,7 @@ DockPoseEstimator::Refined DockPoseEstimator::refine(const Pose2& initial) {
   return out;
 }
 
-std::size_t DockPoseEstimator::span_beams(Real dist_m, const Vec2& t, const Vec2& nd) {
+std::size_t DockPoseEstimatorBase::span_beams(Real dist_m, const Vec2& t, const Vec2& nd) {
   Real lo = 0;
   Real hi = 0;
   placed_.angular_span(&lo, &hi);
@@ -493,7 +493,7 @@ std::size_t DockPoseEstimator::span_beams(Real dist_m, const Vec2& t, const Vec2
   return n;
 }
 
-void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
+void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   r.inliers = r.expected = r.violations = r.occluded = r.extensions = r.wall_seen = r.wall_looked = 0;
   r.shape_rms_m = 0;
   r.evidence = DockEvidence{};
@@ -667,7 +667,7 @@ void DockPoseEstimator::verify(Refined& r, const Pose2* hint) {
   r.ok = true;
 }
 
-void DockPoseEstimator::decide(Refined& r, const Pose2* hint) {
+void DockPoseEstimatorBase::decide(Refined& r, const Pose2* hint) {
   verify(r, hint);
   if (r.ok && hint != nullptr && params_.hint_radius_m > 0 &&
       dist2(r.pose, *hint) > params_.hint_radius_m * params_.hint_radius_m) {
@@ -676,7 +676,7 @@ void DockPoseEstimator::decide(Refined& r, const Pose2* hint) {
   }
 }
 
-Real DockPoseEstimator::prescore(const Pose2& pose) {
+Real DockPoseEstimatorBase::prescore(const Pose2& pose) {
   placed_.place(profile_, pose);
   Real lo = 0;
   Real hi = 0;
@@ -702,7 +702,7 @@ Real DockPoseEstimator::prescore(const Pose2& pose) {
   return score;
 }
 
-void DockPoseEstimator::push_hypothesis(const Vec2& n_scan, const Vec2& anchor_scan, const Vec2& anchor_dock,
+void DockPoseEstimatorBase::push_hypothesis(const Vec2& n_scan, const Vec2& anchor_scan, const Vec2& anchor_dock,
                                         std::size_t profile_segment, std::size_t* n) {
   const Vec2 n_j = profile_.normal(profile_segment);
   const Real yaw = wrap_angle(std::atan2(n_scan.y(), n_scan.x()) - std::atan2(n_j.y(), n_j.x()));
@@ -752,7 +752,7 @@ struct RunningMoments {
 
 }  // namespace
 
-void DockPoseEstimator::add_window_hypotheses(std::size_t* n) {
+void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
   // Split the points into contiguous runs (no range gap), in circular order on a full-turn scan.
   const std::size_t np = points_.size();
   if (np < 5) return;
@@ -816,7 +816,7 @@ void DockPoseEstimator::add_window_hypotheses(std::size_t* n) {
   }
 }
 
-std::size_t DockPoseEstimator::generate_candidates() {
+std::size_t DockPoseEstimatorBase::generate_candidates() {
   build_points();
   std::size_t n = 0;
   add_window_hypotheses(&n);
@@ -870,7 +870,7 @@ std::size_t DockPoseEstimator::generate_candidates() {
   return keep;
 }
 
-void DockPoseEstimator::report(const Refined& r, DockEstimate* est) {
+void DockPoseEstimatorBase::report(const Refined& r, DockEstimate* est) {
   est->inliers = r.inliers;
   est->expected = r.expected;
   est->violations = r.violations;
@@ -881,7 +881,7 @@ void DockPoseEstimator::report(const Refined& r, DockEstimate* est) {
   est->evidence = r.evidence;
 }
 
-DockEstimate DockPoseEstimator::estimate(const ScanView& scan, const Pose2& lidar_mount, const Pose2* hint) {
+DockEstimate DockPoseEstimatorBase::estimate(const ScanView& scan, const Pose2& lidar_mount, const Pose2* hint) {
   DockEstimate est;
   ++counters_.scans;
   if (!configured_) {

@@ -2,7 +2,7 @@
 
 namespace dockcore {
 
-bool Dockcore::configure(const DockProfile& profile, const DockcoreConfig& config) {
+bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& config) {
   config_ = config;
   filter_ = DockPoseFilter(config.filter);
   tasks_.configure(config.task, config.footprint, profile);
@@ -19,13 +19,13 @@ bool Dockcore::configure(const DockProfile& profile, const DockcoreConfig& confi
   return estimator_.configure(profile, config.estimator);
 }
 
-const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_us, const Pose2& odom_pose) {
-  const std::size_t n = scan.count < LaserScan::kCapacity ? scan.count : LaserScan::kCapacity;
-  scan_.reset(n, scan.angle_min_rad, scan.angle_increment_rad, stamp_us);
+const DockEstimate& DockcoreBase::on_scan(const ScanView& scan, std::uint64_t stamp_us, const Pose2& odom_pose) {
+  const std::size_t n = scan.count < scan_capacity_ ? scan.count : scan_capacity_;
   for (std::size_t i = 0; i < n; ++i) {
-    scan_.ranges_m[i] = scan.ranges_m != nullptr ? scan.ranges_m[i] : static_cast<Real>(0);
-    scan_.intensities[i] = scan.intensities != nullptr ? scan.intensities[i] : static_cast<Real>(0);
+    scan_ranges_m_[i] = scan.ranges_m != nullptr ? scan.ranges_m[i] : static_cast<Real>(0);
+    scan_intensities_[i] = scan.intensities != nullptr ? scan.intensities[i] : static_cast<Real>(0);
   }
+  scan_ = ScanView{scan_ranges_m_, scan_intensities_, n, scan.angle_min_rad, scan.angle_increment_rad, stamp_us};
   have_scan_ = true;
   last_scan_us_ = stamp_us;
 
@@ -89,7 +89,7 @@ const DockEstimate& Dockcore::on_scan(const ScanView& scan, std::uint64_t stamp_
   return last_estimate_;
 }
 
-TickOutput Dockcore::tick(const TickInput& in) {
+TickOutput DockcoreBase::tick(const TickInput& in) {
   TaskInput t;
   t.now_us = in.now_us;
   t.command = in.command;
@@ -102,8 +102,7 @@ TickOutput Dockcore::tick(const TickInput& in) {
   const bool scan_recent = have_scan_ && (in.now_us <= last_scan_us_ ||
       static_cast<Real>(in.now_us - last_scan_us_) * static_cast<Real>(1e-6) <= config_.lidar_stale_s);
   t.lidar_ok = in.lidar_ok && scan_recent;
-  const ScanView view = scan_.view();
-  t.scan = have_scan_ ? &view : nullptr;
+  t.scan = have_scan_ ? &scan_ : nullptr;
   t.lidar_mount = config_.lidar_mount;
   if (filter_.initialised()) {
     t.dock.valid = true;
@@ -154,7 +153,7 @@ TickOutput Dockcore::tick(const TickInput& in) {
   return out;
 }
 
-void Dockcore::shape(bool hold, TickOutput* out) {
+void DockcoreBase::shape(bool hold, TickOutput* out) {
   Twist2 c{};
   const Twist2& want = out->cmd;
   // A zero twist (stop, fault, idle) is sent at once: the drive's own limits do the braking.

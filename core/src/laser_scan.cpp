@@ -3,7 +3,7 @@
 namespace dockcore {
 
 std::size_t scan_to_points(const ScanView& scan, const Pose2& lidar_mount, Real min_range_m, Real max_range_m,
-                           ScanPoints& out, std::size_t* truncated) {
+                           ScanPointBuffer& out, std::size_t* truncated) {
   out.clear();
   std::size_t dropped = 0;
   const Real c = std::cos(lidar_mount.yaw_rad);

@@ -75,7 +75,7 @@ Real rms_of(const Moments& m) {
 /// Points in processing order: position `pos` maps to point index (start + pos) mod n, which rotates a wrapping scan
 /// so that a cluster straddling index 0 is contiguous.
 struct RotatedPoints {
-  const ScanPoints& pts;
+  const ScanPointBuffer& pts;
   std::size_t start;
   std::size_t n;
   std::size_t index(std::size_t pos) const {
@@ -112,7 +112,7 @@ struct Piece {
 
 class Extractor {
  public:
-  Extractor(const RotatedPoints& rp, Real angle_increment_rad, const SegmentParams& params, LineSegments& out,
+  Extractor(const RotatedPoints& rp, Real angle_increment_rad, const SegmentParams& params, LineSegmentBuffer& out,
             SegmentStats& stats)
       : rp_(rp), inc_(angle_increment_rad), params_(params), out_(out), stats_(stats) {}
 
@@ -310,7 +310,7 @@ class Extractor {
   const RotatedPoints& rp_;
   Real inc_;
   const SegmentParams& params_;
-  LineSegments& out_;
+  LineSegmentBuffer& out_;
   SegmentStats& stats_;
   Piece pending_;
   bool has_pending_ = false;
@@ -331,8 +331,8 @@ bool is_break(const ScanPoint& a, const ScanPoint& b, Real inc_abs, const Segmen
 }
 
 /// Clusters the points in rotated order from `start` and extracts each cluster's segments into `out`.
-void run_clusters(const ScanPoints& points, std::size_t start, Real angle_increment_rad, const SegmentParams& params,
-                  LineSegments& out, SegmentStats& stats) {
+void run_clusters(const ScanPointBuffer& points, std::size_t start, Real angle_increment_rad, const SegmentParams& params,
+                  LineSegmentBuffer& out, SegmentStats& stats) {
   const std::size_t n = points.size();
   const Real inc_abs = std::fabs(angle_increment_rad);
   const RotatedPoints rp{points, start, n};
@@ -381,8 +381,8 @@ bool fit_line_tls(const Vec2* points_m, std::size_t count, LineFit& fit) {
   return true;
 }
 
-SegmentStats extract_line_segments(const ScanPoints& points, Real angle_increment_rad, bool wraps,
-                                   const SegmentParams& params, LineSegments& out) {
+SegmentStats extract_line_segments(const ScanPointBuffer& points, Real angle_increment_rad, bool wraps,
+                                   const SegmentParams& params, LineSegmentBuffer& out) {
   SegmentStats stats;
   out.clear();
   const std::size_t n = points.size();

@@ -139,7 +139,7 @@ VMarkerError VMarkerDetector::configure(const VMarkerParams& params) {
   return e;
 }
 
-VMarkerDetection VMarkerDetector::detect(const LineSegments& segments, const Pose2* hint) const {
+VMarkerDetection VMarkerDetector::detect(const LineSegmentBuffer& segments, const Pose2* hint) const {
   return detect(segments.data(), segments.size(), hint);
 }
 

@@ -20,10 +20,11 @@
 ///  4. Selection among accepted candidates: one whose evidence is far stronger (kSelectMarginNats) wins; otherwise
 ///     the nearest to the lidar, or the nearest to the hint.
 ///
-/// Cost: O(B) to read the scan (B beams, no trig per beam), O(B) segmentation, then per candidate
-/// O(I · W · S) with I <= max_iterations, W beams in the dock's span, S visible profile segments; at most
-/// max_candidates candidates are refined. No heap; the object holds its working buffers (~290 kB with double,
-/// ~150 kB with float), so keep it static or a member, not on a small stack.
+/// Cost: tracking (a hint that holds) reads only the beams in the dock's span: O(I · W · S) with I <= max_iterations,
+/// W beams in the span, S visible profile segments (most beams keep their segment between iterations). A global
+/// search adds O(B) for the B beams (points, segmentation, hypotheses) and refines at most max_candidates
+/// candidates. The beam directions cost O(B) only when the scan geometry changes. No heap: the working buffers are
+/// DockPoseEstimatorN's, sized by its beam capacity (docs/architecture.md gives the sizes).
 
 #include <cstddef>
 #include <cstdint>
@@ -202,8 +203,13 @@ struct EstimatorCounters {
   std::uint32_t truncated_segments = 0;    ///< Scans whose line extraction hit a cap.
 };
 
-class DockPoseEstimator {
+/// The estimator over working buffers it does not own (DockPoseEstimatorN<N> gives them, for scans of up to N
+/// beams). Everything that takes an estimator takes this, whatever its capacity. Not copyable.
+class DockPoseEstimatorBase {
  public:
+  DockPoseEstimatorBase(const DockPoseEstimatorBase&) = delete;
+  DockPoseEstimatorBase& operator=(const DockPoseEstimatorBase&) = delete;
+
   /// Sets the profile and parameters; returns false (estimator unusable until a good call) for a profile with no
   /// segments. O(vertices).
   bool configure(const DockProfile& profile, const EstimatorParams& params);
@@ -215,6 +221,23 @@ class DockPoseEstimator {
   const EstimatorCounters& counters() const { return counters_; }
   const EstimatorParams& params() const { return params_; }
   const DockProfile& profile() const { return profile_; }
+  /// Most beams a scan may have (larger scans are refused as kBadScan).
+  std::size_t capacity() const { return capacity_; }
+
+ protected:
+  /// The per-beam working buffers, each of `capacity` elements.
+  struct Buffers {
+    Vec2* dir;
+    std::uint16_t* assoc_beam;
+    std::uint8_t* assoc_seg;
+    ScanPointBuffer* points;
+    LineSegmentBuffer* segments;
+    std::size_t capacity;
+  };
+  explicit DockPoseEstimatorBase(const Buffers& b)
+      : dir_(b.dir), assoc_beam_(b.assoc_beam), assoc_seg_(b.assoc_seg), points_(*b.points), segs_(*b.segments),
+        capacity_(b.capacity) {}
+  ~DockPoseEstimatorBase() = default;
 
  private:
   struct Refined {
@@ -309,10 +332,15 @@ class DockPoseEstimator {
   Real shortcut_max_m_[kMaxProfileVertices] = {};
   EstimatorCounters counters_{};
 
-  // The current scan, in the lidar frame: its ranges (the caller's), and beam i's unit direction, kept for the
-  // geometry it was computed for.
+  // Working buffers (the owner's).
+  Vec2* dir_;                  // beam i's unit direction, kept for the geometry it was computed for
+  std::uint16_t* assoc_beam_;  // registration's beams ...
+  std::uint8_t* assoc_seg_;    // ... and the profile segment each was nearest to in the last iteration
+  ScanPointBuffer& points_;
+  LineSegmentBuffer& segs_;
+  std::size_t capacity_;
+  // The current scan, in the lidar frame: its ranges (the caller's).
   const Real* ranges_m_ = nullptr;
-  Vec2 dir_[kMaxScanPoints];
   std::size_t dir_beams_ = 0;
   Real dir_angle_min_rad_ = 0;
   Real dir_angle_inc_rad_ = 0;
@@ -322,14 +350,35 @@ class DockPoseEstimator {
   Real angle_min_rad_ = 0;
   Real angle_inc_rad_ = 0;
   bool wraps_ = false;
-  ScanPoints points_{};
-  LineSegments segs_{};
   PlacedProfile placed_{};
   Hypothesis hyps_[kMaxHypotheses];
-  // Registration's beams: index and the profile segment each was nearest to in the last iteration.
-  static_assert(kMaxScanPoints <= 65536 && kMaxProfileVertices < 255, "association indices are 16 and 8 bits");
-  std::uint16_t assoc_beam_[kMaxScanPoints];
-  std::uint8_t assoc_seg_[kMaxScanPoints];
+  static_assert(kMaxProfileVertices < 255, "association segments are 8 bits with 0xFF for none");
 };
+
+/// Line segments the estimator's global search holds for a scan of up to N beams: a segment takes at least four
+/// beams, and never more than kMaxLineSegments.
+constexpr std::size_t estimator_segment_capacity(std::size_t beams) {
+  return beams / 4 < 16 ? 16 : (beams / 4 > kMaxLineSegments ? kMaxLineSegments : beams / 4);
+}
+
+/// The estimator with its buffers, for scans of up to N beams. Size: about N · (16 + 48) bytes with double (half
+/// with float) plus the segments, the hypotheses and the placed profile; keep it static or a member, not on a stack.
+template <std::size_t N>
+class DockPoseEstimatorN : public DockPoseEstimatorBase {
+ public:
+  static_assert(N >= 16 && N <= 65536, "beam indices are 16 bits");
+  static constexpr std::size_t kCapacity = N;
+  DockPoseEstimatorN() : DockPoseEstimatorBase(Buffers{dir_, assoc_beam_, assoc_seg_, &points_, &segs_, N}) {}
+
+ private:
+  Vec2 dir_[N];
+  std::uint16_t assoc_beam_[N];
+  std::uint8_t assoc_seg_[N];
+  ScanPointsN<N> points_{};
+  FixedVector<LineSegment, estimator_segment_capacity(N)> segs_{};
+};
+
+/// The estimator for scans of any lidar core supports (kMaxScanPoints beams).
+using DockPoseEstimator = DockPoseEstimatorN<kMaxScanPoints>;
 
 }  // namespace dockcore

@@ -22,8 +22,8 @@
 /// it too, but the push test keeps the confirmed estimate from before the outage as its reference — the filter's own,
 /// or the one it had before it restarted at a pushed pose during the outage — carried by odometry, up to
 /// DockcoreConfig::push_check_max_gap_s old, until a detection in ALIGN agrees with it (docs/faults.md, 178).
-/// No heap; the object is large (estimator buffers plus one LaserScan copy, ~360 kB with double): keep it static or
-/// a member, never on a small stack.
+/// No heap. DockcoreN<N> holds the estimator's buffers and the scan copy for N beams (docs/architecture.md: about
+/// 90 KiB with double at 720 beams, 370 KiB at kMaxScanPoints): keep it static or a member, never on a small stack.
 
 #include <cstdint>
 
@@ -85,10 +85,12 @@ struct TickOutput : TaskOutput {
   WheelSpeeds wheels{};  ///< drive_cmd as wheel speeds of DockcoreConfig::drive (count from its kind).
 };
 
-class Dockcore {
+/// The docking stack over an estimator and a scan buffer it does not own (DockcoreN<N> gives them, for scans of up
+/// to N beams). Everything that drives the loop takes this, whatever its capacity. Not copyable.
+class DockcoreBase {
  public:
-  /// `controller` must outlive this object.
-  explicit Dockcore(DockingController& controller) : tasks_(controller) {}
+  DockcoreBase(const DockcoreBase&) = delete;
+  DockcoreBase& operator=(const DockcoreBase&) = delete;
 
   /// Configures every part; false (unusable until a good call) when the profile has no segments. O(vertices).
   bool configure(const DockProfile& profile, const DockcoreConfig& config);
@@ -102,7 +104,9 @@ class Dockcore {
 
   const DockEstimate& last_estimate() const { return last_estimate_; }
   const DockPoseFilter& filter() const { return filter_; }
-  const DockPoseEstimator& estimator() const { return estimator_; }
+  const DockPoseEstimatorBase& estimator() const { return estimator_; }
+  /// Most beams a scan may have: larger scans are refused by the estimator (kBadScan) and their copy truncated.
+  std::size_t scan_capacity() const { return scan_capacity_; }
   const TaskManager& task_manager() const { return tasks_; }
   const DockcoreConfig& config() const { return config_; }
   /// The host sent the drive a zero command outside tick() (shutdown, a stop of its own): the next tick's
@@ -113,14 +117,27 @@ class Dockcore {
   /// Detections that did not fit into one tick's list (more than kMaxDetectionsPerTick scans between two ticks).
   std::uint32_t detections_dropped() const { return pending_dropped_; }
 
+ protected:
+  /// `controller` must outlive this object; `estimator` and the two scan arrays (`scan_capacity` elements each)
+  /// are the owner's.
+  DockcoreBase(DockingController& controller, DockPoseEstimatorBase& estimator, Real* scan_ranges_m,
+               Real* scan_intensities, std::size_t scan_capacity)
+      : estimator_(estimator), tasks_(controller), scan_ranges_m_(scan_ranges_m), scan_intensities_(scan_intensities),
+        scan_capacity_(scan_capacity) {}
+  ~DockcoreBase() = default;
+
  private:
   /// Fills out->drive_cmd and out->wheels from out->cmd (file comment). O(1).
   void shape(bool hold, TickOutput* out);
   DockcoreConfig config_{};
-  DockPoseEstimator estimator_{};
+  DockPoseEstimatorBase& estimator_;
   DockPoseFilter filter_{};
   TaskManager tasks_;
-  LaserScan scan_{};
+  // The latest scan's copy, for the tick: its geometry and the owner's arrays.
+  Real* scan_ranges_m_;
+  Real* scan_intensities_;
+  std::size_t scan_capacity_;
+  ScanView scan_{};
   bool have_scan_ = false;
   std::uint64_t last_scan_us_ = 0;
   DockEstimate last_estimate_{};
@@ -144,5 +161,24 @@ class Dockcore {
   Pose2 confirmed_ref_in_odom_{};
   std::uint64_t confirmed_ref_us_ = 0;
 };
+
+/// The docking stack with its estimator and scan copy, for scans of up to N beams (a board picks N for its lidar:
+/// 720 for an LD06's 0.5°, 1440, or kMaxScanPoints). docs/architecture.md gives the size of each choice.
+template <std::size_t N>
+class DockcoreN : public DockcoreBase {
+ public:
+  static constexpr std::size_t kCapacity = N;
+  /// `controller` must outlive this object.
+  explicit DockcoreN(DockingController& controller)
+      : DockcoreBase(controller, estimator_storage_, scan_ranges_storage_, scan_intensities_storage_, N) {}
+
+ private:
+  DockPoseEstimatorN<N> estimator_storage_;
+  Real scan_ranges_storage_[N] = {};
+  Real scan_intensities_storage_[N] = {};
+};
+
+/// The docking stack for every lidar core supports (kMaxScanPoints beams).
+using Dockcore = DockcoreN<kMaxScanPoints>;
 
 }  // namespace dockcore

@@ -67,13 +67,18 @@ struct ScanPoint {
   std::uint32_t index;  ///< Sample index in the source scan.
 };
 
-using ScanPoints = FixedVector<ScanPoint, kMaxScanPoints>;
+/// Points of a scan, any capacity (what the algorithms take).
+using ScanPointBuffer = FixedVectorBase<ScanPoint>;
+/// Points of a scan of up to N beams.
+template <std::size_t N>
+using ScanPointsN = FixedVector<ScanPoint, N>;
+using ScanPoints = ScanPointsN<kMaxScanPoints>;
 
 /// Converts the valid returns with range in [min_range_m, max_range_m] to points in the frame in which
 /// `lidar_mount` is expressed (identity mount = lidar frame). Invalid samples are skipped, so out's order is the scan
 /// order. Returns the number of points written (<= out capacity; extra points are counted in `*truncated` if given).
 /// Cost O(count).
 std::size_t scan_to_points(const ScanView& scan, const Pose2& lidar_mount, Real min_range_m, Real max_range_m,
-                           ScanPoints& out, std::size_t* truncated = nullptr);
+                           ScanPointBuffer& out, std::size_t* truncated = nullptr);
 
 }  // namespace dockcore

@@ -62,6 +62,8 @@ struct LineSegment {
   Vec2 midpoint_m() const { return (start_m + end_m) * static_cast<Real>(0.5); }
 };
 
+/// Segments of a scan, any capacity (what the algorithms take).
+using LineSegmentBuffer = FixedVectorBase<LineSegment>;
 using LineSegments = FixedVector<LineSegment, kMaxLineSegments>;
 
 /// Thresholds for extract_line_segments. Defaults suit an LD06-class lidar (0.8° steps, range noise σ ≈ 10 mm)
@@ -129,12 +131,12 @@ struct SegmentStats {
 /// Cost: O(n) clustering + O(n · d) splitting (d = split nesting depth, ~log(segments) for real contours, at most
 /// max_split_iterations pops in all) + O(n) fitting and merging; ×2 for a closed contour. Stack use ~1 KB besides
 /// `out`.
-SegmentStats extract_line_segments(const ScanPoints& points, Real angle_increment_rad, bool wraps,
-                                   const SegmentParams& params, LineSegments& out);
+SegmentStats extract_line_segments(const ScanPointBuffer& points, Real angle_increment_rad, bool wraps,
+                                   const SegmentParams& params, LineSegmentBuffer& out);
 
 /// Convenience: takes the step and the wrap flag from the scan the points were made from. Same contract and cost.
-inline SegmentStats extract_line_segments(const ScanPoints& points, const ScanView& scan, const SegmentParams& params,
-                                          LineSegments& out) {
+inline SegmentStats extract_line_segments(const ScanPointBuffer& points, const ScanView& scan,
+                                          const SegmentParams& params, LineSegmentBuffer& out) {
   return extract_line_segments(points, scan.angle_increment_rad, scan.wraps(), params, out);
 }
 

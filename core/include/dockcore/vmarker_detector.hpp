@@ -146,7 +146,7 @@ class VMarkerDetector {
   /// Choice: without a hint, the highest score; with `hint` (expected dock pose in the same frame), the candidate whose
   /// dock origin is nearest the hint among those within hint_gate_m (ties by score). Deterministic: ties keep the
   /// earliest pair. Cost O(segments · pair_span), no allocation.
-  VMarkerDetection detect(const LineSegments& segments, const Pose2* hint = nullptr) const;
+  VMarkerDetection detect(const LineSegmentBuffer& segments, const Pose2* hint = nullptr) const;
   /// Same, over a plain array of `count` segments.
   VMarkerDetection detect(const LineSegment* segments, std::size_t count, const Pose2* hint = nullptr) const;
 
