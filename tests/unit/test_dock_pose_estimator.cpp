@@ -398,3 +398,28 @@ TEST(DockPoseEstimator, PlacedProfileQueriesAgreeWithThePlainFormulas) {
   CHECK_TRUE(rays > 1000);
   CHECK_TRUE(shortcuts > 1000);
 }
+
+TEST(DockPoseEstimator, SmallCapacityOwnerGivesTheSameEstimate) {
+  // A board's 720-beam estimator finds what the 4096-beam one finds on a 720-beam scan, bit for bit, and refuses a
+  // scan larger than its capacity as a bad scan, counted.
+  static DockPoseEstimatorN<720> small;
+  const DockProfile prof = profile("plate-v");
+  g_est.configure(prof, EstimatorParams{});
+  small.configure(prof, EstimatorParams{});
+  CHECK_EQUAL(720u, small.capacity());
+  docksim::LidarModel m = ld06(0.01);
+  m.beams = 720;
+  m.angle_increment_rad = 2 * kPi / 720;
+  simulate(prof, 1.3, 0.4, -0.3, m, 21, 2);
+  const DockEstimate a = g_est.estimate(g_scan.view(), Pose2{});
+  const DockEstimate b = small.estimate(g_scan.view(), Pose2{});
+  CHECK_TRUE(a.found);
+  CHECK_EQUAL(0, std::memcmp(&a.pose, &b.pose, sizeof a.pose));
+  CHECK_EQUAL(0, std::memcmp(a.covariance.data(), b.covariance.data(), sizeof(Real) * 9));
+  m.beams = 721;
+  m.angle_increment_rad = 2 * kPi / 721;
+  simulate(prof, 1.3, 0.4, -0.3, m, 21, 2);
+  const DockEstimate c = small.estimate(g_scan.view(), Pose2{});
+  CHECK_EQUAL(static_cast<int>(EstimateStatus::kBadScan), static_cast<int>(c.status));
+  CHECK_EQUAL(1u, small.counters().bad_scans);
+}
