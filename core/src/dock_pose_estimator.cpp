@@ -290,7 +290,7 @@ void DockPoseEstimatorBase::wall_behind(const Pose2& pose, long first, std::size
   *seen = 0;
   *looked = 0;
   const DockMounting& mount = profile_.mounting;
-  const Vec2 nd(std::cos(pose.yaw_rad), std::sin(pose.yaw_rad));
+  const Vec2& nd = placed_.x_axis;  // verify() placed the profile at `pose`
   const Real back_c = nd.dot(Vec2(pose.x_m, pose.y_m)) + back_x_m_;
   const Real tol = params_.wall_tolerance_m + params_.inlier_gate_m;
   const Real gap_lo = mount.kind == DockMountKind::kWall ? mount.wall_gap_min_m : R(0);
@@ -366,7 +366,7 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
     const Real gate = params_.association_gate_m / shrink > params_.inlier_gate_m ? params_.association_gate_m / shrink
                                                                                    : params_.inlier_gate_m;
     const Vec2 t(pose.x_m, pose.y_m);
-    const Vec2 nd(std::cos(pose.yaw_rad), std::sin(pose.yaw_rad));
+    const Vec2& nd = placed_.x_axis;
     // The beams to fit: every return in the dock's span plus a margin, taken again early on and kept later, with
     // wall points beside the dock left out (the wall explains them, not the dock's sides).
     const bool reuse = last_step_m <= kReuseStepM && n_assoc > 0;
@@ -378,7 +378,10 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
     for (std::size_t k = 0; k < n_assoc; ++k) {
       const std::size_t i = assoc_beam_[k];
       const Vec2 p = ranges_m_[i] * dir_[i];  // span_beams() kept only returns within range
+      // Its segment in the previous iteration, or (after a full pass) the neighbouring beam's, just found: the
+      // shortcut below holds whatever segment it is tried on.
       std::size_t seg = assoc_seg_[k];
+      if (seg == kNoSegment && k > 0) seg = assoc_seg_[k - 1];
       Real dist = 0;
       Real e = 0;
       // A point beyond a segment's end (overhang) belongs to whatever adjoins the dock, e.g. the wall behind it.
@@ -536,7 +539,7 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   const DockMountKind mount = profile_.mounting.kind;
   const Real gap_max_m = mount == DockMountKind::kWall ? profile_.mounting.wall_gap_max_m : DockMounting{}.wall_gap_max_m;
   const Vec2 t_dock(r.pose.x_m, r.pose.y_m);
-  const Vec2 x_dock(std::cos(r.pose.yaw_rad), std::sin(r.pose.yaw_rad));
+  const Vec2& x_dock = placed_.x_axis;
   auto wall_band = [&](const Vec2& p) {
     const Real x = x_dock.dot(p - t_dock);
     return x < back_x_m_ + gate && x > back_x_m_ - gap_max_m - gate;
@@ -649,7 +652,7 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   const Real expected = static_cast<Real>(r.expected);
   const Vec2 t(r.pose.x_m, r.pose.y_m);
   const Real dist_m = t.norm();
-  const Vec2 face(std::cos(r.pose.yaw_rad), std::sin(r.pose.yaw_rad));
+  const Vec2& face = placed_.x_axis;
   const Real cos_view = dist_m > 0 ? -face.dot(t) / dist_m : R(-1);
   r.reject = RejectReason::kNone;
   if (r.inliers < params_.min_inliers) {

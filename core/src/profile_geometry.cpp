@@ -5,6 +5,7 @@ namespace dockcore {
 void PlacedProfile::place(const DockProfile& profile, const Pose2& dock_in_sensor) {
   const Real c = std::cos(dock_in_sensor.yaw_rad);
   const Real s = std::sin(dock_in_sensor.yaw_rad);
+  x_axis = Vec2(c, s);
   const std::size_t nv = profile.vertex_count;
   for (std::size_t i = 0; i < nv; ++i) {
     const Vec2& p = profile.vertices_m[i];

@@ -309,6 +309,7 @@ class DockPoseEstimatorBase {
   Real prescore(const Pose2& pose);
   /// The wall cue's counts: of the beams just outside [k_first_hit, k_last_hit] (offsets from `first`, up to 3 per
   /// side) that could meet a wall behind the dock, how many do where the mounting's gap range puts it.
+  /// Precondition: placed_ holds the profile placed at `pose`.
   void wall_behind(const Pose2& pose, long first, std::size_t k_first_hit, std::size_t k_last_hit,
                    std::uint16_t* seen, std::uint16_t* looked) const;
   /// For a return p: 0 when it is not 4-12 cm past the end of a long visible segment of placed_ (or lies on the

@@ -20,6 +20,7 @@ struct PlacedProfile {
   Real len_m[kMaxProfileVertices];     ///< Length of segment i.
   Real inv_len_sq[kMaxProfileVertices];  ///< 1 / len_m[i]² (the per-query divisions become products).
   std::size_t segments = 0;
+  Vec2 x_axis{1, 0};  ///< The dock's x axis in the sensor frame: (cos yaw, sin yaw) of the pose it was placed at.
 
   /// Places `profile` at `dock_in_sensor`. Cost O(vertices): one sin/cos pair.
   void place(const DockProfile& profile, const Pose2& dock_in_sensor);
