@@ -37,7 +37,7 @@ LineSegments g_segments;
 DockPoseEstimator g_estimator;
 BreakpointDetector g_breakpoint;
 SmoothController g_smooth;
-Dockcore g_core(g_smooth);  // ~360 kB: static, as dockd keeps it
+Dockcore g_core(g_smooth);  // ~330 KiB: static, as dockd keeps it
 }  // namespace
 
 // The whole stack as dockd runs it: Dockcore::on_scan at 10 Hz and Dockcore::tick at 50 Hz with the smooth

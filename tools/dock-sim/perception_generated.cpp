@@ -233,7 +233,7 @@ std::uint64_t scan_seed(std::uint64_t seed, std::uint64_t stream, std::uint64_t 
   return docksim::trial_seed(docksim::seed_stream(seed, 0x5343414e00ull /* "SCAN" */ + stream), index);
 }
 
-/// One thread's estimators and scan buffer (the estimator is ~290 kB: heap, one per case).
+/// One thread's estimators and scan buffer (the estimator is ~260 KiB: heap, one per case).
 struct Worker {
   std::unique_ptr<dockcore::DockPoseEstimator> est[kCases];
   std::unique_ptr<dockcore::LaserScan> scan = std::make_unique<dockcore::LaserScan>();

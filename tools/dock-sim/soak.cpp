@@ -115,7 +115,7 @@ class SoakWorld {
         world_(docksim::scenario_world(sc, true)),
         geom_(docksim::core_drive_geometry(sc.chassis.geometry)),
         target_world_(sc.dock_pose.transform(sc.camera.target_in_dock)) {
-    core_ = std::make_unique<dockcore::Dockcore>(ctl);  // ~360 kB: heap, not stack
+    core_ = std::make_unique<dockcore::Dockcore>(ctl);  // ~330 KiB: heap, not stack
     dockcore::DockcoreConfig cfg;
     cfg.estimator = sc.estimator;
     cfg.task = sc.task;
