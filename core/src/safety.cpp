@@ -112,10 +112,23 @@ ObstacleFlags ObstacleChecker::check(const ScanView& scan, const Pose2& lidar_mo
   const Real front = body_front_m();
   const Real half_w = fp_.check_width_m * static_cast<Real>(0.5);
   const Real r_rot2 = fp_.circumscribed_radius_m * fp_.circumscribed_radius_m;
+  // Every zone below (the check boxes, the body, the rotation circle) lies within reach_m of the robot's centre, and
+  // a return r from the lidar lies at least r - |mount| from it: beyond that, skip the trigonometry (most beams of
+  // a room). The margin keeps rounding from deciding.
+  const Real box_x = front + fp_.check_length_m;
+  const Real box_reach = std::sqrt(box_x * box_x + half_w * half_w);
+  const Real body_reach = fp_.shape == FootprintShape::kCircular
+                              ? fp_.radius_m
+                              : std::sqrt(fp_.half_length_m * fp_.half_length_m + fp_.half_width_m * fp_.half_width_m);
+  Real reach_m = box_reach > body_reach ? box_reach : body_reach;
+  reach_m = reach_m > fp_.circumscribed_radius_m ? reach_m : fp_.circumscribed_radius_m;
+  const Real skip_beyond_m =
+      reach_m + std::sqrt(lidar_mount.x_m * lidar_mount.x_m + lidar_mount.y_m * lidar_mount.y_m) +
+      static_cast<Real>(0.001);
   bool have_nearest = false;
   for (std::size_t i = 0; i < n; ++i) {
     const Real r = scan.ranges_m[i];
-    if (!is_valid_range(r) || r < fp_.min_range_m) continue;
+    if (!is_valid_range(r) || r < fp_.min_range_m || r > skip_beyond_m) continue;
     const Real a = scan.angle_rad(i);
     const Vec2 p = lidar_mount.transform(Vec2(r * std::cos(a), r * std::sin(a)));
     const bool lateral = std::fabs(p.y()) < half_w;
