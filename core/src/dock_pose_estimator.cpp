@@ -188,6 +188,9 @@ bool DockPoseEstimatorBase::configure(const DockProfile& profile, const Estimato
   profile_radius_m_ = 0;
   back_x_m_ = profile.vertices_m[0].x();
   half_width_m_ = 0;
+  // A wall-mounted dock's wall lies within its gap range; any other mounting allows the default range.
+  wall_gap_max_m_ = profile.mounting.kind == DockMountKind::kWall ? profile.mounting.wall_gap_max_m
+                                                                  : DockMounting{}.wall_gap_max_m;
   for (std::size_t i = 0; i < profile.vertex_count; ++i) {
     back_x_m_ = profile.vertices_m[i].x() < back_x_m_ ? profile.vertices_m[i].x() : back_x_m_;
     const Real ay = std::fabs(profile.vertices_m[i].y());
@@ -294,7 +297,7 @@ void DockPoseEstimatorBase::wall_behind(const Pose2& pose, long first, std::size
   const Real back_c = nd.dot(Vec2(pose.x_m, pose.y_m)) + back_x_m_;
   const Real tol = params_.wall_tolerance_m + params_.inlier_gate_m;
   const Real gap_lo = mount.kind == DockMountKind::kWall ? mount.wall_gap_min_m : R(0);
-  const Real gap_hi = mount.kind == DockMountKind::kWall ? mount.wall_gap_max_m : DockMounting{}.wall_gap_max_m;
+  const Real gap_hi = wall_gap_max_m_;
   for (int side = 0; side < 2; ++side) {
     for (std::size_t step = 1; step <= 3; ++step) {
       const long k = side == 0 ? static_cast<long>(k_first_hit) - static_cast<long>(step)
@@ -473,10 +476,8 @@ std::size_t DockPoseEstimatorBase::span_beams(Real dist_m, const Vec2& t, const 
   const std::size_t n_beams = static_cast<std::size_t>((hi - lo) / angle_inc_rad_) + 2;
   const long first = first_beam(lo);
   const bool wall_mounted = profile_.mounting.kind != DockMountKind::kFreeStanding;
-  const Real gap_max_m =
-      profile_.mounting.kind == DockMountKind::kWall ? profile_.mounting.wall_gap_max_m : DockMounting{}.wall_gap_max_m;
   const Real band_hi = back_x_m_ + params_.inlier_gate_m;
-  const Real band_lo = back_x_m_ - gap_max_m - params_.inlier_gate_m;
+  const Real band_lo = back_x_m_ - wall_gap_max_m_ - params_.inlier_gate_m;
   std::size_t n = 0;
   for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
     std::size_t i = 0;
@@ -537,12 +538,11 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   // Returns on the wall the mounting allows behind the dock are the wall's, not a dock surface carrying on: a wall
   // a few centimetres behind a winged dock crosses the wings' lines just past their tips.
   const DockMountKind mount = profile_.mounting.kind;
-  const Real gap_max_m = mount == DockMountKind::kWall ? profile_.mounting.wall_gap_max_m : DockMounting{}.wall_gap_max_m;
   const Vec2 t_dock(r.pose.x_m, r.pose.y_m);
   const Vec2& x_dock = placed_.x_axis;
   auto wall_band = [&](const Vec2& p) {
     const Real x = x_dock.dot(p - t_dock);
-    return x < back_x_m_ + gate && x > back_x_m_ - gap_max_m - gate;
+    return x < back_x_m_ + gate && x > back_x_m_ - wall_gap_max_m_ - gate;
   };
   const bool check_band = mount != DockMountKind::kFreeStanding;
   for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {

@@ -329,6 +329,7 @@ class DockPoseEstimatorBase {
   Real profile_radius_m_ = 0;  // largest vertex distance from the dock origin
   Real back_x_m_ = 0;          // the profile's back plane: its smallest x
   Real half_width_m_ = 0;      // largest |y| of the profile
+  Real wall_gap_max_m_ = 0;    // farthest the wall may lie behind the back plane (the mounting's, or the default)
   // Per segment: the largest line distance at which registration keeps a beam on it unsearched (0: never).
   Real shortcut_max_m_[kMaxProfileVertices] = {};
   EstimatorCounters counters_{};
