@@ -38,6 +38,15 @@ FootprintParams circular_footprint() {
 
 void ObstacleChecker::configure(const FootprintParams& footprint, const DockProfile* profile) {
   fp_ = footprint;
+  // Every zone check() tests (the check boxes, the body, the rotation circle) lies within this of the centre.
+  const Real box_x = body_front_m() + fp_.check_length_m;
+  const Real half_w = fp_.check_width_m * static_cast<Real>(0.5);
+  const Real box_reach = std::sqrt(box_x * box_x + half_w * half_w);
+  const Real body_reach = fp_.shape == FootprintShape::kCircular
+                              ? fp_.radius_m
+                              : std::sqrt(fp_.half_length_m * fp_.half_length_m + fp_.half_width_m * fp_.half_width_m);
+  reach_m_ = box_reach > body_reach ? box_reach : body_reach;
+  reach_m_ = reach_m_ > fp_.circumscribed_radius_m ? reach_m_ : fp_.circumscribed_radius_m;
   have_profile_ = profile != nullptr && profile->vertex_count >= 2;
   if (have_profile_) {
     profile_ = *profile;
@@ -112,18 +121,10 @@ ObstacleFlags ObstacleChecker::check(const ScanView& scan, const Pose2& lidar_mo
   const Real front = body_front_m();
   const Real half_w = fp_.check_width_m * static_cast<Real>(0.5);
   const Real r_rot2 = fp_.circumscribed_radius_m * fp_.circumscribed_radius_m;
-  // Every zone below (the check boxes, the body, the rotation circle) lies within reach_m of the robot's centre, and
-  // a return r from the lidar lies at least r - |mount| from it: beyond that, skip the trigonometry (most beams of
-  // a room). The margin keeps rounding from deciding.
-  const Real box_x = front + fp_.check_length_m;
-  const Real box_reach = std::sqrt(box_x * box_x + half_w * half_w);
-  const Real body_reach = fp_.shape == FootprintShape::kCircular
-                              ? fp_.radius_m
-                              : std::sqrt(fp_.half_length_m * fp_.half_length_m + fp_.half_width_m * fp_.half_width_m);
-  Real reach_m = box_reach > body_reach ? box_reach : body_reach;
-  reach_m = reach_m > fp_.circumscribed_radius_m ? reach_m : fp_.circumscribed_radius_m;
+  // A return r from the lidar lies at least r - |mount| from the robot's centre: beyond every zone's reach it can flag
+  // nothing, so it is skipped before its trigonometry (most beams of a room). The margin keeps rounding from deciding.
   const Real skip_beyond_m =
-      reach_m + std::sqrt(lidar_mount.x_m * lidar_mount.x_m + lidar_mount.y_m * lidar_mount.y_m) +
+      reach_m_ + std::sqrt(lidar_mount.x_m * lidar_mount.x_m + lidar_mount.y_m * lidar_mount.y_m) +
       static_cast<Real>(0.001);
   bool have_nearest = false;
   for (std::size_t i = 0; i < n; ++i) {

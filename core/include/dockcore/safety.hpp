@@ -27,6 +27,7 @@
 /// the profile test). No heap.
 
 #include <cstdint>
+#include <limits>
 
 #include "dockcore/controller.hpp"
 #include "dockcore/dock_profile.hpp"
@@ -124,6 +125,7 @@ class ObstacleChecker {
   DockProfile profile_{};
   bool have_profile_ = false;
   Real profile_max_x_m_ = 0;
+  Real reach_m_ = std::numeric_limits<Real>::infinity();  // farthest any check zone lies from the centre (configure)
 };
 
 /// When a commanded twist counts as a rotation for the rotation check: |wz| at least `min_wz_radps` while |vx| is
