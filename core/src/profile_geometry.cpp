@@ -93,13 +93,31 @@ void PlacedProfile::angular_span(Real* lo_rad, Real* hi_rad) const {
   // Each vertex's bearing relative to the first, from the cross and dot products: already within (-pi, pi].
   const Vec2& a = v_m[0];
   const Real ref = std::atan2(a.y(), a.x());
+  // While every vertex lies within 90 degrees of the first, the sign of a cross product orders two bearings exactly,
+  // so only the two extreme vertices need an arctangent. Otherwise (a sensor almost inside the dock) each does.
+  bool half_plane = true;
+  std::size_t i_lo = 0;
+  std::size_t i_hi = 0;
+  for (std::size_t i = 1; i <= segments && half_plane; ++i) {
+    const Vec2& b = v_m[i];
+    half_plane = a.dot(b) > 0;
+    const Vec2& l = v_m[i_lo];
+    const Vec2& h = v_m[i_hi];
+    if (l.x() * b.y() - l.y() * b.x() < 0) i_lo = i;
+    if (h.x() * b.y() - h.y() * b.x() > 0) i_hi = i;
+  }
   Real lo = 0;
   Real hi = 0;
-  for (std::size_t i = 1; i <= segments; ++i) {
-    const Vec2& b = v_m[i];
-    const Real rel = std::atan2(a.x() * b.y() - a.y() * b.x(), a.x() * b.x() + a.y() * b.y());
-    lo = rel < lo ? rel : lo;
-    hi = rel > hi ? rel : hi;
+  auto rel = [&a](const Vec2& b) { return std::atan2(a.x() * b.y() - a.y() * b.x(), a.x() * b.x() + a.y() * b.y()); };
+  if (half_plane) {
+    if (i_lo != 0) lo = rel(v_m[i_lo]);
+    if (i_hi != 0) hi = rel(v_m[i_hi]);
+  } else {
+    for (std::size_t i = 1; i <= segments; ++i) {
+      const Real r = rel(v_m[i]);
+      lo = r < lo ? r : lo;
+      hi = r > hi ? r : hi;
+    }
   }
   *lo_rad = ref + lo;
   *hi_rad = ref + hi;

@@ -47,7 +47,8 @@ for d in ("estimator", "estimator-tracking", "breakpoint", "vmarker"):
                   tag + "mean %d outside the per-scan range %d..%d"
                   % (r["instructions_per_scan"], r["per_scan_min"], r["per_scan_max"]))
         check(r["ns_per_scan_median"] > 0, tag + "no native timing")
-        check(len(r["top_self"]) == 3 and r["top_self"][0]["share"] > 0.1, tag + "top functions")
+        # At most --top functions: a detector may spend its instructions in fewer.
+        check(1 <= len(r["top_self"]) <= 3 and r["top_self"][0]["share"] > 0.1, tag + "top functions")
         check(all(t["function"].startswith("dockcore::") or "::" not in t["function"] for t in r["top_self"]),
               tag + "top function outside core: %s" % [t["function"] for t in r["top_self"]])
     # Collection really is per scan: twice the points, between 1.3x and 3x the instructions. Tracking reads only

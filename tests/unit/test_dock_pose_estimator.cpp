@@ -318,7 +318,44 @@ Real reference_distance(const PlacedProfile& pp, const Vec2& p, std::size_t i) {
   return (p - pp.v_m[i] - u * d).norm();
 }
 
+// The angular span as every vertex's bearing relative to the first gives it (one arctangent each).
+void check_angular_span(const PlacedProfile& pp, double tol) {
+  const Vec2& a = pp.v_m[0];
+  Real lo_ref = 0;
+  Real hi_ref = 0;
+  for (std::size_t i = 1; i <= pp.segments; ++i) {
+    const Vec2& b = pp.v_m[i];
+    const Real rel = std::atan2(a.x() * b.y() - a.y() * b.x(), a.x() * b.x() + a.y() * b.y());
+    lo_ref = std::fmin(lo_ref, rel);
+    hi_ref = std::fmax(hi_ref, rel);
+  }
+  const Real ref = std::atan2(a.y(), a.x());
+  Real lo = 0;
+  Real hi = 0;
+  pp.angular_span(&lo, &hi);
+  DOUBLES_EQUAL(ref + lo_ref, lo, tol);
+  DOUBLES_EQUAL(ref + hi_ref, hi, tol);
+}
+
 }  // namespace
+
+TEST(DockPoseEstimator, AngularSpanAgreesWithEveryVertexBearing) {
+  // Far poses take the two-arctangent path; poses with the sensor at or inside the dock's outline (vertices more
+  // than 90 degrees apart as seen from it) take the per-vertex one. Both must give the plain answer.
+  docksim::Rng rng(12);
+  auto uniform = [&rng](double lo, double hi) { return static_cast<Real>(rng.uniform(lo, hi)); };
+  const double tol = dockcore_test::real_tol(1.0, 1e-12, 16);
+  static PlacedProfile pp;
+  for (const char* name : {"plate-v", "v-marker", "breakpoint"}) {
+    const DockProfile prof = profile(name);
+    for (int trial = 0; trial < 500; ++trial) {
+      const Real d = trial % 2 == 0 ? uniform(0.3, 3.0) : uniform(0.0, 0.15);
+      const Real bearing = uniform(-kPi, kPi);
+      pp.place(prof, Pose2{d * std::cos(bearing), d * std::sin(bearing), uniform(-kPi, kPi)});
+      check_angular_span(pp, tol);
+    }
+  }
+}
 
 TEST(DockPoseEstimator, PlacedProfileQueriesAgreeWithThePlainFormulas) {
   // Every built-in profile at many poses: the side-test ray cast, the division-free nearest segment, and the
@@ -350,6 +387,7 @@ TEST(DockPoseEstimator, PlacedProfileQueriesAgreeWithThePlainFormulas) {
         }
         max_line[i] = static_cast<Real>(0.45) * clearance;
       }
+      check_angular_span(pp, tol);
       const Real bearing = std::atan2(pose.y_m, pose.x_m);
       for (int k = 0; k < 40; ++k) {
         const Real a = bearing + uniform(-0.4, 0.4);

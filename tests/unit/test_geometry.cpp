@@ -4,6 +4,9 @@
 
 #include "real_tolerance.hpp"
 
+#include <cmath>
+#include <limits>
+
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
@@ -16,6 +19,35 @@ TEST(Geometry, WrapAngleStaysInHalfOpenInterval) {
   // The input angle itself is rounded to Real at its own magnitude (63 rad: 4e-6 in float), so that is the scale.
   DOUBLES_EQUAL(0.5, wrap_angle(0.5 + 10 * kTwoPi), dockcore_test::real_tol(10 * kTwoPi, 1e-9));
   DOUBLES_EQUAL(-0.5, wrap_angle(-0.5 - 3 * kTwoPi), dockcore_test::real_tol(3 * kTwoPi, 1e-9));
+}
+
+TEST(Geometry, WrapAngleIsTheRemainderBitForBit) {
+  // The subtraction wrap_angle takes within three half-turns must give exactly what std::remainder gives, on both
+  // sides of every branch boundary (pi, 3 pi and their negatives, where the remainder's ties round to even).
+  auto reference = [](Real a) {
+    Real r = std::remainder(a, kTwoPi);
+    if (r <= -kPi) r += kTwoPi;
+    return r;
+  };
+  int checked = 0;
+  for (const Real edge : {kPi, 3 * kPi, -kPi, -3 * kPi, static_cast<Real>(0), kTwoPi, -kTwoPi}) {
+    Real below = edge;
+    Real above = edge;
+    for (int k = 0; k < 64; ++k) {
+      for (const Real a : {below, above}) {
+        CHECK_TRUE(wrap_angle(a) == reference(a));
+        ++checked;
+      }
+      below = std::nextafter(below, -std::numeric_limits<Real>::infinity());
+      above = std::nextafter(above, std::numeric_limits<Real>::infinity());
+    }
+  }
+  for (int k = -4000; k <= 4000; ++k) {
+    const Real a = static_cast<Real>(k) * static_cast<Real>(0.00377);  // about +-15 rad, off any grid of pi
+    CHECK_TRUE(wrap_angle(a) == reference(a));
+    ++checked;
+  }
+  CHECK_EQUAL(7 * 64 * 2 + 8001, checked);
 }
 
 TEST(Geometry, ComposeWithInverseIsIdentity) {
