@@ -21,6 +21,15 @@ constexpr Real kStopSigmas = static_cast<Real>(0.2);
 // Registration keeps the previous iteration's beams and association when its last step moved no point of the dock by
 // more than this; after a larger step it takes the span's beams and searches every segment again.
 constexpr Real kReuseStepM = static_cast<Real>(0.02);
+// Window centres of the global search (add_window_hypotheses) lie at least this many scan points apart, and an
+// eighth of a window apart on dense scans: kept windows are a quarter of a segment apart, so centres in between add
+// nothing their neighbours do not.
+constexpr std::size_t kWindowStride = 2;
+constexpr std::size_t kWindowStepsPerWindow = 8;
+// Rays a prescore casts at most: it only ranks hypotheses, so on a dense scan a sample of the span's beams will do.
+constexpr std::size_t kPrescoreRays = 32;
+// Beams registration fits at most while its steps are large (above kReuseStepM).
+constexpr std::size_t kCoarseBeams = 64;
 
 // Association with no segment yet (assoc_seg_).
 constexpr std::uint8_t kNoSegment = 0xFF;
@@ -348,7 +357,7 @@ long DockPoseEstimatorBase::first_beam(Real angle_rad) const {
   return static_cast<long>(std::floor(rel / angle_inc_rad_ + R(0.5)));
 }
 
-DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initial) {
+DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initial, bool rough) {
   Refined out{};
   out.pose = initial;
   out.ok = false;
@@ -360,6 +369,7 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
   // against its previous segment, and searched again among all segments only when it nears that segment's ends.
   std::size_t n_assoc = 0;
   Real last_step_m = std::numeric_limits<Real>::infinity();
+  bool coarse = false;
   for (std::uint8_t it = 0; it < params_.max_iterations; ++it) {
     placed_.place(profile_, pose);
     const Real dist_m = std::sqrt(pose.x_m * pose.x_m + pose.y_m * pose.y_m);
@@ -372,8 +382,19 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
     const Vec2& nd = placed_.x_axis;
     // The beams to fit: every return in the dock's span plus a margin, taken again early on and kept later, with
     // wall points beside the dock left out (the wall explains them, not the dock's sides).
-    const bool reuse = last_step_m <= kReuseStepM && n_assoc > 0;
-    if (!reuse) n_assoc = span_beams(dist_m, t, nd);
+    const bool reuse = last_step_m <= kReuseStepM && n_assoc > 0 && !coarse;
+    if (!reuse) {
+      n_assoc = span_beams(dist_m, t, nd);
+      // While the steps are large, a sample of a dense span moves the pose as well as every beam would: every
+      // stride-th beam, at most kCoarseBeams. Once the steps are small the full span is taken.
+      coarse = rough && last_step_m > kReuseStepM && n_assoc > 2 * kCoarseBeams;
+      if (coarse) {
+        const std::size_t stride = n_assoc / kCoarseBeams;
+        std::size_t kept = 0;
+        for (std::size_t k = 0; k < n_assoc; k += stride) assoc_beam_[kept++] = assoc_beam_[k];
+        n_assoc = kept;
+      }
+    }
     // Normal equations, upper triangle (h is symmetric), as scalars so they stay in registers.
     Real h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0, g0 = 0, g1 = 0, g2 = 0;
     std::uint16_t used = 0;
@@ -459,7 +480,7 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
     // deviation changes nothing the covariance can see. IRLS converges only linearly, so a fixed step size in
     // metres would spend most iterations on digits below the noise.
     const Real step_sq = delta.dot(h * delta);
-    if (step_sq < kStopSigmas * kStopSigmas * params_.range_sigma_m * params_.range_sigma_m) break;
+    if (!coarse && step_sq < kStopSigmas * kStopSigmas * params_.range_sigma_m * params_.range_sigma_m) break;
   }
   out.pose = pose;
   out.ok = out.iterations > 0;
@@ -688,8 +709,11 @@ Real DockPoseEstimatorBase::prescore(const Pose2& pose) {
   const long first = first_beam(lo);
   const Real gate = 2 * params_.inlier_gate_m;
   Real score = 0;
-  // Every other beam: ranking only needs a rough count, refinement and verification look at all of them.
-  for (std::size_t k = 0; k < n_beams && k < beams_; k += 2) {
+  // Every other beam, and no more than kPrescoreRays: ranking only needs a rough count, refinement and verification
+  // look at all of them. Each ray counts for the beams it stands for, so near and far hypotheses compare fairly.
+  const std::size_t step = n_beams > 2 * kPrescoreRays ? n_beams / kPrescoreRays : 2;
+  const Real per_ray = static_cast<Real>(step) * R(0.5);
+  for (std::size_t k = 0; k < n_beams && k < beams_; k += step) {
     std::size_t i = 0;
     if (!beam_at(first, k, &i)) continue;
     Real expected_m = 0;
@@ -697,9 +721,9 @@ Real DockPoseEstimatorBase::prescore(const Pose2& pose) {
     if (!placed_.raycast(dir_[i], &expected_m, &seg)) continue;
     const Real m = range_at(i);
     if (m != 0 && std::fabs(m - expected_m) <= gate) {
-      score += 1;
+      score += per_ray;
     } else if (m == 0 || m > expected_m) {
-      score -= 2;  // seeing through the dock is strong evidence against it
+      score -= 2 * per_ray;  // seeing through the dock is strong evidence against it
     }
   }
   return score;
@@ -707,10 +731,12 @@ Real DockPoseEstimatorBase::prescore(const Pose2& pose) {
 
 void DockPoseEstimatorBase::push_hypothesis(const Vec2& n_scan, const Vec2& anchor_scan, const Vec2& anchor_dock,
                                         std::size_t profile_segment, std::size_t* n) {
+  // The rotation taking the profile's unit normal onto the scan's: cosine and sine straight from the dot and cross
+  // products (both normals are unit), so only the reported yaw needs an arctangent.
   const Vec2 n_j = profile_.normal(profile_segment);
-  const Real yaw = wrap_angle(std::atan2(n_scan.y(), n_scan.x()) - std::atan2(n_j.y(), n_j.x()));
-  const Real c = std::cos(yaw);
-  const Real s = std::sin(yaw);
+  const Real c = n_j.dot(n_scan);
+  const Real s = n_j.x() * n_scan.y() - n_j.y() * n_scan.x();
+  const Real yaw = std::atan2(s, c);
   const Vec2 t = anchor_scan - Vec2(c * anchor_dock.x() - s * anchor_dock.y(), s * anchor_dock.x() + c * anchor_dock.y());
   if (*n >= kMaxHypotheses) {
     ++counters_.truncated_candidates;
@@ -736,8 +762,21 @@ struct RunningMoments {
     sxy += sign * d.x() * d.y();
     syy += sign * d.y() * d.y();
   }
-  // Total-least-squares line: centroid, unit normal and mean squared orthogonal residual.
-  void fit(Vec2* centroid, Vec2* normal, Real* msr) const {
+  // Mean squared orthogonal residual of the total-least-squares line: the smaller eigenvalue of the covariance.
+  // Cheap (one square root), so a window is tested before its line is worked out.
+  Real msr() const {
+    const Real mx = sx / n;
+    const Real my = sy / n;
+    const Real cxx = sxx / n - mx * mx;
+    const Real cxy = sxy / n - mx * my;
+    const Real cyy = syy / n - my * my;
+    const Real half_diff = (cxx - cyy) * R(0.5);
+    const Real lo = (cxx + cyy) * R(0.5) - std::sqrt(half_diff * half_diff + cxy * cxy);
+    return lo > 0 ? lo : 0;
+  }
+  // The line itself: centroid and unit normal. The principal axis is the eigenvector of the larger eigenvalue,
+  // taken from whichever of the two equivalent forms has the larger components (no trigonometry).
+  void line(Vec2* centroid, Vec2* normal) const {
     const Real mx = sx / n;
     const Real my = sy / n;
     const Real cxx = sxx / n - mx * mx;
@@ -745,11 +784,12 @@ struct RunningMoments {
     const Real cyy = syy / n - my * my;
     const Real half_diff = (cxx - cyy) * R(0.5);
     const Real root = std::sqrt(half_diff * half_diff + cxy * cxy);
-    const Real theta = R(0.5) * std::atan2(2 * cxy, cxx - cyy);  // direction of the principal axis
+    // lambda_max - cyy = half_diff + root and lambda_max - cxx = root - half_diff: add, never cancel.
+    Vec2 axis = half_diff >= 0 ? Vec2(half_diff + root, cxy) : Vec2(cxy, root - half_diff);
+    const Real len = axis.norm();
+    axis = len > 0 ? Vec2(axis / len) : Vec2(1, 0);
     *centroid = origin + Vec2(mx, my);
-    *normal = Vec2(-std::sin(theta), std::cos(theta));
-    const Real lo = (cxx + cyy) * R(0.5) - root;
-    *msr = lo > 0 ? lo : 0;
+    *normal = Vec2(-axis.y(), axis.x());
   }
 };
 
@@ -759,12 +799,16 @@ void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
   // Split the points into contiguous runs (no range gap), in circular order on a full-turn scan.
   const std::size_t np = points_.size();
   if (np < 5) return;
-  auto gap_after = [this, np](std::size_t k) {
+  // Where a depth gap follows a point, worked out once for every profile segment's pass. assoc_seg_ holds nothing
+  // until registration starts, so it serves as the scratch flags.
+  std::uint8_t* const gap = assoc_seg_;
+  for (std::size_t k = 0; k < np; ++k) {
     const ScanPoint& a = points_[k];
     const ScanPoint& b = points_[(k + 1) % np];
-    const Real allowed = std::fmax(R(0.05), 5 * a.range_m * angle_inc_rad_);
-    return (b.p_m - a.p_m).norm() > allowed;
-  };
+    const Real allowed = 5 * a.range_m * angle_inc_rad_ > R(0.05) ? 5 * a.range_m * angle_inc_rad_ : R(0.05);
+    gap[k] = (b.p_m - a.p_m).squaredNorm() > allowed * allowed ? 1 : 0;
+  }
+  auto gap_after = [gap](std::size_t k) { return gap[k] != 0; };
   // Start just after a gap so no run is cut by the array's end (only matters when the scan wraps).
   std::size_t start = 0;
   if (wraps_) {
@@ -784,6 +828,9 @@ void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
     if (len_j < params_.min_feature_length_m) continue;
     const Vec2 mid_j = (a_j + b_j) * R(0.5);
     const Real half = len_j * R(0.5);
+    const Real half_sq = half * half;
+    const Real min_span_sq = R(0.49) * len_j * len_j;     // the window spans 70 % of the segment at least
+    const Real min_apart_sq = R(0.0625) * len_j * len_j;  // kept windows a quarter of the segment apart
     std::size_t run_lo = 0;  // positions in circular order, relative to start
     while (run_lo < np) {
       std::size_t run_hi = run_lo;
@@ -795,21 +842,23 @@ void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
       std::size_t hi = run_lo;
       m.add(at(run_lo), 1);
       Vec2 last_kept(std::numeric_limits<Real>::max(), 0);
-      for (std::size_t c = run_lo; c <= run_hi; ++c) {
+      std::size_t step = kWindowStride;
+      for (std::size_t c = run_lo; c <= run_hi; c += step) {
         const Vec2& pc = at(c);
-        while (hi + 1 <= run_hi && (at(hi + 1) - pc).norm() <= half) m.add(at(++hi), 1);
-        while (lo < c && (at(lo) - pc).norm() > half) m.add(at(lo++), -1);
-        if (m.n < 5 || (at(hi) - at(lo)).norm() < R(0.7) * len_j) continue;
+        while (hi + 1 <= run_hi && (at(hi + 1) - pc).squaredNorm() <= half_sq) m.add(at(++hi), 1);
+        while (lo < c && (at(lo) - pc).squaredNorm() > half_sq) m.add(at(lo++), -1);
+        const std::size_t in_window = hi - lo + 1;
+        step = in_window > kWindowStride * kWindowStepsPerWindow ? in_window / kWindowStepsPerWindow : kWindowStride;
+        if (m.n < 5 || (at(hi) - at(lo)).squaredNorm() < min_span_sq) continue;
+        if (m.msr() > gate * gate) continue;
         Vec2 centroid;
         Vec2 normal;
-        Real msr = 0;
-        m.fit(&centroid, &normal, &msr);
-        if (msr > gate * gate) continue;
+        m.line(&centroid, &normal);
         // The surface must stop at one end at least: the middle of a wall is not a dock feature.
         const bool lo_break = lo == run_lo || std::fabs(normal.dot(at(lo - 1) - centroid)) > break_m;
         const bool hi_break = hi == run_hi || std::fabs(normal.dot(at(hi + 1) - centroid)) > break_m;
         if (!lo_break && !hi_break) continue;
-        if ((centroid - last_kept).norm() < R(0.25) * len_j) continue;  // neighbours of a kept window add nothing
+        if ((centroid - last_kept).squaredNorm() < min_apart_sq) continue;  // neighbours of a kept window add nothing
         last_kept = centroid;
         if (normal.dot(centroid) > 0) normal = -normal;  // face the lidar
         push_hypothesis(normal, centroid, mid_j, j, n);
@@ -843,9 +892,11 @@ std::size_t DockPoseEstimatorBase::generate_candidates() {
       const Vec2 d_j = (b_j - a_j) / len_j;
       const Vec2 n_j = profile_.normal(j);
       const Vec2 d_s = seg.direction();
-      // Rotation taking n_j to seg.normal, applied to d_j, compared with the scan direction.
-      const Real yaw = std::atan2(seg.normal.y(), seg.normal.x()) - std::atan2(n_j.y(), n_j.x());
-      const Vec2 d_rot(std::cos(yaw) * d_j.x() - std::sin(yaw) * d_j.y(), std::sin(yaw) * d_j.x() + std::cos(yaw) * d_j.y());
+      // Rotation taking n_j to seg.normal (cosine and sine from the unit normals), applied to d_j, compared with
+      // the scan direction.
+      const Real c = n_j.dot(seg.normal);
+      const Real s = n_j.x() * seg.normal.y() - n_j.y() * seg.normal.x();
+      const Vec2 d_rot(c * d_j.x() - s * d_j.y(), s * d_j.x() + c * d_j.y());
       const bool same_dir = d_rot.dot(d_s) > 0;
       const Vec2& sa = same_dir ? seg.start_m : seg.end_m;
       const Vec2& sb = same_dir ? seg.end_m : seg.start_m;
@@ -904,7 +955,7 @@ DockEstimate DockPoseEstimatorBase::estimate(const ScanView& scan, const Pose2& 
   // same no-points test a hint-less scan gets.
   Refined hinted{};
   if (hint != nullptr) {
-    hinted = refine(hint_lidar);
+    hinted = refine(hint_lidar, false);
     decide(hinted, &hint_lidar);
   }
   const bool hint_holds = hint != nullptr && hinted.ok &&
@@ -968,7 +1019,7 @@ DockEstimate DockPoseEstimatorBase::estimate(const ScanView& scan, const Pose2& 
                                   std::fabs(wrap_angle(hyps_[k].pose.yaw_rad - verified_poses[q].yaw_rad)) < R(0.1));
       }
       if (duplicate) continue;
-      Refined r = refine(hyps_[k].pose);
+      Refined r = refine(hyps_[k].pose, true);
       decide(r, hint != nullptr ? &hint_lidar : nullptr);
       consider(r, false);
       if (r.ok && done < 8) verified_poses[done++] = r.pose;

@@ -130,7 +130,7 @@ struct EstimatorParams {
   Real tukey_c = static_cast<Real>(3.0);          ///< Tukey biweight cut-off in units of range_sigma_m (after).
   Real association_gate_m = static_cast<Real>(0.08);  ///< Points farther from every visible segment are ignored.
   Real inlier_gate_m = static_cast<Real>(0.03);   ///< |measured − expected| below this is an inlier.
-  std::uint8_t max_iterations = 10;               ///< Gauss-Newton cap per candidate.
+  std::uint8_t max_iterations = 6;                ///< Gauss-Newton cap per candidate.
   std::uint8_t max_candidates = 12;               ///< Hypotheses refined per scan at most (best prescore first).
   Real min_feature_length_m = static_cast<Real>(0.08);  ///< Profile segments shorter than this seed no hypotheses.
   /// Returns this close in front of the expected surface count against the dock (free-space cue), not as
@@ -265,7 +265,10 @@ class DockPoseEstimatorBase {
   std::size_t valid_beams();
   /// Fills points_ from the loaded beams (global search only).
   void build_points();
-  Refined refine(const Pose2& initial);
+  /// Gauss-Newton registration from `initial` (dock in lidar frame). `rough`: the start may be centimetres off (a
+  /// global-search hypothesis), so large steps fit a sample of a dense span; a hint refines on every beam from the
+  /// start. O(I · W · S) for I iterations over the W beams of the dock's span and S profile segments.
+  Refined refine(const Pose2& initial, bool rough);
   /// Fills the association list (assoc_beam_, no segment yet) with the returns in placed_'s angular span plus the
   /// association gate's margin, leaving out wall points beside a mounted dock. `t`, `nd`: the dock's position and
   /// x axis in the lidar frame, `dist_m` = |t|. Returns how many. O(beams in the span).
