@@ -21,11 +21,11 @@ constexpr Real kStopSigmas = static_cast<Real>(0.2);
 // Registration keeps the previous iteration's beams and association when its last step moved no point of the dock by
 // more than this; after a larger step it takes the span's beams and searches every segment again.
 constexpr Real kReuseStepM = static_cast<Real>(0.02);
-// Window centres of the global search (add_window_hypotheses) lie at least this many scan points apart, and an
-// eighth of a window apart on dense scans: kept windows are a quarter of a segment apart, so centres in between add
-// nothing their neighbours do not.
-constexpr std::size_t kWindowStride = 2;
-constexpr std::size_t kWindowStepsPerWindow = 8;
+// Window centres of the global search (add_window_hypotheses) step one scan point, or a sixteenth of the window's
+// points on a dense scan: kept windows are a quarter of a segment apart, so finer steps add nothing there. (Every
+// other point at 720 beams costs detection of near docks.)
+constexpr std::size_t kWindowStride = 1;
+constexpr std::size_t kWindowStepsPerWindow = 16;
 // Rays a prescore casts at most: it only ranks hypotheses, so on a dense scan a sample of the span's beams will do.
 constexpr std::size_t kPrescoreRays = 32;
 // Beams registration fits at most while its steps are large (above kReuseStepM).
