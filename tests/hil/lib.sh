@@ -72,7 +72,8 @@ make_dockd_config() {
   sed -e "s|@OUT@|$OUT|g" "$@" "$SRC/tests/hil/dockd-hil.toml" > "$OUT/dockd.toml"
 }
 
-DOCKCTL() { "$BUILD/app/dockctl" --port 7300 --timeout 2 "$@"; }
+# DOCKCTL_TIMEOUT_S: how long dockctl waits for the reply (dockd under memcheck answers slowly).
+DOCKCTL() { "$BUILD/app/dockctl" --port 7300 --timeout "${DOCKCTL_TIMEOUT_S:-2}" "$@"; }
 
 # Current task state name from dockd over UDP ("" when dockd does not answer).
 dock_state() { DOCKCTL status 2>/dev/null | sed -n 's/.*"state":"\([A-Z_]*\)".*/\1/p'; }

@@ -11,10 +11,11 @@ bg dockd valgrind --tool=memcheck --error-exitcode=99 --leak-check=full --errors
 check dockd_up_under_memcheck wait_for 240 state_is NOT_TASKING
 DOCKCTL dock --dock 0 > "$OUT/dock.json" || true
 sleep 15
-DOCKCTL --timeout 10 status > "$OUT/status.json" || true
+DOCKCTL_TIMEOUT_S=10 DOCKCTL status > "$OUT/status.json" || true
 DOCKCTL stop > /dev/null || true
 stop_bg "$PID_dockd" TERM
 echo "INFO dockd under memcheck exit $STOP_STATUS; status: $(cut -c1-160 "$OUT/status.json")"
 grep -E "total heap usage|ERROR SUMMARY|definitely lost|indirectly lost|possibly lost" "$OUT/memcheck.txt" | sed 's/^==[0-9]*== /INFO /'
+check status_answered_under_memcheck grep -q '"state":' "$OUT/status.json"
 check memcheck_exit_0 test "$STOP_STATUS" -eq 0
 check memcheck_no_errors grep -q "ERROR SUMMARY: 0 errors" "$OUT/memcheck.txt"
