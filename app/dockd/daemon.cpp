@@ -59,7 +59,6 @@ Daemon::Daemon(const DockdConfig& config, const DaemonIo& io)
       seed004_(config.seed004),
       seed003_(config.seed003),
       smooth_(config.smooth),
-      scan_(std::make_unique<dockcore::LaserScan>()),
       teach_storage_(std::make_unique<Teach>()),
       teach_(*teach_storage_) {
   build_core();
@@ -176,12 +175,14 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
   }
   DockdConfig old = cfg_;
   cfg_ = *next;
+  // The old core holds the latest scan (dockd keeps no copy of its own): alive until the new core has it.
+  const std::unique_ptr<dockcore::Dockcore> previous = std::move(core_);
   build_core();
-  if (!configure_core(cfg_.default_dock_id, false)) {
+  if (!configure_core(cfg_.default_dock_id, false, previous.get())) {
     // A profile the estimator refuses (validated configs do not have one): back to the old config entirely.
     cfg_ = old;
     build_core();
-    configure_core(cfg_.default_dock_id, false);
+    configure_core(cfg_.default_dock_id, false, previous.get());
     if (io_.udp_host != nullptr) io_.udp_host->set_allowlist(cfg_.host.allowlist, err);
     ++counters_.config_reloads_rejected;
     message = next->source + ": config reload rejected: dock profile refused by the estimator (the running "
@@ -199,7 +200,7 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
 dockcore::TaskState Daemon::state() const { return core_->task_manager().state(); }
 dockcore::FaultCode Daemon::fault() const { return core_->task_manager().fault(); }
 
-bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
+bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile, const dockcore::DockcoreBase* scan_from) {
   const DockEntry* d = cfg_.find_dock(dock_id);
   if (d == nullptr) return false;
   dockcore::DockProfile prof = d->profile;
@@ -212,14 +213,13 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
       prof = profile_for_target(d->profile, nominal, d->target);
     }
   }
+  // configure() forgets the scan: the latest one (the core's own copy, untouched by configure()) is handed back so
+  // the next tick does not see a lidar without data.
+  const dockcore::ScanView last = (scan_from != nullptr ? *scan_from : *core_).last_scan();
   if (!core_->configure(prof, core_cfg_)) return false;
   active_dock_ = dock_id;
   active_raw_ = raw_profile;
-  // configure() forgets the scan: hand the latest one back so the next tick does not see a lidar without data.
-  if (have_scan_ && !last_scan_late_) {
-    const std::uint64_t stamp = scan_->stamp_us != 0 ? scan_->stamp_us : last_scan_rx_us_;
-    core_->on_scan(scan_->view(), stamp, odom_at(stamp));
-  }
+  if (have_scan_ && !last_scan_late_ && last.count > 0) core_->on_scan(last, last.stamp_us, odom_at(last.stamp_us));
   return true;
 }
 
@@ -337,9 +337,11 @@ Pose2 Daemon::odom_at(std::uint64_t stamp_us) const {
 void Daemon::poll_lidar(std::uint64_t now_us) {
   // Only the newest scan matters (poll_scan keeps the newest); bounded to a few per call.
   const std::uint64_t max_period_us = std::max<std::uint64_t>(500000u, std::uint64_t{cfg_.lidar_stale_ms} * 1000u);
-  for (int i = 0; i < 4 && io_.lidar->poll_scan(*scan_); ++i) {
+  // The scan stays in the driver's buffer: the core reads it there (and copies it once, for its tick).
+  const dockcore::LaserScan* scan = nullptr;
+  for (int i = 0; i < 4 && (scan = io_.lidar->poll_scan()) != nullptr; ++i) {
     ++counters_.scans;
-    const std::uint64_t stamp = scan_->stamp_us != 0 && scan_->stamp_us <= now_us ? scan_->stamp_us : now_us;
+    const std::uint64_t stamp = scan->stamp_us != 0 && scan->stamp_us <= now_us ? scan->stamp_us : now_us;
     if (prev_scan_stamp_us_ != 0 && stamp > prev_scan_stamp_us_ && stamp - prev_scan_stamp_us_ <= max_period_us)
       scan_period_us_ = stamp - prev_scan_stamp_us_;
     prev_scan_stamp_us_ = stamp;
@@ -359,7 +361,7 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
     // The lidar counts as fresh from the second scan on, when the turn's length is known; the first one still feeds
     // the core.
     if (scan_period_us_ != 0 && turn_end_us > last_scan_rx_us_) last_scan_rx_us_ = turn_end_us;
-    const dockcore::DockEstimate& e = core_->on_scan(scan_->view(), stamp, odom_at(stamp));
+    const dockcore::DockEstimate& e = core_->on_scan(scan->view(), stamp, odom_at(stamp));
     if (e.found) {
       ++counters_.detections;
       if (teach_.active) teach_sample(e);

@@ -185,7 +185,8 @@ class Daemon {
   void reply_json(const dockcore::drivers::HostRequest& r, const char* json, std::size_t len);
   /// Configures Dockcore for `dock_id` (profile corrected by its taught / configured target). Resets the task
   /// manager: only while idle.
-  bool configure_core(std::uint16_t dock_id, bool raw_profile);
+  /// `scan_from`: the core whose latest scan the configured core is given (default: core_ itself).
+  bool configure_core(std::uint16_t dock_id, bool raw_profile, const dockcore::DockcoreBase* scan_from = nullptr);
   dockcore::Pose2 odom_at(std::uint64_t stamp_us) const;
   void watchdogs(std::uint64_t now_us);
   void start_teach(const dockcore::drivers::HostRequest& r, std::uint64_t now_us);
@@ -208,7 +209,6 @@ class Daemon {
   dockcore::SmoothController smooth_;
   dockcore::DockingController* controller_ = nullptr;
   std::unique_ptr<dockcore::Dockcore> core_;
-  std::unique_ptr<dockcore::LaserScan> scan_;
   std::unique_ptr<Teach> teach_storage_;
   Teach& teach_;
   dockcore::DockcoreConfig core_cfg_{};
@@ -233,7 +233,7 @@ class Daemon {
   std::uint64_t last_scan_rx_us_ = 0;
   std::uint64_t last_scan_parsed_us_ = 0;  ///< When dockd last parsed a usable (not late) scan.
   std::uint64_t prev_scan_stamp_us_ = 0;
-  bool last_scan_late_ = false;       ///< scan_ holds a late scan (not given to the core).
+  bool last_scan_late_ = false;       ///< The newest scan was late (not given to the core).
   std::uint64_t scan_period_us_ = 0;  ///< Spacing of the last two scan stamps, if plausible (≤ 0.5 s or lidar_stale_ms); 0 = unknown.
   dockcore::CameraTarget camera_{};
 

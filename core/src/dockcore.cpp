@@ -21,9 +21,15 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
 
 const DockEstimate& DockcoreBase::on_scan(const ScanView& scan, std::uint64_t stamp_us, const Pose2& odom_pose) {
   const std::size_t n = scan.count < scan_capacity_ ? scan.count : scan_capacity_;
-  for (std::size_t i = 0; i < n; ++i) {
-    scan_ranges_m_[i] = scan.ranges_m != nullptr ? scan.ranges_m[i] : static_cast<Real>(0);
-    scan_intensities_[i] = scan.intensities != nullptr ? scan.intensities[i] : static_cast<Real>(0);
+  // The tick's copy of the scan: the one copy a scan gets on its way from the parser (the estimator reads the
+  // caller's). A scan fed back from that copy (last_scan()) is already there.
+  scan_copy_bytes_ = 0;
+  if (scan.ranges_m != scan_ranges_m_) {
+    for (std::size_t i = 0; i < n; ++i) {
+      scan_ranges_m_[i] = scan.ranges_m != nullptr ? scan.ranges_m[i] : static_cast<Real>(0);
+      scan_intensities_[i] = scan.intensities != nullptr ? scan.intensities[i] : static_cast<Real>(0);
+    }
+    scan_copy_bytes_ = 2 * n * sizeof(Real);
   }
   scan_ = ScanView{scan_ranges_m_, scan_intensities_, n, scan.angle_min_rad, scan.angle_increment_rad, stamp_us};
   have_scan_ = true;

@@ -45,19 +45,20 @@ bool scan_lookup(const ScanView& scan, Real angle_rad, Real* range_m, Real* inte
 bool LidarScanAssembler::configure(std::uint32_t bins_per_turn, Real angle_min_rad) {
   if (bins_per_turn < 1 || bins_per_turn > kMaxScanPoints || !std::isfinite(angle_min_rad)) return false;
   bins_ = bins_per_turn;
+  angle_min_rad_ = angle_min_rad;
   increment_rad_ = kTwoPi / static_cast<Real>(bins_per_turn);
-  scan_.reset(bins_per_turn, angle_min_rad, increment_rad_, 0);
+  scan_->reset(bins_per_turn, angle_min_rad, increment_rad_, 0);
   samples_ = collisions_ = 0;
   return true;
 }
 
 void LidarScanAssembler::begin(std::uint64_t stamp_us) {
-  scan_.reset(bins_, scan_.angle_min_rad, increment_rad_, stamp_us);
+  scan_->reset(bins_, angle_min_rad_, increment_rad_, stamp_us);
   samples_ = collisions_ = 0;
 }
 
 std::uint32_t LidarScanAssembler::bin_of(Real angle_rad) const {
-  const Real a = wrap_angle_positive(angle_rad - scan_.angle_min_rad);
+  const Real a = wrap_angle_positive(angle_rad - angle_min_rad_);
   // Round to the nearest bin centre; the last half bin belongs to bin 0 (full turn).
   auto k = static_cast<std::uint32_t>(a / increment_rad_ + static_cast<Real>(0.5));
   if (k >= bins_) k -= bins_;
@@ -75,8 +76,8 @@ bool LidarScanAssembler::add(Real angle_rad, Real range_m, Real intensity) {
   // A bin is "filled" once any sample reached it. A no-return sample marks its bin with intensity -0 (equal to 0
   // for every reader, normalised on publish) so a later sample in that bin still counts as a collision without a
   // second array.
-  Real& slot_r = scan_.ranges_m[k];
-  Real& slot_i = scan_.intensities[k];
+  Real& slot_r = scan_->ranges_m[k];
+  Real& slot_i = scan_->intensities[k];
   const bool slot_filled = slot_r > 0 || std::signbit(slot_i);
   if (!slot_filled) {
     slot_r = r;
@@ -100,19 +101,28 @@ bool LidarScanOutput::configure(std::uint32_t bins_per_turn, Real angle_min_rad)
 
 void LidarScanOutput::publish(LidarParserCounters& c) {
   if (ready_) ++c.scans_overwritten;
-  ready_scan_ = building_.scan();
+  LaserScan& done = scans_[building_index_];
   // -0 sentinels (visited, no return) read as 0 everywhere, but normalise them so printed scans show plain 0.
-  for (std::size_t i = 0; i < ready_scan_.count; ++i)
-    if (ready_scan_.intensities[i] == 0) ready_scan_.intensities[i] = 0;
+  for (std::size_t i = 0; i < done.count; ++i)
+    if (done.intensities[i] == 0) done.intensities[i] = 0;
+  c.bin_collisions += building_.collisions();
+  ready_index_ = building_index_;
+  building_index_ ^= 1u;
+  building_.retarget(&scans_[building_index_]);
   ready_ = true;
   ++c.scans;
-  c.bin_collisions += building_.collisions();
+}
+
+const LaserScan* LidarScanOutput::take() {
+  if (!ready_) return nullptr;
+  ready_ = false;
+  return &scans_[ready_index_];
 }
 
 bool LidarScanOutput::take(LaserScan& out) {
-  if (!ready_) return false;
-  out = ready_scan_;
-  ready_ = false;
+  const LaserScan* s = take();
+  if (s == nullptr) return false;
+  out = *s;
   return true;
 }
 

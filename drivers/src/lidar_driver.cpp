@@ -121,10 +121,10 @@ std::size_t LidarDecoder::feed_datagram(const std::uint8_t* data, std::size_t n,
   return feed_bytes(data, n, stamp_us, 0);
 }
 
-bool LidarDecoder::take_scan(LaserScan& out) {
-  if (ld06_) return ld06_->take_scan(out);
-  if (rplidar_) return rplidar_->take_scan(out);
-  return lakibeam_->take_scan(out);
+const LaserScan* LidarDecoder::take_scan() {
+  if (ld06_) return ld06_->take_scan();
+  if (rplidar_) return rplidar_->take_scan();
+  return lakibeam_->take_scan();
 }
 
 void LidarDecoder::reset() {
@@ -184,11 +184,9 @@ class SerialLidarDriver final : public LidarDriver {
   }
   ~SerialLidarDriver() override { close_fd(); }
 
-  bool poll_scan(LaserScan& out) override {
+  const LaserScan* poll_scan() override {
     service(monotonic_us());
-    bool got = false;
-    while (decoder_.take_scan(out)) got = true;
-    return got;
+    return decoder_.take_scan();
   }
   int fd() const override { return fd_; }
   const hal::LidarCounters& counters() const override {
@@ -392,11 +390,9 @@ class UdpLidarDriver final : public LidarDriver {
     port_ = ntohs(bound.sin_port);
     return true;
   }
-  bool poll_scan(LaserScan& out) override {
+  const LaserScan* poll_scan() override {
     service(monotonic_us());
-    bool got = false;
-    while (decoder_.take_scan(out)) got = true;
-    return got;
+    return decoder_.take_scan();
   }
   int fd() const override { return fd_; }
   const hal::LidarCounters& counters() const override {

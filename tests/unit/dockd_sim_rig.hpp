@@ -64,11 +64,10 @@ struct SimLidar final : dockcore::hal::LidarSource {
   std::unique_ptr<dockcore::LaserScan> scan = std::make_unique<dockcore::LaserScan>();
   bool pending = false;
   dockcore::hal::LidarCounters c{};
-  bool poll_scan(dockcore::LaserScan& out) override {
-    if (!pending) return false;
-    out = *scan;
+  const dockcore::LaserScan* poll_scan() override {
+    if (!pending) return nullptr;
     pending = false;
-    return true;
+    return scan.get();
   }
   int fd() const override { return -1; }
   const dockcore::hal::LidarCounters& counters() const override { return c; }

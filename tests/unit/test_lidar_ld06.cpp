@@ -137,6 +137,44 @@ TEST(Ld06, StreamAssemblesTurnsAtTheWrap) {
   }
 }
 
+TEST(Ld06, TakenScanStaysInPlaceUntilTheNextOneIsPublished) {
+  // take_scan() without an argument hands out the parser's own buffer (no copy): it must not change while the
+  // next turn is built, and the next published turn must come in the other buffer.
+  auto p = make_parser();
+  const auto s = stream(120);  // 3 turns + 15 points
+  // Feed up to the first turn's end (the wrap inside packet 38 publishes turn 1, the partial first turn is dropped).
+  std::size_t off = 0;
+  while (p->counters().scans < 1 && off < s.size()) p->feed(&s[off++], 1, 5'000'000);
+  const LaserScan* first = p->take_scan();
+  CHECK(first != nullptr);
+  CHECK(p->take_scan() == nullptr);
+  const auto copy = std::make_unique<LaserScan>(*first);
+  // Most of the next turn: the taken scan is untouched.
+  const std::uint32_t samples_at_take = p->counters().samples;
+  while (off < s.size() && p->counters().samples < samples_at_take + 400) p->feed(&s[off++], 1, 5'000'000);
+  CHECK_EQUAL(1u, p->counters().scans);
+  CHECK_EQUAL(copy->count, first->count);
+  CHECK_EQUAL(copy->stamp_us, first->stamp_us);
+  for (std::size_t i = 0; i < copy->count; ++i) {
+    CHECK_TRUE(copy->ranges_m[i] == first->ranges_m[i]);
+    CHECK_TRUE(copy->intensities[i] == first->intensities[i]);
+  }
+  while (p->counters().scans < 2 && off < s.size()) p->feed(&s[off++], 1, 5'000'000);
+  const LaserScan* second = p->take_scan();
+  CHECK(second != nullptr);
+  CHECK(second != first);
+  CHECK_EQUAL(450u, second->count);
+  CHECK_TRUE(second->ranges_m[0] != copy->ranges_m[0]);  // ranges carry their packet's number
+  // The copying take gives what the in-place one would.
+  while (p->counters().scans < 3 && off < s.size()) p->feed(&s[off++], 1, 5'000'000);
+  const LaserScan& waiting = *p->take_scan();
+  const auto third = std::make_unique<LaserScan>(waiting);
+  CHECK_EQUAL(450u, third->count);
+  CHECK_TRUE(third->ranges_m[10] == waiting.ranges_m[10]);
+  CHECK_EQUAL(3u, p->counters().scans);
+  CHECK_EQUAL(0u, p->counters().scans_overwritten);
+}
+
 TEST(Ld06, ScanStampIsFirstPointTime) {
   // Arrival stamps (the test packets' timestamps are all 0); the sensor clock has its own tests below.
   auto p = std::make_unique<Ld06Parser>();

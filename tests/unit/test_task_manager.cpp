@@ -911,6 +911,31 @@ TEST(Dockcore, DocksWithTheRealEstimatorAndFilter) {
          sizeof(TaskManager), sizeof(DockPoseEstimator), sizeof(LaserScan));
 }
 
+TEST(Dockcore, ScanIsCopiedOnceAndItsOwnCopyCanBeFedBack) {
+  // on_scan() copies the scan once, for the tick; fed its own last_scan() (what dockd does after reconfiguring),
+  // it copies nothing and estimates the same dock.
+  FacadeSim f;
+  CHECK_EQUAL(0u, f.core->last_scan().count);
+  simulate_scan(f.w.world_model(), f.w.world, f.w.model, f.w.rng, &f.w.scan, f.w.now_us);
+  const DockEstimate first = f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.odom);
+  CHECK_TRUE(first.found);
+  CHECK_EQUAL(2 * f.w.scan.count * sizeof(Real), f.core->scan_copy_bytes());
+  const ScanView kept = f.core->last_scan();
+  CHECK_EQUAL(f.w.scan.count, kept.count);
+  CHECK_TRUE(kept.ranges_m != f.w.scan.ranges_m);
+  for (std::size_t i = 0; i < kept.count; ++i) CHECK_TRUE(kept.ranges_m[i] == f.w.scan.ranges_m[i]);
+  DockcoreConfig cfg;
+  cfg.task.detect_wait_s = 0.3;
+  CHECK(f.core->configure(f.w.profile, cfg));  // forgets the scan, keeps the copy's storage
+  CHECK_EQUAL(0u, f.core->last_scan().count);
+  const DockEstimate again = f.core->on_scan(kept, kept.stamp_us, f.w.odom);
+  CHECK_EQUAL(0u, f.core->scan_copy_bytes());
+  CHECK_EQUAL(kept.count, f.core->last_scan().count);
+  CHECK_TRUE(again.found);
+  CHECK_TRUE(again.pose.x_m == first.pose.x_m && again.pose.y_m == first.pose.y_m &&
+             again.pose.yaw_rad == first.pose.yaw_rad);
+}
+
 TEST(Dockcore, PushIsAFaultOnTheSecondScanAfterIt) {
   FacadeSim f;
   f.step(HostCommand{HostCommandType::kDock, 0});

@@ -15,7 +15,9 @@
 #include "commands.hpp"
 #include "detectors.hpp"
 #include "dockcore/breakpoint_detector.hpp"
+#include "dockcore/controllers.hpp"
 #include "dockcore/dock_pose_estimator.hpp"
+#include "dockcore/dockcore.hpp"
 #include "dockcore/dock_pose_filter.hpp"
 #include "dockcore/line_segments.hpp"
 #include "dockcore/vmarker_detector.hpp"
@@ -57,6 +59,7 @@ struct Options {
   int points = 720;
   int scans = 200;
   std::string cost_detector = "all";
+  bool cost_copies = false;
   // Real data (sections real, composite).
   std::string realdata_dir;                  // --realdata; empty: $DOCKCORE_REALDATA, else <repo>/../shared/realdata
   std::size_t real_limit = 0;                // scans per recording, 0 = all
@@ -396,10 +399,22 @@ json run_cost(const Options& o) {
         {"points", o.points}, {"scans", o.scans}, {"ns_per_scan_median", percentile(ns, 0.5)}, {"found", found}};
   };
   const dockcore::EstimatorParams params = params_for(0.010);
+  // The copies a scan gets on its way through the docking loop: the parser hands over its own buffer
+  // (LidarScanOutput::take()), the estimator reads it in place, and Dockcore copies it once, for its tick.
+  auto scan_bytes_copied = [&]() {
+    dockcore::SmoothController ctrl;
+    auto core = std::make_unique<dockcore::Dockcore>(ctrl);
+    dockcore::DockcoreConfig cfg;
+    cfg.estimator = params;
+    core->configure(prof, cfg);
+    core->on_scan(scans.front()->view(), scans.front()->stamp_us, Pose2{});
+    return core->scan_copy_bytes();
+  };
   if (want("estimator")) {
     auto est = std::make_unique<dockcore::DockPoseEstimator>();
     est->configure(prof, params);
     time_it("estimator", [&](const dockcore::ScanView& v) { return est->estimate(v, Pose2{}).found; });
+    if (o.cost_copies) out["estimator"]["scan_bytes_copied"] = scan_bytes_copied();
   }
   if (want("estimator-tracking")) {
     auto est = std::make_unique<dockcore::DockPoseEstimator>();
@@ -410,6 +425,7 @@ json run_cost(const Options& o) {
       if (e.found) last = e.pose;
       return e.found;
     });
+    if (o.cost_copies) out["estimator-tracking"]["scan_bytes_copied"] = scan_bytes_copied();
   }
   if (want("breakpoint")) {
     auto bp = std::make_unique<dockcore::BreakpointDetector>();
@@ -852,9 +868,12 @@ void print_text(const json& j) {
   if (j.contains("cost")) {
     std::printf("\n== Cost per scan\n");
     for (const auto& [det, c] : j["cost"].items()) {
-      std::printf("%-20s %5d points  median %10.0f ns/scan  (found in %d of %d scans)\n", det.c_str(),
+      std::printf("%-20s %5d points  median %10.0f ns/scan  (found in %d of %d scans)", det.c_str(),
                   c["points"].get<int>(), c["ns_per_scan_median"].get<double>(), c["found"].get<int>(),
                   c["scans"].get<int>());
+      if (c.contains("scan_bytes_copied"))
+        std::printf("  scan bytes copied: %zu (Dockcore's copy for the tick)", c["scan_bytes_copied"].get<std::size_t>());
+      std::printf("\n");
     }
   }
 }
@@ -918,6 +937,9 @@ void register_perception(CLI::App& app) {
       ->check(docksim::non_negative_integer());
   sub->add_flag("--json", o->json_out, "Print one JSON document instead of tables");
   sub->add_flag("--cost", o->cost, "Measure cost per scan instead (use with callgrind for instruction counts)");
+  sub->add_flag("--copies", o->cost_copies,
+                "Cost: also count the scan bytes the docking loop copies per scan (runs one Dockcore scan, so leave "
+                "it out under callgrind)");
   sub->add_option("--points", o->points, "Cost: points per scan (full turn)")->check(CLI::Range(16, 4096));
   sub->add_option("--scans", o->scans, "Cost: scans to run")->check(CLI::PositiveNumber);
   sub->add_option("--detector", o->cost_detector,

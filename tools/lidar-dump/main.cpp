@@ -101,7 +101,6 @@ int main(int argc, char** argv) {
   Printer out;
   out.csv = csv;
   if (csv) std::printf("scan,stamp_us,index,angle_rad,range_m,intensity\n");
-  auto scan = std::make_unique<dockcore::LaserScan>();
   dockcore::LidarParserCounters counters{};
   std::uint32_t reconnects = 0;
 
@@ -123,7 +122,7 @@ int main(int argc, char** argv) {
           const std::size_t n = std::min(step, bytes.size() - off);
           if (*proto == LidarProtocol::kLakibeam) bd.feed_datagram(bytes.data() + off, n, 0);
           else bd.feed_bytes(bytes.data() + off, n, 0, 0);
-          while (bd.take_scan(*scan)) {
+          while (bd.take_scan() != nullptr) {
           }
         }
       }
@@ -148,7 +147,9 @@ int main(int argc, char** argv) {
       const auto t = static_cast<std::uint64_t>(static_cast<double>(off) * byte_us);
       if (*proto == LidarProtocol::kLakibeam) dec.feed_datagram(bytes.data() + off, n, t);
       else dec.feed_bytes(bytes.data() + off, n, t, 0);
-      while (dec.take_scan(*scan) && !(count > 0 && out.printed >= count)) out.print(*scan);
+      for (const dockcore::LaserScan* sc = dec.take_scan(); sc != nullptr && !(count > 0 && out.printed >= count);
+           sc = dec.take_scan())
+        out.print(*sc);
     }
     counters = dec.counters();
   } else {
@@ -185,7 +186,7 @@ int main(int argc, char** argv) {
       pollfd p{drv->fd(), POLLIN, 0};
       if (p.fd >= 0) ::poll(&p, 1, 20);
       else ::poll(nullptr, 0, 20);
-      if (drv->poll_scan(*scan)) out.print(*scan);
+      if (const dockcore::LaserScan* sc = drv->poll_scan()) out.print(*sc);
       if (last_err != drv->last_error()) {
         last_err = drv->last_error();
         if (!last_err.empty()) std::fprintf(stderr, "lidar-dump: %s\n", last_err.c_str());

@@ -107,6 +107,12 @@ class DockcoreBase {
   const DockPoseEstimatorBase& estimator() const { return estimator_; }
   /// Most beams a scan may have: larger scans are refused by the estimator (kBadScan) and their copy truncated.
   std::size_t scan_capacity() const { return scan_capacity_; }
+  /// The latest scan as kept for the tick (empty before the first). It may be given to on_scan() again (e.g. after
+  /// reconfigure()), which then copies nothing. Valid until the next on_scan(). O(1).
+  ScanView last_scan() const { return have_scan_ ? scan_ : ScanView{}; }
+  /// Bytes the last on_scan() copied (ranges and intensities for the tick): 2 · count · sizeof(Real), 0 when it
+  /// was fed its own last_scan(). O(1).
+  std::size_t scan_copy_bytes() const { return scan_copy_bytes_; }
   const TaskManager& task_manager() const { return tasks_; }
   const DockcoreConfig& config() const { return config_; }
   /// The host sent the drive a zero command outside tick() (shutdown, a stop of its own): the next tick's
@@ -139,6 +145,7 @@ class DockcoreBase {
   std::size_t scan_capacity_;
   ScanView scan_{};
   bool have_scan_ = false;
+  std::size_t scan_copy_bytes_ = 0;
   std::uint64_t last_scan_us_ = 0;
   DockEstimate last_estimate_{};
   DetectionInput pending_[kMaxDetectionsPerTick] = {};

@@ -40,6 +40,8 @@ class LakibeamParser {
   std::size_t feed_datagram(const std::uint8_t* data, std::size_t n, std::uint64_t stamp_us);
   /// Newest complete scan (stamp: arrival of the datagram holding its first point); false if none waiting.
   bool take_scan(LaserScan& out) { return out_.take(out); }
+  /// The waiting scan in place (LidarScanOutput::take()): valid until the parser is fed again; nullptr when none.
+  const LaserScan* take_scan() { return out_.take(); }
   bool scan_ready() const { return out_.ready(); }
   const LidarParserCounters& counters() const { return counters_; }
   std::uint32_t last_timestamp() const { return last_timestamp_; }  ///< Sensor timestamp of the last good datagram.

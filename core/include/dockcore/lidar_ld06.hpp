@@ -94,6 +94,8 @@ class Ld06Parser {
   /// the turn's first point: its packet's time (sensor clock mapped to host time, or the arrival of its first byte
   /// when sensor_clock is off) minus (12 - i) point periods. O(bins).
   bool take_scan(LaserScan& out) { return out_.take(out); }
+  /// The waiting scan in place (LidarScanOutput::take()): valid until the parser is fed again; nullptr when none.
+  const LaserScan* take_scan() { return out_.take(); }
   bool scan_ready() const { return out_.ready(); }
   const LidarParserCounters& counters() const { return counters_; }
   std::size_t buffered() const { return len_; }          ///< Bytes held for an incomplete packet (<= 47).

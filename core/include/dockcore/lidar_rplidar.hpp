@@ -96,6 +96,8 @@ class RplidarParser {
   std::size_t feed(const std::uint8_t* data, std::size_t n, std::uint64_t stamp_us);
   /// Newest complete scan (stamp: arrival of the first byte of the turn's S=1 node); false if none waiting.
   bool take_scan(LaserScan& out) { return out_.take(out); }
+  /// The waiting scan in place (LidarScanOutput::take()): valid until the parser is fed again; nullptr when none.
+  const LaserScan* take_scan() { return out_.take(); }
   bool scan_ready() const { return out_.ready(); }
   const LidarParserCounters& counters() const { return counters_; }
   std::size_t buffered() const { return len_; }

@@ -69,9 +69,15 @@ bool scan_lookup(const ScanView& scan, Real angle_rad, Real* range_m, Real* inte
 /// spanning one full turn (the scan wraps()). Several samples in one bin: a return beats a no-return, and among
 /// returns the NEAREST range wins (what the LDROBOT ROS driver does: the conservative choice for obstacles); each
 /// extra sample counts one bin collision. Bins no sample reached stay 0 = no return.
-/// Storage: one LaserScan (~64 KiB with double); no heap.
+/// Storage: the LaserScan it builds into is its owner's (LidarScanOutput alternates two); no heap.
 class LidarScanAssembler {
  public:
+  /// Builds into `storage`, which must outlive the assembler. O(1).
+  explicit LidarScanAssembler(LaserScan* storage) : scan_(storage) {}
+  LidarScanAssembler(const LidarScanAssembler&) = delete;
+  LidarScanAssembler& operator=(const LidarScanAssembler&) = delete;
+  /// Builds the next turn into `storage`, keeping the grid; the next begin() clears it. O(1).
+  void retarget(LaserScan* storage) { scan_ = storage; }
   /// Sets the grid; clears the scan. bins_per_turn in [1, kMaxScanPoints], angle_min finite; false (nothing
   /// changed) otherwise. O(bins).
   bool configure(std::uint32_t bins_per_turn, Real angle_min_rad);
@@ -85,36 +91,46 @@ class LidarScanAssembler {
   std::uint32_t samples() const { return samples_; }        ///< Samples added since begin().
   std::uint32_t collisions() const { return collisions_; }  ///< Bin collisions since begin().
   std::uint32_t bins() const { return bins_; }
-  const LaserScan& scan() const { return scan_; }
+  const LaserScan& scan() const { return *scan_; }
 
  private:
-  LaserScan scan_{};
+  LaserScan* scan_;
   std::uint32_t bins_ = 0;
+  Real angle_min_rad_ = 0;
   Real increment_rad_ = 0;
   std::uint32_t samples_ = 0;
   std::uint32_t collisions_ = 0;
 };
 
-/// Double buffer the parsers share: `building` collects the current turn; publish() copies it into `ready` and
-/// counts it. Storage ~128 KiB with double (two LaserScans).
+/// Double buffer the parsers share: one scan is built while the last published one waits to be read. publish()
+/// hands the built scan over by swapping the two buffers, so no scan is copied on its way out of a parser.
+/// Storage ~128 KiB with double (two LaserScans). Not copyable (the assembler points into it).
 class LidarScanOutput {
  public:
+  LidarScanOutput() : building_(&scans_[0]) {}
+  LidarScanOutput(const LidarScanOutput&) = delete;
+  LidarScanOutput& operator=(const LidarScanOutput&) = delete;
   bool configure(std::uint32_t bins_per_turn, Real angle_min_rad);
   LidarScanAssembler& building() { return building_; }
   const LidarScanAssembler& building() const { return building_; }
-  /// Publishes the building scan (O(bins) copy) and counts it in c.scans (and c.scans_overwritten if the previous
-  /// one was never taken).
+  /// Publishes the building scan (a buffer swap, plus an O(count) pass that normalises its no-return marks) and
+  /// counts it in c.scans (and c.scans_overwritten if the previous one was never taken).
   void publish(LidarParserCounters& c);
   /// True when a scan is waiting for take().
   bool ready() const { return ready_; }
-  /// Copies the waiting scan into out (O(bins)) and clears ready(); false (out untouched) when none.
+  /// The waiting scan, in place, and clears ready(); nullptr when none. The scan stays as it is until the parser
+  /// publishes the next one: read or copy it before feeding the parser again. O(1).
+  const LaserScan* take();
+  /// Copies the waiting scan into out (O(count)) and clears ready(); false (out untouched) when none.
   bool take(LaserScan& out);
   /// The waiting scan (valid while ready()). O(1).
-  const LaserScan& peek() const { return ready_scan_; }
+  const LaserScan& peek() const { return scans_[ready_index_]; }
 
  private:
-  LidarScanAssembler building_{};
-  LaserScan ready_scan_{};
+  LaserScan scans_[2]{};
+  LidarScanAssembler building_;
+  std::size_t building_index_ = 0;
+  std::size_t ready_index_ = 1;
   bool ready_ = false;
 };
 

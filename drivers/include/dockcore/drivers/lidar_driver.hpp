@@ -90,8 +90,9 @@ class LidarDecoder {
                          std::uint32_t byte_period_us);
   /// One UDP datagram: Lakibeam parses it whole, LD06 takes its bytes. Returns scans completed.
   std::size_t feed_datagram(const std::uint8_t* data, std::size_t n, std::uint64_t stamp_us);
-  /// Newest complete scan; false when none is waiting.
-  bool take_scan(LaserScan& out);
+  /// Newest complete scan in the parser's buffer (valid until the decoder is fed again); nullptr when none is
+  /// waiting.
+  const LaserScan* take_scan();
   /// Forget partial packets and the turn in progress (after a reconnect); counters are kept.
   void reset();
   const LidarParserCounters& counters() const;

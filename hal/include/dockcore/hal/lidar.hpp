@@ -21,9 +21,10 @@ struct LidarCounters {
 /// A lidar delivering complete turns.
 class LidarSource {
  public:
-  /// Copies the newest complete scan into `out` if one arrived since the last call; returns false otherwise (out
-  /// untouched). Non-blocking. stamp_us is the host's monotonic time of the scan's first sample.
-  virtual bool poll_scan(LaserScan& out) = 0;
+  /// The newest complete scan if one arrived since the last call, else nullptr. Non-blocking. The scan is the
+  /// source's own buffer, not a copy: it stays as it is until the next poll_scan() (or a driver's service()), so
+  /// use or copy it before then. stamp_us is the host's monotonic time of the scan's first sample.
+  virtual const LaserScan* poll_scan() = 0;
   /// File descriptor to wait on (epoll), or -1 when the source is polled.
   virtual int fd() const = 0;
   virtual const LidarCounters& counters() const = 0;
