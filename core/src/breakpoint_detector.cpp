@@ -181,13 +181,13 @@ BreakpointDetection BreakpointDetector::detect_seed_code(const ScanView& scan) {
   // Step 4: the first four marks, then slide by one mark at a time, as the seed's loop does.
   std::size_t m[4];
   std::size_t from = 0;
-  for (std::size_t k = 0; k < 4; ++k) {
-    m[k] = next_mark(from);
-    if (m[k] >= n) {
+  for (std::size_t& mk : m) {
+    mk = next_mark(from);
+    if (mk >= n) {
       d.status = BreakpointStatus::kTooFewMutations;
       return d;
     }
-    from = m[k] + 1;
+    from = mk + 1;
   }
 
   const std::size_t off = params_.neighbour_offset_idx;

@@ -24,7 +24,7 @@ void put_i24(std::uint8_t* d, std::int32_t v) {
 std::int32_t get_i24(const std::uint8_t* d) {
   std::uint32_t u = static_cast<std::uint32_t>(d[0]) | (static_cast<std::uint32_t>(d[1]) << 8) |
                     (static_cast<std::uint32_t>(d[2]) << 16);
-  if (u & 0x800000u) u |= 0xFF000000u;  // sign-extend 24 -> 32 bits
+  if ((u & 0x800000u) != 0) u |= 0xFF000000u;  // sign-extend 24 -> 32 bits
   return static_cast<std::int32_t>(u);
 }
 
@@ -74,8 +74,10 @@ const char* to_string(CanV1Error e) {
 bool ids_valid(const Ids& ids) {
   if (ids.chassis_base + kOffChassisStatus > 0x7FFu) return false;
   if (ids.host_base + kOffDockPose > 0x7FFu) return false;
-  const std::uint32_t c0 = ids.chassis_base, c1 = ids.chassis_base + kOffChassisStatus;
-  const std::uint32_t h0 = ids.host_base, h1 = ids.host_base + kOffDockPose;
+  const std::uint32_t c0 = ids.chassis_base;
+  const std::uint32_t c1 = ids.chassis_base + kOffChassisStatus;
+  const std::uint32_t h0 = ids.host_base;
+  const std::uint32_t h1 = ids.host_base + kOffDockPose;
   return c1 < h0 || h1 < c0;
 }
 
@@ -174,7 +176,7 @@ std::uint8_t crc8_h2f(const std::uint8_t* bytes, std::size_t n) {
   unsigned crc = 0xFFu;
   for (std::size_t i = 0; i < n; ++i) {
     crc ^= bytes[i];
-    for (int b = 0; b < 8; ++b) crc = (crc & 0x80u) ? ((crc << 1) ^ 0x2Fu) & 0xFFu : (crc << 1) & 0xFFu;
+    for (int b = 0; b < 8; ++b) crc = (crc & 0x80u) != 0 ? ((crc << 1) ^ 0x2Fu) & 0xFFu : (crc << 1) & 0xFFu;
   }
   return static_cast<std::uint8_t>(crc ^ 0xFFu);
 }
@@ -426,7 +428,8 @@ const CounterTracker& FrameChecker::tracker(MessageKind k) const {
 }
 
 std::uint32_t FrameChecker::count(MessageKind k, CanV1Error e) const {
-  const std::size_t i = static_cast<std::size_t>(k), r = static_cast<std::size_t>(e);
+  const std::size_t i = static_cast<std::size_t>(k);
+  const std::size_t r = static_cast<std::size_t>(e);
   return (i < kKinds && r < kResults) ? counts_[i][r] : 0u;
 }
 

@@ -346,7 +346,8 @@ ControlOutput Seed003Controller::step(const ControlInput& in) {
   win_z_[win_head_] = z_raw;
   win_head_ = (win_head_ + 1) % w;
   if (win_n_ < w) ++win_n_;
-  Real sx = 0, sz = 0;
+  Real sx = 0;
+  Real sz = 0;
   for (std::size_t i = 0; i < win_n_; ++i) {
     sx += win_x_[i];
     sz += win_z_[i];

@@ -1,5 +1,7 @@
 #include "dockcore/dock_profile.hpp"
 
+#include <algorithm>
+
 namespace dockcore {
 namespace {
 
@@ -45,13 +47,12 @@ const char* to_string(DockMountKind k) {
 bool parse_mount_kind(const char* name, DockMountKind* out) {
   if (name == nullptr || out == nullptr) return false;
   const DockMountKind kinds[] = {DockMountKind::kUnknown, DockMountKind::kWall, DockMountKind::kFreeStanding};
-  for (const DockMountKind k : kinds) {
-    if (same_name(name, to_string(k))) {
-      *out = k;
-      return true;
-    }
-  }
-  return false;
+  const DockMountKind* const end = kinds + sizeof(kinds) / sizeof(kinds[0]);
+  const DockMountKind* const k =
+      std::find_if(kinds, end, [name](DockMountKind kind) { return same_name(name, to_string(kind)); });
+  if (k == end) return false;
+  *out = *k;
+  return true;
 }
 
 bool mounting_valid(const DockMounting& m) {

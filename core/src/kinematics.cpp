@@ -104,7 +104,8 @@ Twist2 limit_acceleration(const DriveLimits& lim, const Twist2& previous, const 
   const Real a_ang = lim.max_angular_accel_radps2 > 0 ? lim.max_angular_accel_radps2 * dt_s : 0;
 
   // Preference 1: a scaled copy of the desired twist (same curvature), as large as reachable.
-  Real lo = 0, hi = 1;
+  Real lo = 0;
+  Real hi = 1;
   if (intersect_reachable(desired.vx_mps, previous.vx_mps, a_lin, &lo, &hi) &&
       intersect_reachable(desired.vy_mps, previous.vy_mps, a_lin, &lo, &hi) &&
       intersect_reachable(desired.wz_radps, previous.wz_radps, a_ang, &lo, &hi)) {

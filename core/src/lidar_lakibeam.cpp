@@ -91,7 +91,8 @@ std::size_t LakibeamEncoder::encode_scan(const ScanView& scan, std::uint32_t tim
   for (std::uint32_t j = 0; j < m; ++j) {
     const auto cdeg = static_cast<std::uint32_t>(
         std::round(static_cast<Real>(j) * static_cast<Real>(36000) / static_cast<Real>(m))) % 36000u;
-    Real r = 0, inten = 0;
+    Real r = 0;
+    Real inten = 0;
     const Real core = conv_.to_core(deg_to_rad(static_cast<Real>(cdeg) / static_cast<Real>(100)));
     if (!scan_lookup(scan, core, &r, &inten)) r = inten = 0;
     std::uint16_t mm = 0;
@@ -101,7 +102,8 @@ std::size_t LakibeamEncoder::encode_scan(const ScanView& scan, std::uint32_t tim
     }
     Real iv = std::isfinite(inten) ? std::round(inten) : static_cast<Real>(0);
     const auto rssi = static_cast<std::uint8_t>(iv < 0 ? 0 : (iv > 255 ? 255 : iv));
-    const std::size_t b = pending_ / kLakibeamPointsPerBlock, k = pending_ % kLakibeamPointsPerBlock;
+    const std::size_t b = pending_ / kLakibeamPointsPerBlock;
+    const std::size_t k = pending_ % kLakibeamPointsPerBlock;
     std::uint8_t* blk = dgram_ + b * kLakibeamBlockBytes;
     if (k == 0) {
       blk[0] = 0xFF;

@@ -32,7 +32,7 @@ struct CrcTable {
   constexpr CrcTable() {
     for (unsigned i = 0; i < 256; ++i) {
       unsigned crc = i;
-      for (int b = 0; b < 8; ++b) crc = (crc & 0x80u) ? ((crc << 1) ^ 0x4Du) & 0xFFu : (crc << 1) & 0xFFu;
+      for (int b = 0; b < 8; ++b) crc = (crc & 0x80u) != 0 ? ((crc << 1) ^ 0x4Du) & 0xFFu : (crc << 1) & 0xFFu;
       v[i] = static_cast<std::uint8_t>(crc);
     }
   }
@@ -304,7 +304,8 @@ std::size_t Ld06StreamEncoder::encode_scan(const ScanView& scan, std::uint16_t t
   for (std::uint32_t j = 0; j < m; ++j) {
     const auto cdeg = static_cast<std::uint32_t>(
         std::round(static_cast<Real>(j) * static_cast<Real>(36000) / static_cast<Real>(m)));
-    Real r = 0, inten = 0;
+    Real r = 0;
+    Real inten = 0;
     const Real core = conv_.to_core(deg_to_rad(static_cast<Real>(cdeg) / static_cast<Real>(100)));
     if (!scan_lookup(scan, core, &r, &inten)) r = inten = 0;
     std::uint16_t mm = 0;

@@ -252,7 +252,8 @@ std::size_t RplidarEncoder::encode_scan(const ScanView& scan, std::uint8_t* out,
     }
     const auto q6 = static_cast<std::uint16_t>(
         std::round(static_cast<Real>(j) * static_cast<Real>(kFullTurnQ6) / static_cast<Real>(m)));
-    Real r = 0, inten = 0;
+    Real r = 0;
+    Real inten = 0;
     const Real core = conv_.to_core(deg_to_rad(static_cast<Real>(q6) / static_cast<Real>(64)));
     if (!scan_lookup(scan, core, &r, &inten)) r = inten = 0;
     RplidarNode n;

@@ -73,7 +73,7 @@ void TaskManager::configure(const TaskParams& params, const FootprintParams& foo
   have_prev_tick_ = false;
 }
 
-Real TaskManager::since_s(std::uint64_t t_us, const TaskInput& in) const {
+Real TaskManager::since_s(std::uint64_t t_us, const TaskInput& in) {
   if (in.now_us <= t_us) return 0;
   return static_cast<Real>(in.now_us - t_us) * static_cast<Real>(1e-6);
 }

@@ -92,3 +92,25 @@ TEST(CanAgilex, ErrorsLeaveOutputAlone) {
   CHECK(frame_name(0x312) == nullptr);
   LONGS_EQUAL(20, period_ms(0x111));
 }
+
+TEST(CanAgilex, EveryIdHasItsNameAndPeriod) {
+  // The vendor's frames: name, and the period the header documents (0 = on demand).
+  struct Row {
+    std::uint32_t id;
+    const char* name;
+    std::uint32_t period_ms;
+  };
+  const Row rows[] = {{kIdControlMode, "ControlMode", 0},   {kIdMotionCommand, "MotionCommand", 20},
+                      {kIdSystemState, "SystemState", 100}, {kIdMotionState, "MotionState", 20},
+                      {kIdOdometry, "Odometry", 20},        {kIdBms, "Bms", 500}};
+  for (const Row& r : rows) {
+    STRCMP_EQUAL(r.name, frame_name(r.id));
+    LONGS_EQUAL(r.period_ms, period_ms(r.id));
+  }
+  CHECK(frame_name(0) == nullptr);
+  LONGS_EQUAL(0, period_ms(0x312));
+  const AgxError errors[] = {AgxError::kOk, AgxError::kWrongId, AgxError::kExtendedId, AgxError::kBadLength};
+  const char* const names[] = {"ok", "wrong_id", "extended_id", "bad_length"};
+  for (std::size_t i = 0; i < 4; ++i) STRCMP_EQUAL(names[i], to_string(errors[i]));
+  STRCMP_EQUAL("invalid", to_string(static_cast<AgxError>(200)));
+}

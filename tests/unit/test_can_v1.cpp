@@ -287,3 +287,73 @@ TEST(CanV1, IdsClassifyAndValidate) {
   CHECK(ids_valid(Ids{0x7EA, 0x000}));
   STRCMP_EQUAL("WheelCmdA", to_string(MessageKind::kWheelCmdA));
 }
+
+TEST(CanV1, EveryKindAndErrorHasItsOwnName) {
+  // Message names are the DBC's frame names: one per kind, none shared, "unknown" only for kUnknown and values
+  // outside the enum.
+  const int kinds = static_cast<int>(MessageKind::kCount);
+  for (int a = 1; a < kinds; ++a) {
+    const char* name = to_string(static_cast<MessageKind>(a));
+    CHECK(name != nullptr);
+    CHECK(std::strcmp(name, "unknown") != 0);
+    for (int b = 1; b < a; ++b) CHECK(std::strcmp(name, to_string(static_cast<MessageKind>(b))) != 0);
+  }
+  STRCMP_EQUAL("unknown", to_string(MessageKind::kUnknown));
+  STRCMP_EQUAL("unknown", to_string(MessageKind::kCount));
+  STRCMP_EQUAL("ChassisStatus", to_string(MessageKind::kChassisStatus));
+  STRCMP_EQUAL("DockPose", to_string(MessageKind::kDockPose));
+  // Error names as docs/can.md writes them (dock-decode prints them in brackets); "invalid" outside the enum.
+  const char* const want[] = {"ok",           "wrong_id",          "extended_id",   "bad_length",
+                              "bad_checksum", "counter_duplicate", "counter_stale", "counter_jump"};
+  const CanV1Error errors[] = {CanV1Error::kOk,           CanV1Error::kWrongId,     CanV1Error::kExtendedId,
+                               CanV1Error::kBadLength,    CanV1Error::kBadChecksum, CanV1Error::kCounterDuplicate,
+                               CanV1Error::kCounterStale, CanV1Error::kCounterJump};
+  for (std::size_t i = 0; i < sizeof(errors) / sizeof(errors[0]); ++i) STRCMP_EQUAL(want[i], to_string(errors[i]));
+  STRCMP_EQUAL("invalid", to_string(static_cast<CanV1Error>(200)));
+}
+
+TEST(CanV1, SentByBaseIsExactlyTheBaseToHostRange) {
+  // docs/can.md: chassis+0x10 .. chassis+0x15 go base -> dockd; chassis+0x00 .. 0x02 and the host range do not.
+  for (const Ids ids : {Ids{}, Ids{0x300, 0x080}}) {
+    for (int k = 1; k < static_cast<int>(MessageKind::kCount); ++k) {
+      const MessageKind kind = static_cast<MessageKind>(k);
+      const std::uint32_t id = id_of(ids, kind);
+      const bool base_range = id >= ids.chassis_base + 0x10 && id <= ids.chassis_base + 0x15;
+      CHECK_EQUAL(base_range, sent_by_base(kind));
+    }
+  }
+  CHECK_FALSE(sent_by_base(MessageKind::kUnknown));
+  LONGS_EQUAL(0, id_of(Ids{}, MessageKind::kUnknown));
+  LONGS_EQUAL(0, id_of(Ids{}, MessageKind::kCount));
+}
+
+TEST(CanV1, FrameCheckerResetForgetsOneKindOnly) {
+  const Ids ids;
+  FrameChecker fc(ids);
+  MessageKind k = MessageKind::kUnknown;
+  DockStatusFrame s;
+  WheelFeedbackFrame w;
+  for (std::uint8_t c = 0; c < 3; ++c) {
+    s.counter = c;
+    w.counter = c;
+    CHECK(fc.check(encode(ids, s), k) == CanV1Error::kOk);
+    CHECK(fc.check(encode(ids, w), k) == CanV1Error::kOk);
+    CHECK(k == MessageKind::kWheelFbA);
+  }
+  // A sender that restarted at counter 11: stale (d = 9) for a tracker that remembers 2, accepted after reset().
+  s.counter = 11;
+  CHECK(fc.check(encode(ids, s), k) == CanV1Error::kCounterStale);
+  fc.reset(MessageKind::kDockStatus);
+  s.counter = 12;
+  CHECK(fc.check(encode(ids, s), k) == CanV1Error::kOk);
+  // The wheel feedback's tracker was not reset: its last counter, 2, is still a duplicate.
+  w.counter = 2;
+  CHECK(fc.check(encode(ids, w), k) == CanV1Error::kCounterDuplicate);
+  // tracker() shows each kind's own judgement counts.
+  LONGS_EQUAL(4, fc.tracker(MessageKind::kDockStatus).ok());
+  LONGS_EQUAL(1, fc.tracker(MessageKind::kDockStatus).stale());
+  LONGS_EQUAL(0, fc.tracker(MessageKind::kDockStatus).duplicates());
+  LONGS_EQUAL(3, fc.tracker(MessageKind::kWheelFbA).ok());
+  LONGS_EQUAL(1, fc.tracker(MessageKind::kWheelFbA).duplicates());
+  LONGS_EQUAL(0, fc.tracker(MessageKind::kPower).ok());
+}

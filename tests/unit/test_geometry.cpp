@@ -1,3 +1,6 @@
+#include <cstdio>
+#include <cstring>
+
 #include "dockcore/dock_profile.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
@@ -134,4 +137,56 @@ TEST(Profile, ContactOffsetShiftsOrigin) {
   DockProfile p;
   CHECK_EQUAL(static_cast<int>(ProfileError::kOk), static_cast<int>(make_profile(v, 2, 0.05, "flat", p)));
   REAL_EQUAL(0.0, p.vertices_m[0].x(), 1e-12);
+}
+
+TEST(Profile, TooManyVerticesAreRefused) {
+  Vec2 v[kMaxProfileVertices + 1];
+  for (std::size_t i = 0; i <= kMaxProfileVertices; ++i) v[i] = Vec2(0, 0.01 * static_cast<double>(i));
+  DockProfile p;
+  CHECK_EQUAL(static_cast<int>(ProfileError::kOk),
+              static_cast<int>(make_profile(v, kMaxProfileVertices, 0, "most", p)));
+  CHECK_EQUAL(kMaxProfileVertices, p.vertex_count);
+  CHECK_EQUAL(static_cast<int>(ProfileError::kTooManyVertices),
+              static_cast<int>(make_profile(v, kMaxProfileVertices + 1, 0, "too-many", p)));
+  STRCMP_EQUAL("most", p.name);
+}
+
+TEST(Profile, EveryErrorHasItsOwnMessage) {
+  const ProfileError errors[] = {ProfileError::kOk,
+                                 ProfileError::kTooFewVertices,
+                                 ProfileError::kTooManyVertices,
+                                 ProfileError::kDegenerateSegment,
+                                 ProfileError::kNotFinite,
+                                 ProfileError::kUnknownName};
+  const std::size_t n = sizeof(errors) / sizeof(errors[0]);
+  for (std::size_t a = 0; a < n; ++a) {
+    const char* msg = to_string(errors[a]);
+    CHECK(msg != nullptr);
+    STRCMP_NOCASE_CONTAINS(a == 0 ? "ok" : "profile", msg);
+    for (std::size_t b = 0; b < a; ++b) CHECK(std::strcmp(msg, to_string(errors[b])) != 0);
+  }
+  // The capacity the message names is the real one.
+  char cap[8];
+  std::snprintf(cap, sizeof cap, "%zu", kMaxProfileVertices);
+  STRCMP_CONTAINS(cap, to_string(ProfileError::kTooManyVertices));
+  STRCMP_EQUAL("unknown profile error", to_string(static_cast<ProfileError>(200)));
+}
+
+TEST(Profile, MountKindNamesRoundTripAndOthersAreRefused) {
+  const DockMountKind kinds[] = {DockMountKind::kUnknown, DockMountKind::kWall, DockMountKind::kFreeStanding};
+  for (const DockMountKind k : kinds) {
+    DockMountKind out = k == DockMountKind::kWall ? DockMountKind::kUnknown : DockMountKind::kWall;
+    CHECK(parse_mount_kind(to_string(k), &out));
+    CHECK(out == k);
+  }
+  STRCMP_EQUAL("free_standing", to_string(DockMountKind::kFreeStanding));
+  // Whole names only, and a refusal leaves the output alone.
+  DockMountKind out = DockMountKind::kWall;
+  for (const char* bad : {"floor", "wal", "walls", "Wall", "", "free standing"}) {
+    CHECK_FALSE(parse_mount_kind(bad, &out));
+    CHECK(out == DockMountKind::kWall);
+  }
+  CHECK_FALSE(parse_mount_kind(nullptr, &out));
+  CHECK_FALSE(parse_mount_kind("wall", nullptr));
+  STRCMP_EQUAL("unknown", to_string(static_cast<DockMountKind>(7)));
 }

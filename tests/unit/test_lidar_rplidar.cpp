@@ -585,3 +585,67 @@ TEST(Rplidar, CorruptedRealCaptureLosesRotationsOnlyNearTheDamage) {
     run("truncate", 1, v, offsets(cut), cut, std::vector<std::size_t>{cut});
   }
 }
+
+TEST(Rplidar, ResetDropsBufferedBytesAndTheOpenTurnAndWaitsForADescriptor) {
+  auto p = make_parser();
+  auto s = stream(200);  // one turn opened at node 0, not closed
+  s.push_back(s[7]);     // the first 3 bytes of a node, left in the buffer
+  s.push_back(s[8]);
+  s.push_back(s[9]);
+  p->feed(s.data(), s.size(), 0);
+  CHECK(p->in_scan_mode());
+  CHECK_EQUAL(3u, p->buffered());
+  const LidarParserCounters before = p->counters();
+  p->reset();
+  CHECK_FALSE(p->in_scan_mode());
+  CHECK_EQUAL(0u, p->buffered());
+  CHECK_EQUAL(before.dropped_bytes + 3, p->counters().dropped_bytes);
+  CHECK_EQUAL(before.samples_discarded + 200, p->counters().samples_discarded);
+  check_byte_account(*p);
+  // Nodes without a new descriptor are idle bytes now; the next descriptor starts over, and only a whole turn
+  // after it is published.
+  std::vector<std::uint8_t> nodes;
+  for (int j = 0; j < 50; ++j) put_node(nodes, j == 0, j, 700);
+  p->feed(nodes.data(), nodes.size(), 0);
+  CHECK_EQUAL(before.packets, p->counters().packets);
+  CHECK_FALSE(p->scan_ready());
+  const auto again = stream(400);
+  p->feed(again.data(), again.size(), 0);
+  CHECK_EQUAL(before.packets + 400, p->counters().packets);
+  LaserScan scan;
+  CHECK(p->take_scan(scan));
+  Real r = 0;
+  Real i = 0;
+  CHECK(scan_lookup(scan.view(), kPi - deg_to_rad(10), &r, &i));
+  REAL_EQUAL(0.510, r, 1e-9);
+  check_byte_account(*p);
+}
+
+TEST(Rplidar, DeviceInfoResponseIsCountedAndSkipped) {
+  auto p = make_parser();
+  std::vector<std::uint8_t> s(kRplidarInfoDescriptor, kRplidarInfoDescriptor + kRplidarDescriptorBytes);
+  for (std::size_t k = 0; k < kRplidarInfoBytes; ++k) s.push_back(static_cast<std::uint8_t>(0xA5 + k));  // any payload
+  const auto scan_bytes = stream(400);
+  s.insert(s.end(), scan_bytes.begin(), scan_bytes.end());
+  p->feed(s.data(), s.size(), 0);
+  const auto& c = p->counters();
+  CHECK_EQUAL(1u, c.info_packets);
+  CHECK_EQUAL(400u, c.packets);
+  CHECK_EQUAL(1u, c.scans);
+  CHECK_EQUAL(0u, c.dropped_bytes);
+  CHECK_EQUAL(static_cast<std::uint64_t>(kRplidarDescriptorBytes + kRplidarInfoBytes),
+              rplidar_byte_account(c, p->buffered()).response_bytes);
+  check_byte_account(*p);
+}
+
+TEST(Rplidar, EncoderWritesWholeNodesAndCountsTheRest) {
+  LaserScan in;
+  in.reset(360, -kPi, kTwoPi / 360, 0);
+  for (std::size_t i = 0; i < 360; ++i) in.ranges_m[i] = 1.0;
+  RplidarEncoder enc;
+  std::uint8_t out[5 * 100 + 3];
+  CHECK_EQUAL(5u * 100u, enc.encode_scan(in.view(), out, sizeof out));
+  CHECK_EQUAL(260u, enc.points_lost());
+  CHECK_EQUAL(0u, enc.encode_scan(in.view(), out, 4));
+  CHECK_EQUAL(260u + 360u, enc.points_lost());
+}

@@ -244,3 +244,17 @@ TEST(Safety, FaultNames) {
   STRCMP_EQUAL("task_timeout", to_string(FaultCode::kTaskTimeout));
   STRCMP_EQUAL("unknown", to_string(static_cast<FaultCode>(999)));
 }
+
+TEST(Safety, EveryFaultCodeHasItsStableName) {
+  // Wire codes and names as docs/faults.md lists them; hosts log both, so neither may change.
+  const char* const names[] = {"detection_failed", "distance_deviation",   "angle_deviation", "obstacle_timeout",
+                               "target_lost",      "charge_not_confirmed", "contacts_lost",   "chassis_stale",
+                               "lidar_stale",      "undock_failed",        "bad_command",     "align_failed",
+                               "task_timeout"};
+  for (std::uint16_t code = 177; code <= 189; ++code) {
+    STRCMP_EQUAL(names[code - 177], to_string(static_cast<FaultCode>(code)));
+  }
+  STRCMP_EQUAL("none", to_string(FaultCode::kNone));
+  STRCMP_EQUAL("unknown", to_string(static_cast<FaultCode>(176)));
+  STRCMP_EQUAL("unknown", to_string(static_cast<FaultCode>(190)));
+}

@@ -1166,3 +1166,17 @@ TEST(Dockcore, HoldZeroesTheDriveAndTheRampRestartsFromRest) {
   const DriveLimits lim = f.core->config().limits;
   CHECK(std::fabs(next.drive_cmd.vx_mps) <= lim.max_linear_accel_mps2 * f.core->config().control_period_s + 1e-5);
 }
+
+TEST(TaskManager, StatesAndCommandResultsHaveTheirStableNames) {
+  // States by wire code (0-4 are seed 004's AutoContainerState names, docs/task-manager.md).
+  const char* const states[] = {"NOT_TASKING",     "GET_TASKING_CMD", "REACH_TASKING_POINT", "ALIGN", "FINISH_TASKING",
+                                "WAIT_FOR_CHARGE", "RETRY",           "UNDOCKING",           "FAULT", "TEST_MODE"};
+  for (int s = 0; s < 10; ++s) STRCMP_EQUAL(states[s], to_string(static_cast<TaskState>(s)));
+  STRCMP_EQUAL("UNKNOWN", to_string(static_cast<TaskState>(10)));
+  // Command results by wire code; the rejections are the names docs/faults.md gives for code 187.
+  const char* const results[] = {
+      "none",         "accepted", "already_docked", "rejected_unknown", "rejected_dock_id", "rejected_not_docked",
+      "rejected_busy"};
+  for (int r = 0; r < 7; ++r) STRCMP_EQUAL(results[r], to_string(static_cast<CommandResult>(r)));
+  STRCMP_EQUAL("unknown", to_string(static_cast<CommandResult>(7)));
+}

@@ -544,3 +544,28 @@ TEST(VMarkerSim, ClutterScenesWithoutDock) {
   std::printf("\nVMarkerSim clutter level 3, no dock: %d false detections in %d scans\n", false_pos, n);
   CHECK(false_pos <= n * 2 / 100);
 }
+
+TEST(VMarkerGeometry, EveryErrorAndStatusHasItsOwnName) {
+  const VMarkerError errors[] = {VMarkerError::kOk,       VMarkerError::kNotThreeVertices, VMarkerError::kNotConcave,
+                                 VMarkerError::kBadAngle, VMarkerError::kBadLength,        VMarkerError::kBadParams};
+  const std::size_t ne = sizeof(errors) / sizeof(errors[0]);
+  for (std::size_t a = 0; a < ne; ++a) {
+    const char* name = to_string(errors[a]);
+    CHECK(name != nullptr);
+    CHECK(std::strstr(name, "unknown") == nullptr);
+    for (std::size_t b = 0; b < a; ++b) CHECK(std::strcmp(name, to_string(errors[b])) != 0);
+  }
+  STRCMP_EQUAL("ok", to_string(VMarkerError::kOk));
+  STRCMP_EQUAL("unknown V-marker error", to_string(static_cast<VMarkerError>(200)));
+  const VMarkerStatus statuses[] = {VMarkerStatus::kFound, VMarkerStatus::kNoSegments, VMarkerStatus::kNoCandidate,
+                                    VMarkerStatus::kNoneNearHint, VMarkerStatus::kBadParams};
+  const std::size_t ns = sizeof(statuses) / sizeof(statuses[0]);
+  for (std::size_t a = 0; a < ns; ++a) {
+    const char* name = to_string(statuses[a]);
+    CHECK(name != nullptr);
+    CHECK(std::strstr(name, "unknown") == nullptr);
+    for (std::size_t b = 0; b < a; ++b) CHECK(std::strcmp(name, to_string(statuses[b])) != 0);
+  }
+  STRCMP_EQUAL("found", to_string(VMarkerStatus::kFound));
+  STRCMP_EQUAL("unknown V-marker status", to_string(static_cast<VMarkerStatus>(200)));
+}

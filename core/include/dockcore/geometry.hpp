@@ -77,7 +77,7 @@ struct Pose2 {
   Vec2 transform(const Vec2& p) const {
     const Real c = std::cos(yaw_rad);
     const Real s = std::sin(yaw_rad);
-    return Vec2(x_m + c * p.x() - s * p.y(), y_m + s * p.x() + c * p.y());
+    return {x_m + c * p.x() - s * p.y(), y_m + s * p.x() + c * p.y()};
   }
   /// Maps a point given in the parent frame into this pose's frame. O(1).
   Vec2 inverse_transform(const Vec2& p) const {
@@ -85,7 +85,7 @@ struct Pose2 {
     const Real s = std::sin(yaw_rad);
     const Real dx = p.x() - x_m;
     const Real dy = p.y() - y_m;
-    return Vec2(c * dx + s * dy, -s * dx + c * dy);
+    return {c * dx + s * dy, -s * dx + c * dy};
   }
   /// Composition this ∘ b: b is expressed in this pose's frame; the result is in the parent frame. O(1).
   Pose2 compose(const Pose2& b) const {

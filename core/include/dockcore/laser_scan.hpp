@@ -61,10 +61,10 @@ using LaserScan = LaserScanN<kMaxScanPoints>;
 
 /// One valid return converted to Cartesian coordinates.
 struct ScanPoint {
-  Vec2 p_m;             ///< Position in the target frame (robot frame when a mount pose is given).
-  Real range_m;         ///< Raw range as measured.
-  Real angle_rad;       ///< Beam angle in the lidar frame.
-  std::uint32_t index;  ///< Sample index in the source scan.
+  Vec2 p_m;                 ///< Position in the target frame (robot frame when a mount pose is given).
+  Real range_m = 0;         ///< Raw range as measured.
+  Real angle_rad = 0;       ///< Beam angle in the lidar frame.
+  std::uint32_t index = 0;  ///< Sample index in the source scan.
 };
 
 /// Points of a scan, any capacity (what the algorithms take).

@@ -76,6 +76,7 @@ class LidarScanAssembler {
   explicit LidarScanAssembler(LaserScan* storage) : scan_(storage) {}
   LidarScanAssembler(const LidarScanAssembler&) = delete;
   LidarScanAssembler& operator=(const LidarScanAssembler&) = delete;
+  ~LidarScanAssembler() = default;
   /// Builds the next turn into `storage`, keeping the grid; the next begin() clears it. O(1).
   void retarget(LaserScan* storage) { scan_ = storage; }
   /// Sets the grid; clears the scan. bins_per_turn in [1, kMaxScanPoints], angle_min finite; false (nothing
@@ -110,6 +111,7 @@ class LidarScanOutput {
   LidarScanOutput() : building_(&scans_[0]) {}
   LidarScanOutput(const LidarScanOutput&) = delete;
   LidarScanOutput& operator=(const LidarScanOutput&) = delete;
+  ~LidarScanOutput() = default;
   bool configure(std::uint32_t bins_per_turn, Real angle_min_rad);
   LidarScanAssembler& building() { return building_; }
   const LidarScanAssembler& building() const { return building_; }

@@ -230,7 +230,7 @@ class TaskManager {
   /// Attempt failed (charge not confirmed or controller failure): back off, then retry or fault with `final_fault`.
   void fail_attempt(FaultCode final_fault, const TaskInput& in);
   bool dock_fresh(const TaskInput& in) const;
-  Real since_s(std::uint64_t t_us, const TaskInput& in) const;
+  static Real since_s(std::uint64_t t_us, const TaskInput& in);
   /// The one place the output twist is produced.
   void emit(const TaskInput& in, TaskOutput& out);
 
