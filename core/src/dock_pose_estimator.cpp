@@ -396,7 +396,15 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
       }
     }
     // Normal equations, upper triangle (h is symmetric), as scalars so they stay in registers.
-    Real h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0, g0 = 0, g1 = 0, g2 = 0;
+    Real h00 = 0;
+    Real h01 = 0;
+    Real h02 = 0;
+    Real h11 = 0;
+    Real h12 = 0;
+    Real h22 = 0;
+    Real g0 = 0;
+    Real g1 = 0;
+    Real g2 = 0;
     std::uint16_t used = 0;
     Real sum_sq = 0;
     for (std::size_t k = 0; k < n_assoc; ++k) {
@@ -880,8 +888,7 @@ std::size_t DockPoseEstimatorBase::generate_candidates() {
     const Real len_j = (b_j - a_j).norm();
     if (len_j < params_.min_feature_length_m) continue;
     const Vec2 mid_j = (a_j + b_j) * R(0.5);
-    for (std::size_t k = 0; k < segs_.size(); ++k) {
-      const LineSegment& seg = segs_[k];
+    for (const LineSegment& seg : segs_) {
       const Real len_s = seg.length_m();
       // A partly hidden feature may be short; one much longer than the profile's is something else.
       if (len_s < R(0.35) * len_j || len_s > R(1.3) * len_j + 2 * params_.inlier_gate_m) continue;

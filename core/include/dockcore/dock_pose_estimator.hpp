@@ -322,8 +322,8 @@ class DockPoseEstimatorBase {
   /// Hypotheses collected per scan before ranking; beyond this they are counted as truncated.
   static constexpr std::size_t kMaxHypotheses = 128;
   struct Hypothesis {
-    Pose2 pose;   // dock in lidar frame
-    Real prescore;
+    Pose2 pose{};       // dock in lidar frame
+    Real prescore = 0;
   };
 
   DockProfile profile_{};
@@ -377,8 +377,8 @@ class DockPoseEstimatorN : public DockPoseEstimatorBase {
 
  private:
   Vec2 dir_[N];
-  std::uint16_t assoc_beam_[N];
-  std::uint8_t assoc_seg_[N];
+  std::uint16_t assoc_beam_[N] = {};
+  std::uint8_t assoc_seg_[N] = {};
   ScanPointsN<N> points_{};
   FixedVector<LineSegment, estimator_segment_capacity(N)> segs_{};
 };

@@ -13,12 +13,12 @@ namespace dockcore {
 struct PlacedProfile {
   Vec2 v_m[kMaxProfileVertices];       ///< Vertices in the sensor frame.
   Vec2 n[kMaxProfileVertices];         ///< Outward unit normal of segment i (i < segments).
-  Real c_m[kMaxProfileVertices];       ///< Line offset: n[i]·x = c_m[i] on segment i.
-  bool visible[kMaxProfileVertices];   ///< Segment faces the sensor origin (its outward side contains the origin).
+  Real c_m[kMaxProfileVertices] = {};     ///< Line offset: n[i]·x = c_m[i] on segment i.
+  bool visible[kMaxProfileVertices] = {}; ///< Segment faces the sensor origin (its outward side contains the origin).
   Vec2 d_m[kMaxProfileVertices];       ///< Segment i as a vector: v_m[i + 1] - v_m[i].
   Vec2 u[kMaxProfileVertices];         ///< Unit direction of segment i.
-  Real len_m[kMaxProfileVertices];     ///< Length of segment i.
-  Real inv_len_sq[kMaxProfileVertices];  ///< 1 / len_m[i]² (the per-query divisions become products).
+  Real len_m[kMaxProfileVertices] = {};   ///< Length of segment i.
+  Real inv_len_sq[kMaxProfileVertices] = {};///< 1 / len_m[i]² (the per-query divisions become products).
   std::size_t segments = 0;
   Vec2 x_axis{1, 0};  ///< The dock's x axis in the sensor frame: (cos yaw, sin yaw) of the pose it was placed at.
 
