@@ -91,9 +91,10 @@ TEST(TagMeasurement, RoundTripThroughAnyMountAndTagPlacement) {
     TagMeasurement m;
     CHECK(tag_to_dock_measurement(o, p, &m) == TagStatus::kFused);
     const Pose2 truth = robot.inverse().compose(dock);
-    REAL_EQUAL(truth.x_m, m.dock_in_robot.x_m, 1e-6);
-    REAL_EQUAL(truth.y_m, m.dock_in_robot.y_m, 1e-6);
-    REAL_EQUAL(0, wrap_angle(truth.yaw_rad - m.dock_in_robot.yaw_rad), 1e-6);
+    // 10 µm: a chain of four 3D rotations, also in the float build.
+    REAL_EQUAL(truth.x_m, m.dock_in_robot.x_m, 1e-5);
+    REAL_EQUAL(truth.y_m, m.dock_in_robot.y_m, 1e-5);
+    REAL_EQUAL(0, wrap_angle(truth.yaw_rad - m.dock_in_robot.yaw_rad), 1e-5);
   }
 }
 

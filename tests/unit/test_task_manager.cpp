@@ -1251,7 +1251,7 @@ TEST(Dockcore, LidarAndTagFusedAreAtLeastAsAccurateAsLidarAlone) {
       FacadeSim f;
       f.w.model.sigma_const_m = 0.01;
       f.w.rng = docksim::Rng(static_cast<std::uint64_t>(seed));
-      f.w.world = f.w.odom = Pose2{1.2, -0.15 + 0.025 * seed, kPi + 0.02 * (seed - 6)};
+      f.w.world = f.w.odom = dockcore_test::pose(1.2, -0.15 + 0.025 * seed, kPi + 0.02 * (seed - 6));
       if (tags != 0) f.enable_tags(facade_tag_params());
       for (int i = 0; i < 100; ++i) f.step();
       CHECK(f.core->filter().initialised());
