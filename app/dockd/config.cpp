@@ -171,13 +171,14 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   const toml::node* lidar_protocol_node = nullptr;
   // The core structs' keys, with their bounds, come from the parameter table (the same as dock-sim's scenarios).
   namespace params = dockcore::params;
-  const params::ParamTargets targets{&c.drive,   &c.limits,  &c.footprint, &c.task,  &c.estimator,
-                                     &c.seed000, &c.seed004, &c.seed003,   &c.smooth};
+  const params::ParamTargets targets{&c.drive,   &c.limits,  &c.footprint, &c.task,   &c.estimator,
+                                     &c.seed000, &c.seed004, &c.seed003,   &c.smooth, &c.tag_fusion};
   auto table_keys = [&](const std::string& table, Handlers h) {
     params::add_params(p, h, table, targets, params::kDockd);
     return h;
   };
   std::vector<const toml::node*> dock_profile_nodes;
+  std::vector<toml::source_region> dock_tag_nodes;  ///< Where a [[docks]] entry set tag_id (for the camera check).
   // Per dock: the [mounting] given in its entry, which replaces the profile's own (the same dock shape may stand
   // against a wall in one place and free in another).
   std::vector<std::pair<bool, dockcore::DockMounting>> dock_mountings;
@@ -246,18 +247,65 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
     const toml::node* profile_node = &n;
     double tx = 0, ty = 0, tyaw = 0;
     bool tx_set = false, ty_set = false, tyaw_set = false;
+    double tag_id = -1, tag_yaw_deg = 0;
+    bool tag_id_set = false, tag_place_set = false;
+    const toml::node* tag_place_node = nullptr;
+    toml::source_region tag_id_region{};
+    auto tag_place = [&](dockcore::Real* out) {
+      return [&, out](const toml::node& v) {
+        *out = static_cast<Real>(p.number(v, -2, 2));
+        tag_place_set = true;
+        tag_place_node = &v;
+      };
+    };
     std::pair<bool, dockcore::DockMounting> mounting{false, {}};
     const std::string base = p.key() + ".";
     p.each(t, base,
            Handlers{{"id", p.integ(&d.id, 0, 31)},
-                    {"profile", [&](const toml::node& v) {
+                    {"profile",
+                     [&](const toml::node& v) {
                        d.profile_ref = p.string(v);
                        profile_node = &v;
                      }},
-                    {"target_x_m", [&](const toml::node& v) { tx = p.number(v, -3, 3); tx_set = true; }},
-                    {"target_y_m", [&](const toml::node& v) { ty = p.number(v, -3, 3); ty_set = true; }},
-                    {"target_yaw_deg", [&](const toml::node& v) { tyaw = p.number(v, -180, 180); tyaw_set = true; }},
+                    {"target_x_m",
+                     [&](const toml::node& v) {
+                       tx = p.number(v, -3, 3);
+                       tx_set = true;
+                     }},
+                    {"target_y_m",
+                     [&](const toml::node& v) {
+                       ty = p.number(v, -3, 3);
+                       ty_set = true;
+                     }},
+                    {"target_yaw_deg",
+                     [&](const toml::node& v) {
+                       tyaw = p.number(v, -180, 180);
+                       tyaw_set = true;
+                     }},
+                    {"tag_id",
+                     [&](const toml::node& v) {
+                       tag_id = static_cast<double>(p.integer(v, 0, 65535));
+                       tag_id_set = true;
+                       tag_id_region = v.source();
+                     }},
+                    {"tag_x_m", tag_place(&d.tag.x_m)},
+                    {"tag_y_m", tag_place(&d.tag.y_m)},
+                    {"tag_z_m", tag_place(&d.tag.z_m)},
+                    {"tag_yaw_deg",
+                     [&](const toml::node& v) {
+                       tag_yaw_deg = p.number(v, -180, 180);
+                       tag_place_set = true;
+                       tag_place_node = &v;
+                     }},
                     {"mounting", mounting_handler(&mounting, base + "mounting.")}});
+    if (tag_place_set && !tag_id_set) {
+      p.fail(tag_place_node->source(),
+             base + "tag_x_m / tag_y_m / tag_z_m / tag_yaw_deg need " + base + "tag_id (the id of the tag they place)");
+    }
+    if (tag_id_set) {
+      d.tag.id = static_cast<std::int32_t>(tag_id);
+      d.tag.yaw_rad = static_cast<Real>(tag_yaw_deg * kDeg);
+    }
     if (tx_set || ty_set || tyaw_set) {
       if (!(tx_set && ty_set && tyaw_set)) p.fail(n.source(), "dock target needs all of target_x_m, target_y_m, target_yaw_deg");
       d.has_target = true;
@@ -269,6 +317,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
     c.docks.push_back(d);
     dock_profile_nodes.push_back(profile_node);
     dock_mountings.push_back(mounting);
+    if (tag_id_set) dock_tag_nodes.push_back(tag_id_region);
   };
 
   auto controller = [&]() {
@@ -315,6 +364,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
                {"target_id", p.integ(&k.target_id, -1, 65535)},
                {"max_age_ms", p.integ(&k.max_age_ms, 10, 10000)}};
     add_camera_device_keys(p, h, c.camera_device);  // dockd's own capture and detector (camera_config.cpp)
+    h.emplace_back("fusion", params::param_sub(p, "camera.fusion", targets, params::kDockd));
     return h;
   };
 
@@ -433,6 +483,17 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   }
 
   finish_camera_device(p, root.source(), c);  // after [controller]: it sets seed003's camera model
+  // The tag's pose comes from dockd's own camera only: a tag on a dock or the fusion's tuning without it would do
+  // nothing.
+  if (!c.camera_device.enabled) {
+    if (!dock_tag_nodes.empty()) {
+      p.fail(dock_tag_nodes.front(),
+             "docks.tag_id needs [camera.device] (the tag's pose comes from dockd's own camera)");
+    }
+    if (p.where("camera.fusion", toml::source_region{}).begin.line != 0) {
+      p.fail(p.where("camera.fusion", root.source()), "[camera.fusion] needs [camera.device] (dockd's own capture)");
+    }
+  }
 
   if (c.docks.empty()) {
     DockEntry d;

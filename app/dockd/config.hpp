@@ -17,6 +17,7 @@
 #include "dockcore/kinematics.hpp"
 #include "dockcore/safety.hpp"
 #include "dockcore/task_manager.hpp"
+#include "dockcore/tag_measurement.hpp"
 #include "dockcore/drivers/can_link.hpp"
 #include "dockcore/drivers/lidar_driver.hpp"
 #include "dockcore/drivers/udp_camera.hpp"
@@ -48,6 +49,9 @@ struct DockEntry {
   /// the nominal pose from the pads (pad_reach_m ahead, facing the robot). A taught target (state file) wins.
   bool has_target = false;
   Pose2 target{};
+  /// The dock's AprilTag (docs/camera.md, "Fusion"): id −1 = none. Its place is in this dock's frame (before a
+  /// taught or configured target corrects the frame; dockd maps it with the profile).
+  dockcore::DockTag tag{};
 };
 
 enum class LogLevel : std::uint8_t { kError = 0, kWarn = 1, kInfo = 2, kDebug = 3 };
@@ -98,6 +102,9 @@ struct DockdConfig {
   /// [camera.device], [camera.intrinsics], [camera.mount], [camera.tag]: dockd's own capture and detector
   /// (camera_config.hpp, docs/camera.md). target_id and max_age_ms above apply to it too.
   CameraDeviceConfig camera_device{};
+  /// [camera.fusion]: the tag covariance model and time bound (the parameter table); the camera's mount, focal
+  /// length and tag size come from [camera.mount], [camera.intrinsics], [camera.tag], the tag's place from [[docks]].
+  dockcore::TagFusionParams tag_fusion{};
 
   // [record]
   std::string record_dir;                      ///< "" = no session record.

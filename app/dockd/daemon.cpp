@@ -85,6 +85,17 @@ void Daemon::build_core() {
   // dockd's own watchdog (receive time, lidar_stale_ms) is the tight one; Dockcore's scan-stamp check is a backstop
   // that must not fire first (a scan's stamp is its first sample, a whole turn before delivery).
   core_cfg_.lidar_stale_s = static_cast<Real>(cfg_.lidar_stale_ms) * static_cast<Real>(1e-3) + static_cast<Real>(0.3);
+  // The tag fusion: the model's keys, and the camera's mount, focal length and tag size (configure_core adds the
+  // active dock's tag).
+  core_cfg_.tag = cfg_.tag_fusion;
+  if (cfg_.camera_device.enabled) {
+    const CameraMount& m = cfg_.camera_device.mount;
+    core_cfg_.tag.mount = dockcore::CameraMount3{static_cast<Real>(m.x_m),       static_cast<Real>(m.y_m),
+                                                 static_cast<Real>(m.z_m),       static_cast<Real>(m.yaw_rad),
+                                                 static_cast<Real>(m.pitch_rad), static_cast<Real>(m.roll_rad)};
+    core_cfg_.tag.fx_px = static_cast<Real>(cfg_.camera_device.tag.intrinsics.fx_px);
+    core_cfg_.tag.tag_size_m = static_cast<Real>(cfg_.camera_device.tag.tag_size_m);
+  }
 }
 
 Daemon::~Daemon() = default;
@@ -205,14 +216,27 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile, const dockc
   if (d == nullptr) return false;
   dockcore::DockProfile prof = d->profile;
   const Pose2 nominal = nominal_docked_target(cfg_);
+  // The dock's tag sits in the dock's frame; a taught or configured target moves that frame, so the tag moves with
+  // the profile's vertices (nominal⁻¹ ∘ target).
+  dockcore::DockTag tag = d->tag;
+  auto move_tag = [&tag, &nominal](const Pose2& target) {
+    const Pose2 m = nominal.inverse().compose(target);
+    const dockcore::Vec2 at = m.transform(dockcore::Vec2(tag.x_m, tag.y_m));
+    tag.x_m = at.x();
+    tag.y_m = at.y();
+    tag.yaw_rad = dockcore::wrap_angle(tag.yaw_rad + m.yaw_rad);
+  };
   if (!raw_profile) {
     const TaughtTarget* t = state_.find(dock_id);
     if (t != nullptr) {
       prof = profile_for_target(d->profile, nominal, t->target);
+      move_tag(t->target);
     } else if (d->has_target) {
       prof = profile_for_target(d->profile, nominal, d->target);
+      move_tag(d->target);
     }
   }
+  core_cfg_.tag.dock_tag = tag;
   // configure() forgets the scan: the latest one (the core's own copy, untouched by configure()) is handed back so
   // the next tick does not see a lidar without data.
   const dockcore::ScanView last = (scan_from != nullptr ? *scan_from : *core_).last_scan();
@@ -382,6 +406,15 @@ void Daemon::poll_camera(std::uint64_t) {
     }
   }
   if (have) camera_ = best;
+  // The own camera's tag poses, in frame order, into the dock filter through the odometry pose at each frame's
+  // stamp (docs/camera.md, "Fusion"). The source holds at most a queue's worth.
+  if (io_.tags != nullptr) {
+    dockcore::TagObservation o;
+    for (int i = 0; i < 16 && io_.tags->poll_tag(o); ++i) {
+      const dockcore::TagStatus st = core_->on_tag(o, odom_at(o.stamp_us));
+      ++counters_.tags[static_cast<std::size_t>(st)];
+    }
+  }
 }
 
 bool Daemon::enqueue(const PendingCommand& c) {
@@ -943,6 +976,17 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       core_->filter().confirmed() ? "true" : "false");
   if (n < 0 || static_cast<std::size_t>(n) >= size) return 0;
   std::size_t len = static_cast<std::size_t>(n);
+  // The tag fusion's counters (docs/camera.md, "Status"), likewise only when they fit.
+  if (io_.tags != nullptr) {
+    const std::uint32_t* t = counters_.tags;
+    char extra[200];
+    const int k = std::snprintf(extra, sizeof extra, ",\"tag_fused\":%u,\"tag_refused\":[%u,%u,%u,%u,%u,%u,%u,%u]}",
+                                t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8]);
+    if (k > 0 && static_cast<std::size_t>(k) < sizeof extra && len - 1 + static_cast<std::size_t>(k) < size) {
+      std::memcpy(buf + len - 1, extra, static_cast<std::size_t>(k) + 1);
+      len += static_cast<std::size_t>(k) - 1;
+    }
+  }
   // The own camera's fields go before the closing brace when they fit; otherwise the status goes without them.
   if (io_.camera_status != nullptr) {
     const std::size_t k = io_.camera_status(io_.camera_status_ctx, buf + len - 1, size - len);

@@ -42,6 +42,8 @@ struct DaemonIo {
   dockcore::drivers::UdpHostLink* udp_host = nullptr;    ///< JSON requests and the status stream.
   dockcore::hal::CameraTargetSource* camera = nullptr;      ///< The UDP camera datagram (external detectors).
   dockcore::hal::CameraTargetSource* camera_own = nullptr;  ///< dockd's own capture + detector (docs/camera.md).
+  /// dockd's own detector's tag poses, fused into the dock filter (docs/camera.md, "Fusion"); null: no fusion.
+  dockcore::hal::TagPoseSource* tags = nullptr;
   /// Optional: writes the own camera's status fields (",\"camera_frames\":…", no heap, never blocking) into `buf`
   /// (`size` bytes with the NUL) and returns their length; 0 when they do not fit (the status then goes without
   /// them). `ctx` is camera_status_ctx.
@@ -81,6 +83,8 @@ struct DaemonCounters {
   std::uint32_t status_sent = 0;
   std::uint32_t config_reloads = 0;          ///< Reloads applied.
   std::uint32_t config_reloads_rejected = 0; ///< Reloads refused (invalid file, restart-only key changed).
+  /// Tag poses handed to the core, by what became of them (index: dockcore::TagStatus; kFused = fused).
+  std::uint32_t tags[dockcore::kTagStatusCount] = {};
 };
 
 /// What a config reload request came to (docs/dockd.md, "Config reload").

@@ -373,6 +373,7 @@ int main(int argc, char** argv) {
   io.camera = camera.get();
 #ifdef DOCKD_HAVE_VISION
   io.camera_own = camera_own.get();
+  io.tags = camera_own.get();
   if (camera_own) {
     io.camera_status = own_camera_status;
     io.camera_status_ctx = camera_own.get();

@@ -9,6 +9,10 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
   have_scan_ = false;
   pending_count_ = 0;
   pending_dropped_ = 0;
+  for (std::uint32_t& c : tag_counts_) c = 0;
+  have_tag_ = false;
+  last_tag_us_ = 0;
+  last_tag_ = TagMeasurement{};
   filter_confirmed_ = false;
   restart_ref_set_ = false;
   push_ref_set_ = false;
@@ -93,6 +97,38 @@ const DockEstimate& DockcoreBase::on_scan(const ScanView& scan, std::uint64_t st
     }
   }
   return last_estimate_;
+}
+
+TagStatus DockcoreBase::on_tag(const TagObservation& obs, const Pose2& odom_at_stamp) {
+  const TagFusionParams& p = config_.tag;
+  TagStatus st = TagStatus::kFused;
+  TagMeasurement m;
+  if (p.dock_tag.id < 0 || obs.id != p.dock_tag.id) {
+    st = TagStatus::kWrongId;
+  } else if (have_tag_ && obs.stamp_us <= last_tag_us_) {
+    st = TagStatus::kOutOfOrder;
+  } else {
+    have_tag_ = true;
+    last_tag_us_ = obs.stamp_us;
+    const Real lag_s = have_scan_ && last_scan_us_ > obs.stamp_us
+                           ? static_cast<Real>(last_scan_us_ - obs.stamp_us) * static_cast<Real>(1e-6)
+                           : static_cast<Real>(0);
+    if (!(lag_s <= p.max_lag_s)) {
+      st = TagStatus::kStale;
+    } else {
+      st = tag_to_dock_measurement(obs, p, &m);
+    }
+  }
+  if (st == TagStatus::kFused) {
+    last_tag_ = m;
+    const FilterUpdate u = filter_.update_tag(m.dock_in_robot, m.covariance, odom_at_stamp, obs.stamp_us);
+    if (u == FilterUpdate::kGated) st = TagStatus::kGated;
+    if (u == FilterUpdate::kInvalid) st = TagStatus::kInvalid;
+    // A filter (re)started by a tag rests on it alone: the push test waits for a second lidar detection.
+    if (u == FilterUpdate::kInitialised || u == FilterUpdate::kReinitialised) filter_confirmed_ = false;
+  }
+  ++tag_counts_[static_cast<std::size_t>(st)];
+  return st;
 }
 
 TickOutput DockcoreBase::tick(const TickInput& in) {

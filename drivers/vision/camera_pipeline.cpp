@@ -87,6 +87,14 @@ void CameraPipeline::run() {
       r.target.v_px = static_cast<Real>(tag->v_px);
       r.target.confidence = static_cast<Real>(std::min(1.0, std::max(0.0, tag->decision_margin / opt_.full_confidence_margin)));
       r.target.stamp_us = f.stamp_us;
+      if (tag->has_pose) {
+        r.has_pose = true;
+        r.tag.id = tag->id;
+        r.tag.decision_margin = static_cast<Real>(tag->decision_margin);
+        r.tag.stamp_us = f.stamp_us;
+        for (int k = 0; k < 9; ++k) r.tag.rotation(k / 3, k % 3) = static_cast<Real>(tag->rotation[k]);
+        for (int k = 0; k < 3; ++k) r.tag.translation_m(k) = static_cast<Real>(tag->translation_m[k]);
+      }
       if (push(r)) {
         const std::uint64_t one = 1;
         // The counter only saturates after 2^64 - 2 unread writes; EAGAIN then means "already readable".
@@ -113,7 +121,7 @@ void CameraPipeline::run() {
   }
 }
 
-bool CameraPipeline::poll_target(CameraTarget& out) {
+void CameraPipeline::drain() {
   std::uint64_t v = 0;
   // Clears the wake-up; EAGAIN (nothing written since) is the common case.
   if (::read(event_fd_, &v, sizeof v) < 0 && errno != EAGAIN) {
@@ -121,15 +129,43 @@ bool CameraPipeline::poll_target(CameraTarget& out) {
   }
   const std::size_t head = head_.load(std::memory_order_acquire);
   std::size_t tail = tail_.load(std::memory_order_relaxed);
-  if (head == tail) return false;
-  const Result r = ring_[(head - 1) % kCameraQueueCapacity];  // newest
+  if (head == tail) return;
+  for (; tail != head; ++tail) {
+    const Result& r = ring_[tail % kCameraQueueCapacity];
+    if (!r.has_pose) continue;
+    if (tags_count_ == kCameraQueueCapacity) {  // the oldest goes: the fusion wants recent frames
+      tags_head_ = (tags_head_ + 1) % kCameraQueueCapacity;
+      --tags_count_;
+      ++tags_dropped_;
+    }
+    tags_[(tags_head_ + tags_count_) % kCameraQueueCapacity] = r.tag;
+    ++tags_count_;
+  }
+  pending_target_ = true;
+  pending_target_value_ = ring_[(head - 1) % kCameraQueueCapacity].target;  // newest
   tail_.store(head, std::memory_order_release);
+}
+
+bool CameraPipeline::poll_target(CameraTarget& out) {
+  drain();
+  if (!pending_target_) return false;
+  pending_target_ = false;
+  const CameraTarget& t = pending_target_value_;
   const std::uint64_t now = mono_us();
-  if (now > r.target.stamp_us && now - r.target.stamp_us > static_cast<std::uint64_t>(opt_.max_age_ms) * 1000u) {
+  if (now > t.stamp_us && now - t.stamp_us > static_cast<std::uint64_t>(opt_.max_age_ms) * 1000u) {
     stale_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
-  out = r.target;
+  out = t;
+  return true;
+}
+
+bool CameraPipeline::poll_tag(TagObservation& out) {
+  drain();
+  if (tags_count_ == 0) return false;
+  out = tags_[tags_head_];
+  tags_head_ = (tags_head_ + 1) % kCameraQueueCapacity;
+  --tags_count_;
   return true;
 }
 

@@ -221,6 +221,34 @@ TEST(CameraPipeline, TargetReachesThePollWithTheFrameStamp) {
   p->stop();
 }
 
+TEST(CameraPipeline, TagPosesComeInFrameOrderWithTheirStampsBesideTheTarget) {
+  FakeFrames src(drawn_frame(7, 200, 150), 0, 5);
+  TagDetectorOptions o;
+  o.intrinsics = pinhole();
+  std::string err;
+  auto det = TagDetector::create(o, err);
+  CameraPipelineOptions po;
+  po.target_id = 7;
+  auto p = CameraPipeline::start(src, *det, po, err);
+  CHECK_TEXT(p != nullptr, err.c_str());
+  CHECK(wait_for([&] { return p->stats().target_frames >= 3; }, 3000));
+  p->stop();
+  // Draining for the poses leaves the newest target for poll_target.
+  TagObservation a, b;
+  CHECK(p->poll_tag(a));
+  CHECK(p->poll_tag(b));
+  CHECK_EQUAL(7, a.id);
+  CHECK(b.stamp_us > a.stamp_us);
+  CHECK(a.translation_m.z() > 0);
+  CHECK(a.decision_margin > 0);
+  CameraTarget t;
+  CHECK(p->poll_target(t));
+  CHECK(t.stamp_us >= b.stamp_us);
+  while (p->poll_tag(a)) {
+  }
+  CHECK_FALSE(p->poll_tag(a));
+}
+
 TEST(CameraPipeline, OtherIdsAreNoTarget) {
   FakeFrames src(drawn_frame(7, 200, 150), 0, 5);
   std::string err;

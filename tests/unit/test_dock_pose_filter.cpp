@@ -131,3 +131,44 @@ TEST(DockPoseFilter, EvidenceOfAgreeingDetectionsConfirms) {
   CHECK_FALSE(g.confirmed());
   REAL_EQUAL(0.0, g.evidence_nats(), 1e-12);
 }
+
+TEST(DockPoseFilter, TagMeasurementsAddNoEvidenceAndCountNoScans) {
+  DockPoseFilter f;
+  const Pose2 odom{};
+  const Pose2 det{1.0, 0.0, kPi};
+  CHECK(f.update_tag(det, diag_cov(0.005, 0.05), odom, 100) == FilterUpdate::kInitialised);
+  for (int i = 0; i < 20; ++i) CHECK(f.update_tag(det, diag_cov(0.005, 0.05), odom, 200 + i) == FilterUpdate::kFused);
+  REAL_EQUAL(0, f.evidence_nats(), 0);
+  LONGS_EQUAL(0, f.fused_since_start());
+  CHECK_FALSE(f.confirmed());
+  CHECK_FALSE(f.lidar_since_start());
+  LONGS_EQUAL(21, f.tag_fused());
+  LONGS_EQUAL(0, f.fused());  // the lidar's counter
+  // One lidar detection with all the evidence is still one scan: not confirmed; a second confirms.
+  CHECK(f.update(det, diag_cov(0.005, 0.01), odom, 300, 20) == FilterUpdate::kFused);
+  CHECK_FALSE(f.confirmed());
+  CHECK(f.update(det, diag_cov(0.005, 0.01), odom, 400, 0) == FilterUpdate::kFused);
+  CHECK(f.confirmed());
+}
+
+TEST(DockPoseFilter, TagsRestartTheFilterOnlyWhileItRestsOnTags) {
+  const Pose2 odom{};
+  const Pose2 det{1.0, 0.0, kPi};
+  const Pose2 moved{1.0, 0.3, kPi};
+  // Tags alone: three jumps in a row restart it at the new place (the robot was pushed).
+  DockPoseFilter a;
+  a.update_tag(det, diag_cov(0.005, 0.05), odom, 1);
+  CHECK(a.update_tag(moved, diag_cov(0.005, 0.05), odom, 2) == FilterUpdate::kGated);
+  CHECK(a.update_tag(moved, diag_cov(0.005, 0.05), odom, 3) == FilterUpdate::kGated);
+  CHECK(a.update_tag(moved, diag_cov(0.005, 0.05), odom, 4) == FilterUpdate::kReinitialised);
+  REAL_EQUAL(0.3, a.dock_in_odom().y_m, 1e-9);
+  // With a lidar detection fused since the start, a disagreeing tag is gated however often.
+  DockPoseFilter b;
+  b.update(det, diag_cov(0.005, 0.01), odom, 1, 5);
+  for (int i = 0; i < 10; ++i) CHECK(b.update_tag(moved, diag_cov(0.005, 0.05), odom, 2 + i) == FilterUpdate::kGated);
+  LONGS_EQUAL(10, b.tag_gated());
+  LONGS_EQUAL(0, b.reinitialisations());
+  REAL_EQUAL(0.0, b.dock_in_odom().y_m, 1e-9);
+  // Non-finite tag input changes nothing.
+  CHECK(b.update_tag(Pose2{std::nan(""), 0, 0}, diag_cov(0.005, 0.05), odom, 20) == FilterUpdate::kInvalid);
+}

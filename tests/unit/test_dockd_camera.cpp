@@ -6,6 +6,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "dockd_sim_rig.hpp"
 
@@ -33,6 +34,25 @@ struct FakeTargets final : dockcore::hal::CameraTargetSource {
   int fd() const override { return -1; }
 };
 
+struct FakeTags final : dockcore::hal::TagPoseSource {
+  std::vector<dockcore::TagObservation> queue;
+  /// A tag 1 m straight ahead of the camera, facing it.
+  void put(int id, std::uint64_t stamp_us) {
+    dockcore::TagObservation o;
+    o.id = id;
+    o.decision_margin = 80;
+    o.stamp_us = stamp_us;
+    o.translation_m = dockcore::Vec3(0, 0, 1);
+    queue.push_back(o);
+  }
+  bool poll_tag(dockcore::TagObservation& out) override {
+    if (queue.empty()) return false;
+    out = queue.front();
+    queue.erase(queue.begin());
+    return true;
+  }
+};
+
 std::size_t fields(const void* ctx, char* buf, std::size_t size) {
   const int n = std::snprintf(buf, size, "%s", static_cast<const char*>(ctx));
   if (n < 0 || static_cast<std::size_t>(n) >= size) {
@@ -50,11 +70,13 @@ struct CameraRig {
   dockd_test::SimChassis link;
   dockd_test::SimLidar lidar;
   FakeTargets udp, own;
+  FakeTags tags;
   std::unique_ptr<dockd::Daemon> daemon;
   std::string state_file = "/tmp/dockd_test_camera_" + std::to_string(::getpid());
 
-  explicit CameraRig(const char* status_fields) {
+  explicit CameraRig(const char* status_fields, int dock_tag_id = -1) {
     cfg.state_file = state_file;
+    cfg.docks[0].tag.id = dock_tag_id;
     chassis = dockd_test::scenario_chassis(sc, link, clock);
     dockd::DaemonIo io;
     io.lidar = &lidar;
@@ -62,6 +84,7 @@ struct CameraRig {
     io.clock = &clock;
     io.camera = &udp;
     io.camera_own = &own;
+    io.tags = &tags;
     io.stderr_level = dockd::LogLevel::kError;
     if (status_fields != nullptr) {
       io.camera_status = fields;
@@ -127,4 +150,24 @@ TEST(DockdCamera, StatusWithoutTheCameraFieldsWhenTheyDoNotFit) {
   CHECK_EQUAL('}', st[len - 1]);
   CHECK(std::strstr(st, "camera_x") == nullptr);
   STRCMP_CONTAINS("\"dock_confirmed\":", st);
+}
+
+TEST(DockdCamera, TagPosesReachTheCoreAndAreCountedInTheStatus) {
+  CameraRig r(nullptr, 3);
+  char st[dockcore::drivers::kMaxHostReply];
+  r.daemon->status_json(st, sizeof st, 0);
+  STRCMP_CONTAINS(",\"tag_fused\":0,\"tag_refused\":[0,0,0,0,0,0,0,0]}", st);
+  // The active dock's tag, another dock's tag, the same frame again.
+  r.tags.put(3, r.clock.t - 30000);
+  r.tags.put(5, r.clock.t - 20000);
+  r.tags.put(3, r.clock.t - 30000);
+  r.daemon->on_camera_readable(r.clock.t);
+  r.daemon->status_json(st, sizeof st, 0);
+  STRCMP_CONTAINS(",\"tag_fused\":1,\"tag_refused\":[1,0,0,0,0,0,1,0]}", st);
+  // A dock without a tag refuses every tag as another dock's.
+  CameraRig none(nullptr, -1);
+  none.tags.put(3, none.clock.t);
+  none.daemon->on_camera_readable(none.clock.t);
+  none.daemon->status_json(st, sizeof st, 0);
+  STRCMP_CONTAINS(",\"tag_fused\":0,\"tag_refused\":[1,", st);
 }

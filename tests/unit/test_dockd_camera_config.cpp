@@ -1,6 +1,7 @@
 // dockd's own camera in the config ([camera.device], [camera.intrinsics], [camera.mount], [camera.tag];
 // docs/camera.md): values and defaults, seed003's camera model taken from the camera, and every missing or
 // inconsistent key reported at file:line:column naming the key.
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -113,4 +114,38 @@ TEST(DockdCameraConfig, EveryCameraKeyIsRestartOnly) {
   CHECK_EQUAL(2u, changed.size());
   STRCMP_EQUAL("camera.device.*", changed[0].c_str());
   STRCMP_EQUAL("camera.tag.*", changed[1].c_str());
+}
+
+TEST(DockdCameraConfig, TagFusionKeysArrive) {
+  const std::string text = std::string(kCamera) +
+                           "[camera.fusion]\nsigma_px = 0.5\nmax_lag_s = 0.03\n[dock]\ndefault_id = 1\n"
+                           "[[docks]]\nid = 1\ntag_id = 7\ntag_y_m = 0.05\ntag_z_m = 0.2\ntag_yaw_deg = 3\n"
+                           "[[docks]]\nid = 2\n";
+  const dockd::DockdConfig c = dockd::parse_config_toml(text, "t.toml");
+  DOUBLES_EQUAL(0.5, static_cast<double>(c.tag_fusion.sigma_px), 1e-9);
+  DOUBLES_EQUAL(0.03, static_cast<double>(c.tag_fusion.max_lag_s), 1e-9);
+  DOUBLES_EQUAL(1, static_cast<double>(c.tag_fusion.sigma_scale), 0);  // the struct's default
+  const dockd::DockEntry* d1 = c.find_dock(1);
+  const dockd::DockEntry* d2 = c.find_dock(2);
+  CHECK(d1 != nullptr && d2 != nullptr);
+  LONGS_EQUAL(7, d1->tag.id);
+  DOUBLES_EQUAL(0.05, static_cast<double>(d1->tag.y_m), 1e-9);
+  DOUBLES_EQUAL(0.2, static_cast<double>(d1->tag.z_m), 1e-9);
+  DOUBLES_EQUAL(3 * 3.14159265358979 / 180, static_cast<double>(d1->tag.yaw_rad), 1e-6);
+  LONGS_EQUAL(-1, d2->tag.id);  // no tag on dock 2
+}
+
+TEST(DockdCameraConfig, TagFusionMistakesAreNamedAtTheirLine) {
+  STRCMP_CONTAINS("t.toml:3:11: docks.tag_x_m / tag_y_m / tag_z_m / tag_yaw_deg need docks.tag_id",
+                  error_of(std::string("[[docks]]\nid = 1\ntag_y_m = 0.05\n")).c_str());
+  STRCMP_CONTAINS("t.toml:3:10: docks.tag_id needs [camera.device]",
+                  error_of(std::string("[[docks]]\nid = 1\ntag_id = 4\n")).c_str());
+  STRCMP_CONTAINS("[camera.fusion] needs [camera.device]", error_of("[camera.fusion]\nsigma_px = 0.4\n").c_str());
+  const std::string cam(kCamera);
+  const int lines = static_cast<int>(std::count(cam.begin(), cam.end(), '\n'));
+  STRCMP_CONTAINS(("t.toml:" + std::to_string(lines + 2) + ":12: camera.fusion.sigma_px = 0 is out of range").c_str(),
+                  error_of(cam + "[camera.fusion]\nsigma_px = 0\n").c_str());
+  STRCMP_CONTAINS("unknown key 'camera.fusion.sigma'", error_of(cam + "[camera.fusion]\nsigma = 1\n").c_str());
+  STRCMP_CONTAINS("docks.tag_z_m = 3 is out of range", error_of(cam + "[[docks]]\ntag_id = 1\ntag_z_m = 3\n").c_str());
+  STRCMP_CONTAINS("docks.tag_id = -1 is out of range", error_of(cam + "[[docks]]\ntag_id = -1\n").c_str());
 }

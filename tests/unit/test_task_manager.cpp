@@ -8,15 +8,18 @@
 
 #include "dockcore/dock_profile.hpp"
 #include "dockcore/dockcore.hpp"
+#include "dockcore/tag_measurement.hpp"
 #include "dockcore/task_manager.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 
 #include "real_tolerance.hpp"
+#include "tag_observe.hpp"
 
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
+using dockcore_test::observe_tag;
 
 namespace {
 
@@ -838,6 +841,19 @@ TEST(TaskManager, Deterministic) {
 
 namespace {
 
+/// The camera and tag of the facade tests: camera 0.2 m ahead of the centre at 0.2 m height, an 80 mm tag 0.2 m
+/// above the contacts on a 600 px camera.
+TagFusionParams facade_tag_params() {
+  TagFusionParams p;
+  p.mount.x_m = 0.2;
+  p.mount.z_m = 0.2;
+  p.fx_px = 600;
+  p.tag_size_m = 0.08;
+  p.dock_tag.id = 3;
+  p.dock_tag.z_m = 0.2;
+  return p;
+}
+
 /// The Sim's world and robot, driven through Dockcore with the real estimator and filter on simulated scans.
 struct FacadeSim {
   Sim w;  // world, robot integration and charging script (its TaskManager is unused)
@@ -848,11 +864,39 @@ struct FacadeSim {
     cfg.task.detect_wait_s = 0.3;
     CHECK(core->configure(w.profile, cfg));
   }
+  /// Tag detections every other tick (25 frames/s), 40 ms old when they arrive, mapped through the odometry pose
+  /// at their stamp.
+  void enable_tags(const TagFusionParams& p, bool feed = true) {
+    DockcoreConfig cfg;
+    cfg.task.detect_wait_s = 0.3;
+    cfg.tag = p;
+    CHECK(core->configure(w.profile, cfg));
+    tags_on = feed;
+    tag_truth = p;
+  }
+  TagFusionParams tag_truth{};  // where the tag really is (observe_tag), whatever the core is told
+  bool tags_on = false;
+  bool lidar_sees_dock = true;  // false: every scan has no returns (no lidar detection; the scans still arrive)
+  double tag_sigma_px = 0.3;
+  docksim::Rng tag_rng{7};  // its own stream: the lidar's noise is the same with and without tags
+  struct Past {
+    std::uint64_t stamp_us;
+    Pose2 world, odom;
+  };
+  std::vector<Past> past;
   bool scans_on = true;  // false: a lidar gap (the host drops late scans); ticks and odometry go on
   TickOutput step(HostCommand cmd = HostCommand{}, bool resume = false) {
     if (scans_on && w.ticks % 5 == 0) {
       simulate_scan(w.world_model(), w.world, w.model, w.rng, &w.scan, w.now_us);
+      if (!lidar_sees_dock) {
+        for (std::size_t i = 0; i < w.scan.count; ++i) w.scan.ranges_m[i] = 0;
+      }
       core->on_scan(w.scan.view(), w.now_us, w.odom);
+    }
+    past.push_back(Past{w.now_us, w.world, w.odom});
+    if (tags_on && w.ticks % 2 == 0 && past.size() > 2) {
+      const Past& then = past[past.size() - 3];  // two ticks ago: 40 ms
+      core->on_tag(observe_tag(then.world, w.dock, tag_truth, &tag_rng, tag_sigma_px, then.stamp_us), then.odom);
     }
     TickInput in;
     in.now_us = w.now_us;
@@ -1179,4 +1223,123 @@ TEST(TaskManager, StatesAndCommandResultsHaveTheirStableNames) {
       "rejected_busy"};
   for (int r = 0; r < 7; ++r) STRCMP_EQUAL(results[r], to_string(static_cast<CommandResult>(r)));
   STRCMP_EQUAL("unknown", to_string(static_cast<CommandResult>(7)));
+}
+
+TEST(Dockcore, TagAloneDocksWhenTheLidarSeesNoDock) {
+  // The lidar still scans (the obstacle check needs it) but never detects the dock: the tag alone docks.
+  FacadeSim f;
+  f.enable_tags(facade_tag_params());
+  f.lidar_sees_dock = false;
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  CHECK(f.run_until(TaskState::kFinishTasking, 30));
+  LONGS_EQUAL(0, f.core->estimator().counters().found);
+  CHECK(f.core->tag_count(TagStatus::kFused) > 100);
+  LONGS_EQUAL(0, f.core->tag_count(TagStatus::kStale) + f.core->tag_count(TagStatus::kOutOfOrder));
+  const Vec2 front = f.w.world.transform(Vec2(kHalfLength, 0));
+  REAL_EQUAL(0.0, front.x(), 0.003);
+  CHECK(std::fabs(front.y()) < 0.05);
+  // Tags add no evidence: the sequential test is the lidar's.
+  REAL_EQUAL(0.0, f.core->filter().evidence_nats(), 0);
+  CHECK_FALSE(f.core->filter().confirmed());
+  LONGS_EQUAL(0, f.w.zero_violations);
+}
+
+TEST(Dockcore, TagWithoutScansIsStillLidarStale) {
+  // The tag replaces the lidar's dock detection, not its obstacle check: no scans at all is still fault 185.
+  FacadeSim f;
+  f.enable_tags(facade_tag_params());
+  f.scans_on = false;
+  TickOutput o = f.step(HostCommand{HostCommandType::kDock, 0});
+  for (int i = 0; i < 100 && o.status.state != TaskState::kFault; ++i) o = f.step();
+  CHECK(o.status.state == TaskState::kFault);
+  LONGS_EQUAL(185, static_cast<int>(o.status.fault));
+}
+
+TEST(Dockcore, LidarAndTagFusedAreAtLeastAsAccurateAsLidarAlone) {
+  // The same lidar noise (σ 10 mm, its own random stream) with and without tags; the robot stands 1.2 m off the
+  // dock at several bearings; the filter's dock after 2 s against the truth.
+  double se_lidar[3] = {0, 0, 0}, se_fused[3] = {0, 0, 0};
+  int n = 0;
+  for (int seed = 1; seed <= 12; ++seed) {
+    for (int tags = 0; tags <= 1; ++tags) {
+      FacadeSim f;
+      f.w.model.sigma_const_m = 0.01;
+      f.w.rng = docksim::Rng(static_cast<std::uint64_t>(seed));
+      f.w.world = f.w.odom = dockcore_test::pose(1.2, -0.15 + 0.025 * seed, kPi + 0.02 * (seed - 6));
+      if (tags != 0) f.enable_tags(facade_tag_params());
+      for (int i = 0; i < 100; ++i) f.step();
+      CHECK(f.core->filter().initialised());
+      const Pose2 est = f.core->filter().dock_in_robot(f.w.odom);
+      const Pose2 truth = f.w.world.inverse().compose(f.w.dock);
+      const double e[3] = {est.x_m - truth.x_m, est.y_m - truth.y_m, wrap_angle(est.yaw_rad - truth.yaw_rad)};
+      for (int k = 0; k < 3; ++k) (tags != 0 ? se_fused : se_lidar)[k] += e[k] * e[k];
+      if (tags != 0) CHECK(f.core->tag_count(TagStatus::kFused) > 40);
+    }
+    ++n;
+  }
+  const char* names[3] = {"x", "y (lateral)", "yaw"};
+  for (int k = 0; k < 3; ++k) {
+    const double lidar = std::sqrt(se_lidar[k] / n), fused = std::sqrt(se_fused[k] / n);
+    printf("\n%s RMS: lidar %.5f, lidar + tag %.5f", names[k], lidar, fused);
+    CHECK_TEXT(fused <= lidar, names[k]);
+  }
+  printf("\n");
+}
+
+TEST(Dockcore, WrongIdStaleAndOutOfOrderTagsAreCountedAndChangeNothing) {
+  FacadeSim f;
+  const TagFusionParams p = facade_tag_params();
+  f.enable_tags(p, false);               // configured, fed by hand below
+  for (int i = 0; i < 6; ++i) f.step();  // scans at ticks 0 and 5
+  const std::uint64_t scan_us = f.core->last_scan().stamp_us;
+  CHECK(f.core->filter().initialised());
+  auto tag_at = [&](std::uint64_t stamp_us) { return observe_tag(f.w.world, f.w.dock, p, nullptr, 0, stamp_us); };
+  auto check_refused = [&](const TagObservation& o, TagStatus want) {
+    const Pose2 dock = f.core->filter().dock_in_odom();
+    const Mat3 cov = f.core->filter().covariance_odom();
+    const std::uint32_t fused = f.core->filter().tag_fused(), before = f.core->tag_count(want);
+    CHECK_EQUAL_TEXT(static_cast<int>(want), static_cast<int>(f.core->on_tag(o, f.w.odom)), to_string(want));
+    const Pose2 d = f.core->filter().dock_in_odom();
+    CHECK(d.x_m == dock.x_m && d.y_m == dock.y_m && d.yaw_rad == dock.yaw_rad);
+    CHECK(f.core->filter().covariance_odom() == cov);
+    LONGS_EQUAL(fused, f.core->filter().tag_fused());
+    LONGS_EQUAL(before + 1, f.core->tag_count(want));
+  };
+  check_refused(tag_at(scan_us - 60000), TagStatus::kStale);  // 60 ms before the newest scan (bound 50 ms)
+  CHECK(f.core->on_tag(tag_at(scan_us - 40000), f.w.odom) == TagStatus::kFused);
+  LONGS_EQUAL(1, f.core->filter().tag_fused());
+  check_refused(tag_at(scan_us - 45000), TagStatus::kOutOfOrder);  // older than the previous frame
+  check_refused(tag_at(scan_us - 40000), TagStatus::kOutOfOrder);  // the same frame again
+  TagObservation wrong = tag_at(scan_us);
+  wrong.id = 4;  // another dock's tag
+  check_refused(wrong, TagStatus::kWrongId);
+  TagObservation behind = tag_at(scan_us + 1);
+  behind.translation_m.z() = -behind.translation_m.z();
+  check_refused(behind, TagStatus::kBehind);
+  TagObservation nan = tag_at(scan_us + 2);
+  nan.rotation(0, 0) = std::nan("");
+  check_refused(nan, TagStatus::kInvalid);
+  CHECK(f.core->on_tag(tag_at(scan_us + 3), f.w.odom) == TagStatus::kFused);
+  // A dock without a tag (id −1) takes none.
+  TagFusionParams none = p;
+  none.dock_tag.id = -1;
+  f.enable_tags(none, false);
+  for (int i = 0; i < 5; ++i) f.step();
+  check_refused(tag_at(f.core->last_scan().stamp_us), TagStatus::kWrongId);
+}
+
+TEST(Dockcore, AMisplacedTagIsGatedAndDoesNotOverruleTheLidar) {
+  // The tag's configured place is 0.3 m off: with the lidar fusing, its measurements are gated and never restart
+  // the filter; the lidar's dock stands.
+  FacadeSim f;
+  TagFusionParams told = facade_tag_params();
+  told.dock_tag.y_m = 0.3;
+  f.enable_tags(told);
+  f.tag_truth = facade_tag_params();  // where the tag really is
+  for (int i = 0; i < 200; ++i) f.step();
+  CHECK(f.core->tag_count(TagStatus::kGated) > 50);
+  LONGS_EQUAL(0, f.core->filter().reinitialisations());
+  const Pose2 est = f.core->filter().dock_in_robot(f.w.odom);
+  const Pose2 want = f.w.world.inverse().compose(f.w.dock);
+  REAL_EQUAL(want.y_m, est.y_m, 0.01);
 }

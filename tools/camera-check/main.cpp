@@ -3,6 +3,7 @@
 //   camera-check capture --detect --fx 600 --tag-size 0.1 ...        the same, with the tags of every frame (pose)
 //   camera-check detect --image photo.jpg --fx 600 ...               tags in one image, with pose
 //   camera-check bench --image photo.jpg --frames 200                detection time per 640×480 grey frame
+//   camera-check tag-pose --frames 300 --distance 1.0                 dock pose from a tag on rendered frames
 // Output is JSON, one object per line. Exit status: 0 ok, 1 the check failed (capture: no frame, stamps not
 // increasing, --expect-reconnect without a loss and reopen; detect: no tag), 2 usage or option error, 3 the device
 // could not be used (refused, or no frame for --give-up-seconds).
@@ -25,6 +26,7 @@
 #include "dockcore/drivers/apriltag_detector.hpp"
 #include "dockcore/drivers/v4l2_camera.hpp"
 #include "jpeg_grey.hpp"
+#include "tag_pose.hpp"
 
 using namespace dockcore::drivers;
 
@@ -204,6 +206,22 @@ int main(int argc, char** argv) {
   bench->add_option("--width", width, "frame width, px (the image's centre is cropped to it)")->capture_default_str();
   bench->add_option("--height", height, "frame height, px")->capture_default_str();
 
+  camera_check::TagPoseOptions tp;
+  double tp_fx = 600;
+  auto* tagpose = app.add_subcommand(
+      "tag-pose", "error of the dock pose derived from a tag on rendered frames with noise and blur");
+  add_detector_options(tagpose, nullptr);
+  tagpose->add_option("--frames", tp.frames, "rendered frames")->capture_default_str();
+  tagpose->add_option("--distance", tp.distance_m, "camera to tag, m")->capture_default_str();
+  tagpose->add_option("--lateral", tp.lateral_m, "robot offset from the dock axis: uniform in ±this, m")
+      ->capture_default_str();
+  tagpose->add_option("--yaw", tp.yaw_deg, "dock turned: uniform in ±this, °")->capture_default_str();
+  tagpose->add_option("--noise", tp.noise_grey, "Gaussian pixel noise σ, grey levels")->capture_default_str();
+  tagpose->add_option("--blur", tp.blur_px, "Gaussian blur σ, px")->capture_default_str();
+  tagpose->add_option("--sigma-px", tp.sigma_px, "the covariance model's corner noise, px")->capture_default_str();
+  tagpose->add_option("--focal", tp_fx, "focal length of the rendered 640×480 camera, px")->capture_default_str();
+  tagpose->add_option("--seed", tp.seed)->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -211,6 +229,7 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
 
+  if (tagpose->parsed()) return camera_check::run_tag_pose(tp, det_opt, tp_fx);
   std::string err;
   auto set_intrinsics = [&](std::uint32_t w, std::uint32_t h) {
     if (fx <= 0) return;

@@ -6,7 +6,9 @@
 /// update with the yaw innovation wrapped to (-pi, pi]. Odometry drift is the process noise: the estimate's
 /// covariance grows with the distance and angle the robot travels. A Mahalanobis gate rejects jumps (a bad
 /// detection, or the robot pushed so odometry no longer matches); after `reinit_after` consecutive rejections the
-/// filter restarts from the newest detection and reports it. Cost O(1) per call; no heap.
+/// filter restarts from the newest detection and reports it. A second source, a camera's tag pose (update_tag), goes
+/// through the same mapping, gate and Kalman update but adds no evidence to the sequential test and restarts the
+/// filter only while it rests on tags alone (docs/camera.md, "Fusion"). Cost O(1) per call; no heap.
 
 #include <cstdint>
 
@@ -53,6 +55,13 @@ class DockPoseFilter {
   FilterUpdate update(const Pose2& dock_in_robot, const Mat3& cov_robot, const Pose2& odom_pose, std::uint64_t stamp_us,
                       Real evidence_nats = 0);
 
+  /// Fuses a tag measurement (dock pose in the robot frame from a camera's tag, TagMeasurement) like update(), with
+  /// three differences: it adds no evidence and does not count as a scan for confirmed(); its consecutive gated
+  /// measurements restart the filter only while no lidar detection has been fused since the filter (re)started (the
+  /// lidar, when present, is not overruled by the camera); and a filter it starts counts no scans. O(1).
+  FilterUpdate update_tag(const Pose2& dock_in_robot, const Mat3& cov_robot, const Pose2& odom_pose,
+                          std::uint64_t stamp_us);
+
   bool initialised() const { return initialised_; }
   /// Dock pose in the odometry frame and its covariance. Meaningful only when initialised().
   const Pose2& dock_in_odom() const { return dock_odom_; }
@@ -64,6 +73,11 @@ class DockPoseFilter {
   std::uint32_t fused() const { return fused_; }
   std::uint32_t gated() const { return gated_; }
   std::uint32_t reinitialisations() const { return reinits_; }
+  /// Tag measurements fused (update_tag: kInitialised, kFused, kReinitialised) and gated.
+  std::uint32_t tag_fused() const { return tag_fused_; }
+  std::uint32_t tag_gated() const { return tag_gated_; }
+  /// A lidar detection has been fused since the filter (re)started.
+  bool lidar_since_start() const { return lidar_since_start_; }
   /// Mahalanobis² of the most recent innovation (gated or not).
   Real last_mahalanobis2() const { return last_d2_; }
   /// The sequential test's sum: evidence of the detections fused since the filter (re)started, nats.
@@ -77,6 +91,12 @@ class DockPoseFilter {
 
  private:
   void start(const Pose2& z, const Mat3& rz, std::uint64_t stamp_us, Real evidence_nats);
+  /// The measurement mapped into the odometry frame with its floored covariance (after predict). O(1).
+  void to_odom(const Pose2& dock_in_robot, const Mat3& cov_robot, const Pose2& odom_pose, Pose2* z, Mat3* rz) const;
+  /// Mahalanobis² of z against the estimate into last_d2_; false when the innovation covariance is singular. O(1).
+  bool innovation(const Pose2& z, const Mat3& rz, Vec3* nu, Mat3* s_inv);
+  /// The Kalman update with innovation nu. O(1).
+  void correct(const Vec3& nu, const Mat3& s_inv, const Mat3& rz);
 
   DockFilterParams params_;
   bool initialised_ = false;
@@ -92,6 +112,10 @@ class DockPoseFilter {
   Real last_d2_ = 0;
   Real evidence_nats_ = 0;
   std::uint32_t fused_since_start_ = 0;
+  bool lidar_since_start_ = false;
+  std::uint8_t consecutive_tag_gated_ = 0;
+  std::uint32_t tag_fused_ = 0;
+  std::uint32_t tag_gated_ = 0;
 };
 
 }  // namespace dockcore

@@ -22,6 +22,12 @@
 /// it too, but the push test keeps the confirmed estimate from before the outage as its reference — the filter's own,
 /// or the one it had before it restarted at a pushed pose during the outage — carried by odometry, up to
 /// DockcoreConfig::push_check_max_gap_s old, until a detection in ALIGN agrees with it (docs/faults.md, 178).
+/// - on_tag(): a camera's tag detection (docs/camera.md, "Fusion"): the active dock's tag only, in stamp order, not
+///   older than the newest scan by more than TagFusionParams::max_lag_s, turned into a dock pose
+///   (tag_to_dock_measurement) and fused into the same filter (DockPoseFilter::update_tag: same gate, no evidence).
+///   Refusals are counted by reason and change nothing else. Tag measurements are not raw detections for the push
+///   test, and the lidar's scan stays the obstacle check's input: the tag replaces the lidar's dock detection, not
+///   its safety role.
 /// No heap. DockcoreN<N> holds the estimator's buffers and the scan copy for N beams (docs/architecture.md: about
 /// 90 KiB with double at 720 beams, 370 KiB at kMaxScanPoints): keep it static or a member, never on a small stack.
 
@@ -35,6 +41,7 @@
 #include "dockcore/kinematics.hpp"
 #include "dockcore/laser_scan.hpp"
 #include "dockcore/safety.hpp"
+#include "dockcore/tag_measurement.hpp"
 #include "dockcore/task_manager.hpp"
 
 namespace dockcore {
@@ -56,6 +63,9 @@ struct DockcoreConfig {
   /// outage, so the old estimate carried by odometry still says where the dock must be; beyond this, odometry drift
   /// (and the chance that the robot was carried) make it no evidence of a push, and the task starts afresh.
   Real push_check_max_gap_s = static_cast<Real>(3.0);
+  /// The camera, the active dock's tag and the tag noise model (on_tag). dock_tag.id −1 (the default): every tag
+  /// detection is refused as kWrongId.
+  TagFusionParams tag{};
 };
 
 /// Per-tick input from the chassis and the host.
@@ -98,6 +108,15 @@ class DockcoreBase {
   /// One scan: detection (hint = the filter's prediction for `odom_pose`), filter update, scan copy.
   /// `odom_pose`: robot odometry pose at the scan time; `stamp_us`: scan time. Cost: the estimator's plus O(count).
   const DockEstimate& on_scan(const ScanView& scan, std::uint64_t stamp_us, const Pose2& odom_pose);
+
+  /// One tag detection from a camera frame captured at `obs.stamp_us` (file comment); `odom_at_stamp`: the robot's
+  /// odometry pose at that stamp (the host's odometry history, not the current pose). Returns what became of it;
+  /// anything but kFused leaves the filter unchanged. Counted in tag_counts(). O(1).
+  TagStatus on_tag(const TagObservation& obs, const Pose2& odom_at_stamp);
+  /// Tag detections by outcome since configure(), indexed by TagStatus. O(1).
+  std::uint32_t tag_count(TagStatus s) const { return tag_counts_[static_cast<std::size_t>(s)]; }
+  /// The last tag measurement made (valid once a detection passed the id, order and age checks and was usable).
+  const TagMeasurement& last_tag_measurement() const { return last_tag_; }
 
   /// One control tick: the task manager, then the output shaping (file comment). Cost: TaskManager::tick + O(1).
   TickOutput tick(const TickInput& in);
@@ -151,6 +170,10 @@ class DockcoreBase {
   DetectionInput pending_[kMaxDetectionsPerTick] = {};
   std::uint8_t pending_count_ = 0;
   std::uint32_t pending_dropped_ = 0;  ///< Detections beyond kMaxDetectionsPerTick between two ticks (not tested).
+  std::uint32_t tag_counts_[kTagStatusCount] = {};
+  bool have_tag_ = false;
+  std::uint64_t last_tag_us_ = 0;  ///< Newest tag frame past the id and order checks.
+  TagMeasurement last_tag_{};
   TaskState prev_state_ = TaskState::kNotTasking;
   Twist2 prev_drive_cmd_{};  ///< drive_cmd of the previous tick: the acceleration limit's start.
   bool filter_confirmed_ = false;  ///< The filter fused a detection since its last (re)initialisation.

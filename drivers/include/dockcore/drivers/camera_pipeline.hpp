@@ -45,7 +45,8 @@ struct CameraPipelineStats {
   std::uint64_t last_tag_stamp_us = 0;
 };
 
-class CameraPipeline final : public hal::CameraTargetSource {
+/// Also a hal::TagPoseSource: the target tag's pose of every frame that had one (with intrinsics), in frame order.
+class CameraPipeline final : public hal::CameraTargetSource, public hal::TagPoseSource {
  public:
   /// Starts the thread. The source and the detector must outlive the pipeline; only the thread uses them.
   /// nullptr + message when the wake-up descriptor or the thread cannot be created.
@@ -57,6 +58,11 @@ class CameraPipeline final : public hal::CameraTargetSource {
 
   /// Newest target queued since the last call and not older than max_age_ms; false otherwise. Never blocks. O(queue).
   bool poll_target(CameraTarget& out) override;
+  /// The oldest queued tag pose not yet handed out (results drained from the queue by either poll keep their pose
+  /// here, at most kCameraQueueCapacity; older ones are dropped and counted in tags_dropped()). Never blocks. O(1).
+  bool poll_tag(TagObservation& out) override;
+  /// Tag poses dropped because poll_tag was not called for kCameraQueueCapacity results. Tick side only.
+  std::uint64_t tags_dropped() const { return tags_dropped_; }
   /// An eventfd that is readable when the thread has queued a result (poll_target clears it).
   int fd() const override { return event_fd_; }
   /// The latest snapshot; never blocks (when the thread is updating it, the previous snapshot is returned).
@@ -67,7 +73,11 @@ class CameraPipeline final : public hal::CameraTargetSource {
  private:
   struct Result {
     CameraTarget target{};
+    bool has_pose = false;
+    TagObservation tag{};
   };
+  /// Moves every queued result into pending_target_ and the tag buffer. Tick side only.
+  void drain();
   CameraPipeline(hal::CameraFrameSource& s, TagDetector& d, const CameraPipelineOptions& o, int efd);
   void run();
   bool push(const Result& r);
@@ -83,6 +93,12 @@ class CameraPipeline final : public hal::CameraTargetSource {
   std::atomic<std::size_t> head_{0};
   std::atomic<std::size_t> tail_{0};
   std::atomic<std::uint64_t> stale_{0};
+  // Tick side only: the newest drained target not yet polled, and the drained tag poses not yet polled.
+  bool pending_target_ = false;
+  CameraTarget pending_target_value_{};
+  TagObservation tags_[kCameraQueueCapacity];
+  std::size_t tags_head_ = 0, tags_count_ = 0;
+  std::uint64_t tags_dropped_ = 0;
   mutable std::mutex stats_mutex_;
   CameraPipelineStats stats_{};           ///< Written by the thread under stats_mutex_.
   mutable CameraPipelineStats last_read_{};  ///< The tick's copy when the lock was busy.

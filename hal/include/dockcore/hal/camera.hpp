@@ -2,6 +2,7 @@
 /// @file HAL: the camera. Two interfaces for the two places a camera's data can come from:
 ///  - CameraTargetSource: the dock target as the controllers use it (pixel column/row, confidence, stamp), from any
 ///    vision process (the UDP datagram of docs/dockd.md) or from dockd's own detector (docs/camera.md);
+///  - TagPoseSource: the dock tag's pose per frame (DockcoreBase::on_tag's input), from dockd's own detector;
 ///  - CameraFrameSource: raw grey frames from a capture device (a V4L2 camera), stamped by the driver, for a
 ///    detector that runs on the robot's board.
 
@@ -9,6 +10,7 @@
 #include <cstdint>
 
 #include "dockcore/controller.hpp"
+#include "dockcore/tag_measurement.hpp"
 
 namespace dockcore::hal {
 
@@ -21,6 +23,16 @@ class CameraTargetSource {
 
  protected:
   ~CameraTargetSource() = default;
+};
+
+/// Tag poses in frame order, each handed out once (the dock-pose fusion, docs/camera.md "Fusion").
+class TagPoseSource {
+ public:
+  /// The oldest tag pose not yet handed out; false when none is waiting (out untouched). Never blocks.
+  virtual bool poll_tag(TagObservation& out) = 0;
+
+ protected:
+  ~TagPoseSource() = default;
 };
 
 /// One captured frame as 8-bit grey, row-major. The pixels belong to the source and stay valid until the next

@@ -15,6 +15,7 @@
 #include "dockcore/dock_pose_estimator.hpp"
 #include "dockcore/kinematics.hpp"
 #include "dockcore/safety.hpp"
+#include "dockcore/tag_measurement.hpp"
 #include "dockcore/task_manager.hpp"
 
 namespace dockcore::params {
@@ -46,6 +47,7 @@ struct ParamTargets {
   Seed004Params* seed004 = nullptr;
   Seed003Params* seed003 = nullptr;
   SmoothParams* smooth = nullptr;
+  TagFusionParams* tag_fusion = nullptr;  ///< dockd only: [camera.fusion].
 };
 
 /// One parameter.

@@ -1,0 +1,188 @@
+// camera-check tag-pose (see tag_pose.hpp).
+#include "tag_pose.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "dockcore/geometry.hpp"
+#include "dockcore/tag_measurement.hpp"
+#include "docksim/rng.hpp"
+#include "docksim/tag_render.hpp"
+
+namespace camera_check {
+
+using dockcore::Mat3;
+using dockcore::Pose2;
+using dockcore::Real;
+using dockcore::Vec2;
+using dockcore::Vec3;
+
+namespace {
+
+Mat3 rot_z(double a) {
+  Mat3 r = Mat3::Identity();
+  r(0, 0) = static_cast<Real>(std::cos(a));
+  r(0, 1) = static_cast<Real>(-std::sin(a));
+  r(1, 0) = static_cast<Real>(std::sin(a));
+  r(1, 1) = static_cast<Real>(std::cos(a));
+  return r;
+}
+
+/// Separable Gaussian blur of σ px (kernel ±3σ), in place.
+void blur(std::vector<std::uint8_t>& img, std::uint32_t w, std::uint32_t h, double sigma) {
+  if (sigma <= 0) return;
+  const int r = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
+  std::vector<double> k(static_cast<std::size_t>(2 * r + 1));
+  double sum = 0;
+  for (int i = -r; i <= r; ++i) sum += k[static_cast<std::size_t>(i + r)] = std::exp(-0.5 * i * i / (sigma * sigma));
+  for (double& v : k) v /= sum;
+  std::vector<double> tmp(img.size());
+  const int iw = static_cast<int>(w), ih = static_cast<int>(h);
+  for (int y = 0; y < ih; ++y) {
+    for (int x = 0; x < iw; ++x) {
+      double a = 0;
+      for (int i = -r; i <= r; ++i)
+        a += k[static_cast<std::size_t>(i + r)] * img[static_cast<std::size_t>(y * iw + std::clamp(x + i, 0, iw - 1))];
+      tmp[static_cast<std::size_t>(y * iw + x)] = a;
+    }
+  }
+  for (int y = 0; y < ih; ++y) {
+    for (int x = 0; x < iw; ++x) {
+      double a = 0;
+      for (int i = -r; i <= r; ++i)
+        a += k[static_cast<std::size_t>(i + r)] * tmp[static_cast<std::size_t>(std::clamp(y + i, 0, ih - 1) * iw + x)];
+      img[static_cast<std::size_t>(y * iw + x)] = static_cast<std::uint8_t>(std::clamp(std::lround(a), 0L, 255L));
+    }
+  }
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))];
+}
+
+double rms(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x * x;
+  return v.empty() ? std::nan("") : std::sqrt(s / static_cast<double>(v.size()));
+}
+
+}  // namespace
+
+int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions det, double fx_px) {
+  if (o.frames == 0 || o.distance_m <= 0 || fx_px <= 0 || det.tag_size_m <= 0) {
+    std::fprintf(stderr, "camera-check tag-pose: --frames, --distance, --fx and --tag-size must be > 0\n");
+    return 2;
+  }
+  const int family_id = 3;
+  // The pattern, one pixel per cell, and the black square's side in cells.
+  std::vector<std::uint8_t> cells(64 * 64, 0);
+  std::uint32_t black_cells = 0;
+  std::uint32_t side = 0;
+  for (std::uint32_t n = 4; n <= 64 && black_cells == 0; ++n) {
+    if (dockcore::drivers::draw_tag_upright(det.family, family_id, 1, 0, 0, cells.data(), n, n, n, &black_cells))
+      side = n;
+  }
+  if (side == 0) {
+    std::fprintf(stderr, "camera-check tag-pose: cannot draw tag %d of %s\n", family_id, det.family.c_str());
+    return 2;
+  }
+  cells.resize(static_cast<std::size_t>(side) * side);
+  const docksim::TagPattern pattern{cells.data(), side, det.tag_size_m / black_cells};
+  docksim::PinholeView view;
+  view.fx_px = view.fy_px = fx_px;
+  view.width_px = o.width_px;
+  view.height_px = o.height_px;
+  view.cx_px = (o.width_px - 1) / 2.0;
+  view.cy_px = (o.height_px - 1) / 2.0;
+  det.intrinsics = dockcore::drivers::CameraIntrinsics{fx_px, fx_px, view.cx_px, view.cy_px};
+  std::string err;
+  auto detector = dockcore::drivers::TagDetector::create(det, err);
+  if (!detector) {
+    std::fprintf(stderr, "camera-check tag-pose: %s\n", err.c_str());
+    return 2;
+  }
+  // The robot: camera 0.2 m ahead of its centre at the tag's height (0.2 m), level; the tag on the dock face, 0.2 m
+  // above the contacts.
+  dockcore::TagFusionParams p;
+  p.mount.x_m = static_cast<Real>(0.2);
+  p.mount.z_m = static_cast<Real>(0.2);
+  p.fx_px = static_cast<Real>(fx_px);
+  p.tag_size_m = static_cast<Real>(det.tag_size_m);
+  p.dock_tag.id = family_id;
+  p.dock_tag.z_m = static_cast<Real>(0.2);
+  p.sigma_px = static_cast<Real>(o.sigma_px);
+  Mat3 upright = Mat3::Zero();
+  upright(1, 0) = 1;
+  upright(2, 1) = -1;
+  upright(0, 2) = -1;
+  const Mat3 r_rc = dockcore::camera_rotation(p.mount);
+  docksim::Rng rng(o.seed);
+  std::vector<std::uint8_t> img(static_cast<std::size_t>(o.width_px) * o.height_px);
+  std::vector<double> lat_mm, depth_mm, yaw_deg, z_lat, z_yaw, in_dock_mm;
+  std::uint32_t found = 0;
+  for (std::uint32_t i = 0; i < o.frames; ++i) {
+    // The dock in the robot frame: ahead at distance + mount, offset sideways, turned.
+    const double yaw = dockcore::kPi + rng.uniform(-1, 1) * o.yaw_deg * dockcore::kPi / 180;
+    const Pose2 dock{static_cast<Real>(o.distance_m + 0.2), static_cast<Real>(rng.uniform(-1, 1) * o.lateral_m),
+                     static_cast<Real>(yaw)};
+    const Mat3 r_rt = rot_z(dock.yaw_rad) * upright;
+    const Vec2 t2 = dock.transform(Vec2(0, 0));
+    const Vec3 t_rt(t2.x(), t2.y(), static_cast<Real>(0.2));
+    const Mat3 r_ct = r_rc.transpose() * r_rt;
+    const Vec3 t_ct = r_rc.transpose() * (t_rt - Vec3(p.mount.x_m, p.mount.y_m, p.mount.z_m));
+    for (int k = 0; k < 9; ++k) view.rotation[k] = static_cast<double>(r_ct(k / 3, k % 3));
+    for (int k = 0; k < 3; ++k) view.translation_m[k] = static_cast<double>(t_ct(k));
+    view.background = static_cast<std::uint8_t>(100 + rng.uniform(0, 60));
+    docksim::render_tag(pattern, view, img.data(), o.width_px);
+    blur(img, o.width_px, o.height_px, o.blur_px);
+    for (std::uint8_t& px : img)
+      px = static_cast<std::uint8_t>(std::clamp(std::lround(px + rng.normal() * o.noise_grey), 0L, 255L));
+    dockcore::drivers::TagDetection d[4];
+    const std::size_t n = detector->detect(img.data(), o.width_px, o.height_px, o.width_px, d, 4);
+    const dockcore::drivers::TagDetection* tag = nullptr;
+    for (std::size_t k = 0; k < n && tag == nullptr; ++k) {
+      if (d[k].id == family_id && d[k].has_pose) tag = &d[k];
+    }
+    if (tag == nullptr) continue;
+    dockcore::TagObservation obs;
+    obs.id = tag->id;
+    obs.decision_margin = static_cast<Real>(tag->decision_margin);
+    for (int k = 0; k < 9; ++k) obs.rotation(k / 3, k % 3) = static_cast<Real>(tag->rotation[k]);
+    for (int k = 0; k < 3; ++k) obs.translation_m(k) = static_cast<Real>(tag->translation_m[k]);
+    dockcore::TagMeasurement m;
+    if (dockcore::tag_to_dock_measurement(obs, p, &m) != dockcore::TagStatus::kFused) continue;
+    ++found;
+    const double ey = static_cast<double>(m.dock_in_robot.y_m - dock.y_m);
+    const double ex = static_cast<double>(m.dock_in_robot.x_m - dock.x_m);
+    const double eyaw = static_cast<double>(dockcore::wrap_angle(m.dock_in_robot.yaw_rad - dock.yaw_rad));
+    lat_mm.push_back(1000 * ey);
+    // Where the robot stands sideways in the dock frame, as the measurement says and in truth: the yaw error's lever.
+    in_dock_mm.push_back(1000 * static_cast<double>(m.dock_in_robot.inverse().y_m - dock.inverse().y_m));
+    depth_mm.push_back(1000 * ex);
+    yaw_deg.push_back(eyaw * 180 / dockcore::kPi);
+    z_lat.push_back(ey / std::sqrt(static_cast<double>(m.covariance(1, 1))));
+    z_yaw.push_back(eyaw / std::sqrt(static_cast<double>(m.covariance(2, 2))));
+  }
+  auto abs_all = [](std::vector<double> v) {
+    for (double& x : v) x = std::fabs(x);
+    return v;
+  };
+  std::printf(
+      "{\"type\":\"tag_pose\",\"frames\":%u,\"found\":%u,\"distance_m\":%g,\"tag_size_m\":%g,\"fx_px\":%g,"
+      "\"noise_grey\":%g,\"blur_px\":%g,\"decimate\":%g,\"lateral_p50_mm\":%.2f,\"lateral_p95_mm\":%.2f,"
+      "\"depth_p95_mm\":%.2f,\"robot_in_dock_lateral_p95_mm\":%.1f,\"yaw_p50_deg\":%.3f,\"yaw_p95_deg\":%.3f,\"sigma_"
+      "px\":%g,"
+      "\"lateral_rms_over_model_sigma\":%.2f,\"yaw_rms_over_model_sigma\":%.2f}\n",
+      o.frames, found, o.distance_m, det.tag_size_m, fx_px, o.noise_grey, o.blur_px, det.quad_decimate,
+      percentile(abs_all(lat_mm), 0.5), percentile(abs_all(lat_mm), 0.95), percentile(abs_all(depth_mm), 0.95),
+      percentile(abs_all(in_dock_mm), 0.95), percentile(abs_all(yaw_deg), 0.5), percentile(abs_all(yaw_deg), 0.95),
+      o.sigma_px, rms(z_lat), rms(z_yaw));
+  return found > 0 ? 0 : 1;
+}
+
+}  // namespace camera_check

@@ -1,0 +1,25 @@
+#pragma once
+// camera-check tag-pose: the dock pose derived from a tag on rendered frames (docs/camera.md, "Fusion").
+#include <cstdint>
+
+#include "dockcore/drivers/apriltag_detector.hpp"
+
+namespace camera_check {
+
+struct TagPoseOptions {
+  std::uint32_t frames = 300;  ///< Rendered frames.
+  double distance_m = 1.0;     ///< Camera to tag, along the dock's axis.
+  double lateral_m = 0.10;     ///< Robot offset from the dock's axis: uniform in ±this.
+  double yaw_deg = 15;         ///< Dock turned against the robot: uniform in ±this.
+  double noise_grey = 4;       ///< Gaussian pixel noise, grey levels (σ).
+  double blur_px = 0.8;        ///< Gaussian blur σ, px (0: none).
+  double sigma_px = 0.3;       ///< The covariance model's corner noise, for the model's σ printed beside.
+  std::uint64_t seed = 1;
+  std::uint32_t width_px = 640, height_px = 480;
+};
+
+/// Renders, detects and prints one JSON summary line (percentiles of the errors of the dock pose in the robot frame,
+/// the model's σ). Returns the exit status: 0, 1 when no frame had the tag, 2 for bad options.
+int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions det, double fx_px);
+
+}  // namespace camera_check
