@@ -122,15 +122,16 @@ TEST(DockdCameraConfig, TagFusionKeysArrive) {
                            "[[docks]]\nid = 1\ntag_id = 7\ntag_y_m = 0.05\ntag_z_m = 0.2\ntag_yaw_deg = 3\n"
                            "[[docks]]\nid = 2\n";
   const dockd::DockdConfig c = dockd::parse_config_toml(text, "t.toml");
-  DOUBLES_EQUAL(0.5, static_cast<double>(c.tag_fusion.sigma_px), 1e-9);
-  DOUBLES_EQUAL(0.03, static_cast<double>(c.tag_fusion.max_lag_s), 1e-9);
+  const double tol = 1e-6;  // the values are Real: float in the float build
+  DOUBLES_EQUAL(0.5, static_cast<double>(c.tag_fusion.sigma_px), tol);
+  DOUBLES_EQUAL(0.03, static_cast<double>(c.tag_fusion.max_lag_s), tol);
   DOUBLES_EQUAL(1, static_cast<double>(c.tag_fusion.sigma_scale), 0);  // the struct's default
   const dockd::DockEntry* d1 = c.find_dock(1);
   const dockd::DockEntry* d2 = c.find_dock(2);
   CHECK(d1 != nullptr && d2 != nullptr);
   LONGS_EQUAL(7, d1->tag.id);
-  DOUBLES_EQUAL(0.05, static_cast<double>(d1->tag.y_m), 1e-9);
-  DOUBLES_EQUAL(0.2, static_cast<double>(d1->tag.z_m), 1e-9);
+  DOUBLES_EQUAL(0.05, static_cast<double>(d1->tag.y_m), tol);
+  DOUBLES_EQUAL(0.2, static_cast<double>(d1->tag.z_m), tol);
   DOUBLES_EQUAL(3 * 3.14159265358979 / 180, static_cast<double>(d1->tag.yaw_rad), 1e-6);
   LONGS_EQUAL(-1, d2->tag.id);  // no tag on dock 2
 }
