@@ -5,13 +5,15 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 
 #include "dockcore/lidar_lakibeam.hpp"
 
 using namespace dockcore;
 
 namespace {
-LakibeamParser g_parser;
+// A fresh parser per input (parsers are not copyable: their output points into its own buffers).
+std::optional<LakibeamParser> g_fresh;
 LaserScan g_scan;
 std::uint8_t g_dgram[1400];
 void check(bool ok) {
@@ -21,7 +23,7 @@ void check(bool ok) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
-  g_parser = LakibeamParser{};
+  LakibeamParser& g_parser = g_fresh.emplace();
   LakibeamConfig cfg;
   cfg.bins_per_turn = 1u + static_cast<std::uint32_t>(data[0]) * 16u;
   check(g_parser.configure(cfg));

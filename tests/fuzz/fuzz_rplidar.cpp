@@ -5,13 +5,15 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 
 #include "dockcore/lidar_rplidar.hpp"
 
 using namespace dockcore;
 
 namespace {
-RplidarParser g_parser;
+// A fresh parser per input (parsers are not copyable: their output points into its own buffers).
+std::optional<RplidarParser> g_fresh;
 LaserScan g_scan;
 void check(bool ok) {
   if (!ok) __builtin_trap();
@@ -25,7 +27,7 @@ bool monotonic(const LidarParserCounters& a, const LidarParserCounters& b) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
-  g_parser = RplidarParser{};
+  RplidarParser& g_parser = g_fresh.emplace();
   RplidarConfig cfg;
   cfg.bins_per_turn = 1u + static_cast<std::uint32_t>(data[0]) * 16u;  // 1 .. 4081
   cfg.require_descriptor = (data[0] & 1) != 0;
