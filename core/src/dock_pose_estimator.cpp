@@ -1050,13 +1050,7 @@ DockEstimate DockPoseEstimatorBase::estimate(const ScanView& scan, const Pose2& 
   Mat3 h_inv = Mat3::Constant(std::numeric_limits<Real>::infinity());
   invert_sym3(best.h, &h_inv);
   const Mat3 cov_lidar = sigma * sigma * h_inv;
-  const Real c = std::cos(lidar_mount.yaw_rad);
-  const Real s = std::sin(lidar_mount.yaw_rad);
-  Mat3 rot = Mat3::Identity();
-  rot(0, 0) = c;
-  rot(0, 1) = -s;
-  rot(1, 0) = s;
-  rot(1, 1) = c;
+  const Mat3 rot = axis_rotation(2, lidar_mount.yaw_rad);
   est.covariance = rot * cov_lidar * rot.transpose();
   if (!est.covariance.allFinite() || std::sqrt(est.covariance(0, 0) + est.covariance(1, 1)) > params_.max_sigma_m) {
     ++counters_.rejected;

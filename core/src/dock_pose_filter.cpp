@@ -1,19 +1,7 @@
 #include "dockcore/dock_pose_filter.hpp"
 
-
 namespace dockcore {
 namespace {
-
-Mat3 rotation3(Real yaw_rad) {
-  const Real c = std::cos(yaw_rad);
-  const Real s = std::sin(yaw_rad);
-  Mat3 r = Mat3::Identity();
-  r(0, 0) = c;
-  r(0, 1) = -s;
-  r(1, 0) = s;
-  r(1, 1) = c;
-  return r;
-}
 
 bool finite_pose(const Pose2& p) { return std::isfinite(p.x_m) && std::isfinite(p.y_m) && std::isfinite(p.yaw_rad); }
 
@@ -63,7 +51,7 @@ void DockPoseFilter::to_odom(const Pose2& dock_in_robot, const Mat3& cov_robot, 
                              Mat3* rz) const {
   // Detection mapped into the odometry frame, with its covariance rotated alongside.
   *z = odom_pose.compose(dock_in_robot);
-  const Mat3 rot = rotation3(odom_pose.yaw_rad);
+  const Mat3 rot = axis_rotation(2, odom_pose.yaw_rad);
   *rz = rot * cov_robot * rot.transpose();
   const Real floor_p = params_.min_meas_sigma_m * params_.min_meas_sigma_m;
   const Real floor_y = params_.min_meas_sigma_rad * params_.min_meas_sigma_rad;
@@ -167,7 +155,7 @@ FilterUpdate DockPoseFilter::update_tag(const Pose2& dock_in_robot, const Mat3& 
 Pose2 DockPoseFilter::dock_in_robot(const Pose2& odom_pose, Mat3* cov_robot) const {
   const Pose2 d = odom_pose.inverse().compose(dock_odom_);
   if (cov_robot != nullptr) {
-    const Mat3 rot = rotation3(-odom_pose.yaw_rad);
+    const Mat3 rot = axis_rotation(2, -odom_pose.yaw_rad);
     *cov_robot = rot * cov_odom_ * rot.transpose();
   }
   return d;

@@ -3,33 +3,6 @@
 namespace dockcore {
 namespace {
 
-Mat3 rot_z(Real a) {
-  Mat3 r = Mat3::Identity();
-  r(0, 0) = std::cos(a);
-  r(0, 1) = -std::sin(a);
-  r(1, 0) = std::sin(a);
-  r(1, 1) = std::cos(a);
-  return r;
-}
-
-Mat3 rot_y(Real a) {
-  Mat3 r = Mat3::Identity();
-  r(0, 0) = std::cos(a);
-  r(0, 2) = std::sin(a);
-  r(2, 0) = -std::sin(a);
-  r(2, 2) = std::cos(a);
-  return r;
-}
-
-Mat3 rot_x(Real a) {
-  Mat3 r = Mat3::Identity();
-  r(1, 1) = std::cos(a);
-  r(1, 2) = -std::sin(a);
-  r(2, 1) = std::sin(a);
-  r(2, 2) = std::cos(a);
-  return r;
-}
-
 /// Columns: the optical frame's x (right), y (down), z (forward) in the camera body frame (x forward, y left, z up).
 Mat3 body_from_optical() {
   Mat3 r = Mat3::Zero();
@@ -84,7 +57,7 @@ const char* to_string(TagStatus s) {
 }
 
 Mat3 camera_rotation(const CameraMount3& m) {
-  return rot_z(m.yaw_rad) * rot_y(m.pitch_rad) * rot_x(m.roll_rad) * body_from_optical();
+  return axis_rotation(2, m.yaw_rad) * axis_rotation(1, m.pitch_rad) * axis_rotation(0, m.roll_rad) * body_from_optical();
 }
 
 TagStatus tag_to_dock_measurement(const TagObservation& obs, const TagFusionParams& p, TagMeasurement* out) {
@@ -105,7 +78,7 @@ TagStatus tag_to_dock_measurement(const TagObservation& obs, const TagFusionPara
   const Vec3 t_rc(p.mount.x_m, p.mount.y_m, p.mount.z_m);
   const Mat3 r_rt = r_ro * obs.rotation;
   const Vec3 p_rt = t_rc + r_ro * t;
-  const Mat3 r_dt = rot_z(p.dock_tag.yaw_rad) * dock_from_upright_tag();
+  const Mat3 r_dt = axis_rotation(2, p.dock_tag.yaw_rad) * dock_from_upright_tag();
   const Vec3 p_dt(p.dock_tag.x_m, p.dock_tag.y_m, p.dock_tag.z_m);
   const Mat3 r_rd = r_rt * r_dt.transpose();
   const Vec3 o = r_rd * p_dt;  // dock origin → tag centre, robot frame

@@ -22,14 +22,7 @@ using dockcore::Vec3;
 /// when `rng` is given (lateral, depth, and a turn about the camera's vertical axis).
 inline TagObservation observe_tag(const Pose2& robot, const Pose2& dock, const TagFusionParams& p, docksim::Rng* rng,
                                   double sigma_px, std::uint64_t stamp_us) {
-  auto rz = [](double a) {
-    Mat3 r = Mat3::Identity();
-    r(0, 0) = std::cos(a);
-    r(0, 1) = -std::sin(a);
-    r(1, 0) = std::sin(a);
-    r(1, 1) = std::cos(a);
-    return r;
-  };
+  auto rz = [](dockcore::Real a) { return dockcore::axis_rotation(2, a); };
   Mat3 upright = Mat3::Zero();  // tag x, y, z in the dock frame for a tag looking out along the dock's +x
   upright(1, 0) = 1;
   upright(2, 1) = -1;
@@ -53,11 +46,8 @@ inline TagObservation observe_tag(const Pose2& robot, const Pose2& dock, const T
     o.translation_m.y() += rng->normal() * z * sigma_px / (2 * f);
     o.translation_m.z() += rng->normal() * z * z * sigma_px / (std::sqrt(2.0) * f * s);
     const double d = rng->normal() * 2 * z * z * sigma_px / (f * s * s * cos_view);
-    Mat3 ry = Mat3::Identity();  // about the optical frame's y (down): a level camera's vertical
-    ry(0, 0) = std::cos(d);
-    ry(0, 2) = std::sin(d);
-    ry(2, 0) = -std::sin(d);
-    ry(2, 2) = std::cos(d);
+    // About the optical frame's y (down): a level camera's vertical.
+    const Mat3 ry = dockcore::axis_rotation(1, static_cast<dockcore::Real>(d));
     o.rotation = ry * o.rotation;
   }
   return o;

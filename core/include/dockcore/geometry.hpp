@@ -43,6 +43,21 @@ inline Real wrap_angle(Real angle_rad) {
   return a;
 }
 
+/// Rotation by `angle_rad` about axis `axis` (0 = x, 1 = y, 2 = z) as a 3×3 matrix; about z it also turns an
+/// (x, y, yaw) covariance by a yaw. Precondition: axis in 0..2. O(1): one cos and one sin.
+inline Mat3 axis_rotation(int axis, Real angle_rad) {
+  const Real c = std::cos(angle_rad);
+  const Real s = std::sin(angle_rad);
+  const int i = (axis + 1) % 3;
+  const int j = (axis + 2) % 3;
+  Mat3 r = Mat3::Identity();
+  r(i, i) = c;
+  r(i, j) = -s;
+  r(j, i) = s;
+  r(j, j) = c;
+  return r;
+}
+
 /// Inverse of a symmetric 3x3 matrix by cofactors (closed form: no pivoting loops, no Eigen decompositions, whose
 /// generic code paths reference malloc). Returns false, leaving `out` alone, when |det| is not above
 /// `min_abs_det` or not finite. O(1).
