@@ -13,7 +13,6 @@ void DockPoseFilter::reset() {
   consecutive_gated_ = 0;
   evidence_nats_ = 0;
   fused_since_start_ = 0;
-  lidar_since_start_ = false;
   consecutive_tag_gated_ = 0;
 }
 
@@ -38,7 +37,6 @@ void DockPoseFilter::predict(const Pose2& odom_pose) {
 void DockPoseFilter::start(const Pose2& z, const Mat3& rz, std::uint64_t stamp_us, Real evidence_nats) {
   evidence_nats_ = evidence_nats;
   fused_since_start_ = 1;
-  lidar_since_start_ = true;
   dock_odom_ = z;
   cov_odom_ = rz;
   initialised_ = true;
@@ -110,7 +108,6 @@ FilterUpdate DockPoseFilter::update(const Pose2& dock_in_robot, const Mat3& cov_
   last_update_us_ = stamp_us;
   ++fused_;
   ++fused_since_start_;
-  lidar_since_start_ = true;
   evidence_nats_ += evidence_nats;
   return FilterUpdate::kFused;
 }
@@ -126,7 +123,6 @@ FilterUpdate DockPoseFilter::update_tag(const Pose2& dock_in_robot, const Mat3& 
   auto start_from_tag = [&]() {
     start(z, rz, stamp_us, 0);
     fused_since_start_ = 0;
-    lidar_since_start_ = false;
     ++tag_fused_;
   };
   if (!initialised_) {
@@ -137,7 +133,7 @@ FilterUpdate DockPoseFilter::update_tag(const Pose2& dock_in_robot, const Mat3& 
   Mat3 s_inv;
   if (!innovation(z, rz, &nu, &s_inv)) return FilterUpdate::kInvalid;
   if (!(last_d2_ <= params_.gate_chi2)) {
-    if (!lidar_since_start_ && ++consecutive_tag_gated_ >= params_.reinit_after) {
+    if (!lidar_since_start() && ++consecutive_tag_gated_ >= params_.reinit_after) {
       ++reinits_;
       start_from_tag();
       return FilterUpdate::kReinitialised;

@@ -76,8 +76,8 @@ class DockPoseFilter {
   /// Tag measurements fused (update_tag: kInitialised, kFused, kReinitialised) and gated.
   std::uint32_t tag_fused() const { return tag_fused_; }
   std::uint32_t tag_gated() const { return tag_gated_; }
-  /// A lidar detection has been fused since the filter (re)started.
-  bool lidar_since_start() const { return lidar_since_start_; }
+  /// A lidar detection has been fused since the filter (re)started (a tag start counts none). O(1).
+  bool lidar_since_start() const { return fused_since_start_ > 0; }
   /// Mahalanobis² of the most recent innovation (gated or not).
   Real last_mahalanobis2() const { return last_d2_; }
   /// The sequential test's sum: evidence of the detections fused since the filter (re)started, nats.
@@ -112,7 +112,6 @@ class DockPoseFilter {
   Real last_d2_ = 0;
   Real evidence_nats_ = 0;
   std::uint32_t fused_since_start_ = 0;
-  bool lidar_since_start_ = false;
   std::uint8_t consecutive_tag_gated_ = 0;
   std::uint32_t tag_fused_ = 0;
   std::uint32_t tag_gated_ = 0;
