@@ -24,7 +24,6 @@ constexpr Real kReuseStepM = static_cast<Real>(0.02);
 // Window centres of the global search (add_window_hypotheses) step one scan point, or a sixteenth of the window's
 // points on a dense scan: kept windows are a quarter of a segment apart, so finer steps add nothing there. (Every
 // other point at 720 beams costs detection of near docks.)
-constexpr std::size_t kWindowStride = 1;
 constexpr std::size_t kWindowStepsPerWindow = 16;
 // Rays a prescore casts at most: it only ranks hypotheses, so on a dense scan a sample of the span's beams will do.
 constexpr std::size_t kPrescoreRays = 32;
@@ -770,33 +769,36 @@ struct RunningMoments {
     sxy += sign * d.x() * d.y();
     syy += sign * d.y() * d.y();
   }
-  // Mean squared orthogonal residual of the total-least-squares line: the smaller eigenvalue of the covariance.
-  // Cheap (one square root), so a window is tested before its line is worked out.
-  Real msr() const {
+  // Centroid (relative to origin) and covariance of the points, with half the difference of its diagonal and the
+  // distance of its eigenvalues from their mean.
+  struct Spread {
+    Real mx, my, cxy, half_sum, half_diff, root;
+  };
+  Spread spread() const {
     const Real mx = sx / n;
     const Real my = sy / n;
     const Real cxx = sxx / n - mx * mx;
     const Real cxy = sxy / n - mx * my;
     const Real cyy = syy / n - my * my;
     const Real half_diff = (cxx - cyy) * R(0.5);
-    const Real lo = (cxx + cyy) * R(0.5) - std::sqrt(half_diff * half_diff + cxy * cxy);
+    return Spread{mx, my, cxy, (cxx + cyy) * R(0.5), half_diff, std::sqrt(half_diff * half_diff + cxy * cxy)};
+  }
+  // Mean squared orthogonal residual of the total-least-squares line: the smaller eigenvalue of the covariance.
+  // Cheap (one square root), so a window is tested before its line is worked out.
+  Real msr() const {
+    const Spread c = spread();
+    const Real lo = c.half_sum - c.root;
     return lo > 0 ? lo : 0;
   }
   // The line itself: centroid and unit normal. The principal axis is the eigenvector of the larger eigenvalue,
   // taken from whichever of the two equivalent forms has the larger components (no trigonometry).
   void line(Vec2* centroid, Vec2* normal) const {
-    const Real mx = sx / n;
-    const Real my = sy / n;
-    const Real cxx = sxx / n - mx * mx;
-    const Real cxy = sxy / n - mx * my;
-    const Real cyy = syy / n - my * my;
-    const Real half_diff = (cxx - cyy) * R(0.5);
-    const Real root = std::sqrt(half_diff * half_diff + cxy * cxy);
+    const Spread c = spread();
     // lambda_max - cyy = half_diff + root and lambda_max - cxx = root - half_diff: add, never cancel.
-    Vec2 axis = half_diff >= 0 ? Vec2(half_diff + root, cxy) : Vec2(cxy, root - half_diff);
+    Vec2 axis = c.half_diff >= 0 ? Vec2(c.half_diff + c.root, c.cxy) : Vec2(c.cxy, c.root - c.half_diff);
     const Real len = axis.norm();
     axis = len > 0 ? Vec2(axis / len) : Vec2(1, 0);
-    *centroid = origin + Vec2(mx, my);
+    *centroid = origin + Vec2(c.mx, c.my);
     *normal = Vec2(-axis.y(), axis.x());
   }
 };
@@ -850,13 +852,13 @@ void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
       std::size_t hi = run_lo;
       m.add(at(run_lo), 1);
       Vec2 last_kept(std::numeric_limits<Real>::max(), 0);
-      std::size_t step = kWindowStride;
+      std::size_t step = 1;
       for (std::size_t c = run_lo; c <= run_hi; c += step) {
         const Vec2& pc = at(c);
         while (hi + 1 <= run_hi && (at(hi + 1) - pc).squaredNorm() <= half_sq) m.add(at(++hi), 1);
         while (lo < c && (at(lo) - pc).squaredNorm() > half_sq) m.add(at(lo++), -1);
         const std::size_t in_window = hi - lo + 1;
-        step = in_window > kWindowStride * kWindowStepsPerWindow ? in_window / kWindowStepsPerWindow : kWindowStride;
+        step = in_window > kWindowStepsPerWindow ? in_window / kWindowStepsPerWindow : 1;
         if (m.n < 5 || (at(hi) - at(lo)).squaredNorm() < min_span_sq) continue;
         if (m.msr() > gate * gate) continue;
         Vec2 centroid;
