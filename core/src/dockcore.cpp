@@ -12,7 +12,6 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
   for (std::uint32_t& c : tag_counts_) c = 0;
   have_tag_ = false;
   last_tag_us_ = 0;
-  last_tag_ = TagMeasurement{};
   filter_confirmed_ = false;
   restart_ref_set_ = false;
   push_ref_set_ = false;
@@ -120,7 +119,6 @@ TagStatus DockcoreBase::on_tag(const TagObservation& obs, const Pose2& odom_at_s
     }
   }
   if (st == TagStatus::kFused) {
-    last_tag_ = m;
     const FilterUpdate u = filter_.update_tag(m.dock_in_robot, m.covariance, odom_at_stamp, obs.stamp_us);
     if (u == FilterUpdate::kGated) st = TagStatus::kGated;
     if (u == FilterUpdate::kInvalid) st = TagStatus::kInvalid;

@@ -115,8 +115,6 @@ class DockcoreBase {
   TagStatus on_tag(const TagObservation& obs, const Pose2& odom_at_stamp);
   /// Tag detections by outcome since configure(), indexed by TagStatus. O(1).
   std::uint32_t tag_count(TagStatus s) const { return tag_counts_[static_cast<std::size_t>(s)]; }
-  /// The last tag measurement made (valid once a detection passed the id, order and age checks and was usable).
-  const TagMeasurement& last_tag_measurement() const { return last_tag_; }
 
   /// One control tick: the task manager, then the output shaping (file comment). Cost: TaskManager::tick + O(1).
   TickOutput tick(const TickInput& in);
@@ -173,7 +171,6 @@ class DockcoreBase {
   std::uint32_t tag_counts_[kTagStatusCount] = {};
   bool have_tag_ = false;
   std::uint64_t last_tag_us_ = 0;  ///< Newest tag frame past the id and order checks.
-  TagMeasurement last_tag_{};
   TaskState prev_state_ = TaskState::kNotTasking;
   Twist2 prev_drive_cmd_{};  ///< drive_cmd of the previous tick: the acceleration limit's start.
   bool filter_confirmed_ = false;  ///< The filter fused a detection since its last (re)initialisation.
