@@ -37,11 +37,14 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
-double r6(double v) { return std::round(v * 1e6) / 1e6; }
+double r6(double v) {
+  return std::round(v * 1e6) / 1e6;
+}
 
 std::vector<Vec2> profile_world(const docksim::Scenario& sc) {
   std::vector<Vec2> pts;
-  for (std::size_t i = 0; i < sc.profile.vertex_count; ++i) pts.push_back(sc.dock_pose.transform(sc.profile.vertices_m[i]));
+  for (std::size_t i = 0; i < sc.profile.vertex_count; ++i)
+    pts.push_back(sc.dock_pose.transform(sc.profile.vertices_m[i]));
   return pts;
 }
 
@@ -96,7 +99,7 @@ struct RunOptions {
   std::string scenario;
   std::string controller;  // empty: the scenario's
   std::uint64_t seed = 0;
-  bool seed_set = false;   // false: the scenario's
+  bool seed_set = false;  // false: the scenario's
   std::string svg;
   bool json = false;
   bool trace = false;
@@ -108,8 +111,9 @@ void draw_run(const docksim::Scenario& sc, const docksim::SimRun& r, const std::
   for (const auto& s : r.trajectory) poses.push_back(s.pose);
   poses.push_back(r.start.robot_world);
   const docksim::SimOutcome& o = r.outcome;
-  docksim::SvgCanvas c = make_canvas(sc, poses, sc.name + " / " + r.controller + " / seed " + std::to_string(r.seed) +
-                                                    (o.charging_confirmed ? " / charging" : " / NOT charging"));
+  docksim::SvgCanvas c = make_canvas(sc, poses,
+                                     sc.name + " / " + r.controller + " / seed " + std::to_string(r.seed) +
+                                         (o.charging_confirmed ? " / charging" : " / NOT charging"));
   c.dots(r.last_scan_world, 1.5, SvgStyle::filled("#1f77b4"));
   const std::vector<Vec2> outline = docksim::footprint_outline(sc.chassis);
   const SvgStyle ghost = SvgStyle::line("#ff7f0e", 0.7);
@@ -145,7 +149,8 @@ nlohmann::ordered_json outcome_json(const docksim::SimRun& r) {
                 {"bearing_deg", r6(r.start.bearing_rad * kRadToDeg)},
                 {"heading_deg", r6(r.start.heading_rad * kRadToDeg)}};
   j["charging_confirmed"] = o.charging_confirmed;
-  j["time_to_charging_s"] = o.charging_confirmed ? nlohmann::ordered_json(r6(o.time_to_charging_s)) : nlohmann::ordered_json();
+  j["time_to_charging_s"] =
+      o.charging_confirmed ? nlohmann::ordered_json(r6(o.time_to_charging_s)) : nlohmann::ordered_json();
   j["lateral_m"] = r6(o.lateral_m);
   j["longitudinal_m"] = r6(o.longitudinal_m);
   j["yaw_deg"] = r6(o.yaw_rad * kRadToDeg);
@@ -153,7 +158,8 @@ nlohmann::ordered_json outcome_json(const docksim::SimRun& r) {
   j["reversals"] = o.reversals;
   j["inplace_turns_45"] = o.inplace_turns_45;
   j["retries"] = o.retries;
-  j["min_clearance_m"] = std::isfinite(o.min_clearance_m) ? nlohmann::ordered_json(r6(o.min_clearance_m)) : nlohmann::ordered_json();
+  j["min_clearance_m"] =
+      std::isfinite(o.min_clearance_m) ? nlohmann::ordered_json(r6(o.min_clearance_m)) : nlohmann::ordered_json();
   nlohmann::ordered_json f = nlohmann::ordered_json::object();
   for (const auto& kv : o.faults) f[std::to_string(kv.first)] = kv.second;
   j["faults"] = f;
@@ -161,7 +167,8 @@ nlohmann::ordered_json outcome_json(const docksim::SimRun& r) {
   j["timed_out"] = o.timed_out;
   j["end_time_s"] = r6(o.end_time_s);
   if (!std::isnan(o.seed_success_t_s)) {
-    j["seed_success"] = {{"t_s", r6(o.seed_success_t_s)}, {"z_err_m", r6(o.seed_success_z_err_m)}, {"x_m", r6(o.seed_success_x_m)}};
+    j["seed_success"] = {
+        {"t_s", r6(o.seed_success_t_s)}, {"z_err_m", r6(o.seed_success_z_err_m)}, {"x_m", r6(o.seed_success_x_m)}};
   }
   return j;
 }
@@ -201,22 +208,26 @@ int run_one(const RunOptions& opt) {
   } else {
     std::printf("scenario %s, controller %s, seed %llu\n", sc.name.c_str(), ctl.c_str(),
                 static_cast<unsigned long long>(seed));
-    std::printf("start: distance %.3f m, bearing %+.1f deg, heading %+.1f deg (robot at x %.3f y %.3f yaw %+.1f deg, dock frame)\n",
-                r.start.distance_m, r.start.bearing_rad * kRadToDeg, r.start.heading_rad * kRadToDeg,
-                static_cast<double>(r.start.robot_in_dock.x_m), static_cast<double>(r.start.robot_in_dock.y_m),
-                static_cast<double>(r.start.robot_in_dock.yaw_rad) * kRadToDeg);
+    std::printf(
+        "start: distance %.3f m, bearing %+.1f deg, heading %+.1f deg (robot at x %.3f y %.3f yaw %+.1f deg, dock "
+        "frame)\n",
+        r.start.distance_m, r.start.bearing_rad * kRadToDeg, r.start.heading_rad * kRadToDeg,
+        static_cast<double>(r.start.robot_in_dock.x_m), static_cast<double>(r.start.robot_in_dock.y_m),
+        static_cast<double>(r.start.robot_in_dock.yaw_rad) * kRadToDeg);
     std::printf("timeline:\n");
-    for (const auto& e : r.timeline) std::printf("  %8.2f s  %-7s %s\n", e.t_s, docksim::to_string(e.kind), e.text.c_str());
+    for (const auto& e : r.timeline)
+      std::printf("  %8.2f s  %-7s %s\n", e.t_s, docksim::to_string(e.kind), e.text.c_str());
     std::printf("outcome: %s", o.charging_confirmed ? "CHARGING" : (o.timed_out ? "TIMEOUT" : "FAILED"));
     if (o.charging_confirmed) std::printf(" after %.2f s", o.time_to_charging_s);
     std::printf(" (final state %s)\n", dockcore::to_string(o.final_state));
-    std::printf("  pads: lateral %+.1f mm, longitudinal %+.1f mm (negative = pressed), yaw %+.2f deg\n", o.lateral_m * 1e3,
-                o.longitudinal_m * 1e3, o.yaw_rad * kRadToDeg);
-    std::printf("  path %.2f m, reversals %d, in-place turns > 45 deg %d (largest %.0f deg), retries %d\n", o.path_length_m,
-                o.reversals, o.inplace_turns_45, o.max_inplace_turn_rad * kRadToDeg, o.retries);
+    std::printf("  pads: lateral %+.1f mm, longitudinal %+.1f mm (negative = pressed), yaw %+.2f deg\n",
+                o.lateral_m * 1e3, o.longitudinal_m * 1e3, o.yaw_rad * kRadToDeg);
+    std::printf("  path %.2f m, reversals %d, in-place turns > 45 deg %d (largest %.0f deg), retries %d\n",
+                o.path_length_m, o.reversals, o.inplace_turns_45, o.max_inplace_turn_rad * kRadToDeg, o.retries);
     if (std::isfinite(o.min_clearance_m)) std::printf("  minimum obstacle clearance %.3f m\n", o.min_clearance_m);
     for (const auto& kv : o.faults) {
-      std::printf("  fault %d %s x%d\n", kv.first, dockcore::to_string(static_cast<dockcore::FaultCode>(kv.first)), kv.second);
+      std::printf("  fault %d %s x%d\n", kv.first, dockcore::to_string(static_cast<dockcore::FaultCode>(kv.first)),
+                  kv.second);
     }
   }
   if (opt.trace) {
@@ -309,11 +320,12 @@ std::string faults_str(const std::map<int, int>& f) {
 
 void print_table(const std::vector<Summary>& sums) {
   std::printf("%-8s %8s %16s %16s %16s %12s %8s %10s %12s %10s %10s  %s\n", "ctrl", "success", "lat mm p50/95/max",
-              "lon mm p50/95/max", "yaw deg p50/95/max", "t s p50/p95", "path m", "reversals", "inplace>45",
-              "retries", "clearance", "faults");
+              "lon mm p50/95/max", "yaw deg p50/95/max", "t s p50/p95", "path m", "reversals", "inplace>45", "retries",
+              "clearance", "faults");
   for (const auto& s : sums) {
     const std::string rate = fmt("%.1f%%", 100.0 * s.successes / std::max(1, s.trials));
-    const std::string t = s.time_s.empty() ? "-" : fmt("%.1f", pct(s.time_s, 50)) + "/" + fmt("%.1f", pct(s.time_s, 95));
+    const std::string t =
+        s.time_s.empty() ? "-" : fmt("%.1f", pct(s.time_s, 50)) + "/" + fmt("%.1f", pct(s.time_s, 95));
     auto total_runs = [](long total, long runs) { return std::to_string(total) + " (" + std::to_string(runs) + ")"; };
     const std::string rev = total_runs(s.reversals, s.runs_with_reversals);
     const std::string inp = total_runs(s.inplace, s.runs_with_inplace);
@@ -342,13 +354,15 @@ void print_table(const std::vector<Summary>& sums) {
       az = std::max(az, std::fabs(s.seed_z[i]));
       ax = std::max(ax, std::fabs(s.seed_x[i]));
     }
-    std::printf("%s own success test held in %zu/%d runs: mean time %.1f s; at that moment depth error mean %+.1f cm "
-                "sd %.1f cm max|.| %.1f cm, lateral mean %+.1f cm sd %.1f cm max|.| %.1f cm\n",
-                s.name.c_str(), s.seed_t.size(), s.trials, mt, mz * 100, std::sqrt(sz) * 100, az * 100, mx * 100,
-                std::sqrt(sx) * 100, ax * 100);
+    std::printf(
+        "%s own success test held in %zu/%d runs: mean time %.1f s; at that moment depth error mean %+.1f cm "
+        "sd %.1f cm max|.| %.1f cm, lateral mean %+.1f cm sd %.1f cm max|.| %.1f cm\n",
+        s.name.c_str(), s.seed_t.size(), s.trials, mt, mz * 100, std::sqrt(sz) * 100, az * 100, mx * 100,
+        std::sqrt(sx) * 100, ax * 100);
   }
-  std::printf("errors and times over successful runs; path = median; reversals / in-place turns: total (runs with any);"
-              " clearance = minimum over all runs\n");
+  std::printf(
+      "errors and times over successful runs; path = median; reversals / in-place turns: total (runs with any);"
+      " clearance = minimum over all runs\n");
 }
 
 std::string svg_path_for(const std::string& base, const std::string& ctl, bool many) {
@@ -374,7 +388,8 @@ void draw_mc(const docksim::Scenario& sc, const std::string& ctl, const std::vec
              const Summary& s, const std::string& path) {
   std::vector<Pose2> poses;
   for (const auto& r : runs) poses.push_back(r.start.robot_world);
-  docksim::SvgCanvas c = make_canvas(sc, poses, sc.name + " / " + ctl + " / " + std::to_string(runs.size()) + " trials");
+  docksim::SvgCanvas c =
+      make_canvas(sc, poses, sc.name + " / " + ctl + " / " + std::to_string(runs.size()) + " trials");
   for (const auto& r : runs) {
     std::vector<Vec2> pts;
     for (const auto& t : r.trajectory) pts.emplace_back(t.pose.x_m, t.pose.y_m);
@@ -419,7 +434,8 @@ int run_mc(const McOptions& opt) {
   } else {
     ctls.push_back(opt.controller.empty() ? sc.controller : opt.controller);
     if (!docksim::is_controller_name(ctls[0])) {
-      std::cerr << "dock-sim montecarlo: unknown controller '" << ctls[0] << "' (seed000, seed004, seed003, smooth, all)\n";
+      std::cerr << "dock-sim montecarlo: unknown controller '" << ctls[0]
+                << "' (seed000, seed004, seed003, smooth, all)\n";
       return 2;
     }
   }
@@ -461,7 +477,8 @@ int run_mc(const McOptions& opt) {
 
   std::vector<Summary> sums;
   for (std::size_t ci = 0; ci < ctls.size(); ++ci) {
-    const std::vector<docksim::SimRun> mine(runs.begin() + static_cast<long>(ci * n), runs.begin() + static_cast<long>((ci + 1) * n));
+    const std::vector<docksim::SimRun> mine(runs.begin() + static_cast<long>(ci * n),
+                                            runs.begin() + static_cast<long>((ci + 1) * n));
     sums.push_back(summarise(ctls[ci], mine));
     if (!opt.svg.empty()) draw_mc(sc, ctls[ci], mine, sums.back(), svg_path_for(opt.svg, ctls[ci], ctls.size() > 1));
   }
@@ -476,7 +493,8 @@ int run_mc(const McOptions& opt) {
       const Summary& s = sums[ci];
       auto stats = [](const std::vector<double>& v) {
         if (v.empty()) return nlohmann::ordered_json();
-        return nlohmann::ordered_json{{"p50", r6(pct(v, 50))}, {"p95", r6(pct(v, 95))}, {"max", r6(*std::max_element(v.begin(), v.end()))}};
+        return nlohmann::ordered_json{
+            {"p50", r6(pct(v, 50))}, {"p95", r6(pct(v, 95))}, {"max", r6(*std::max_element(v.begin(), v.end()))}};
       };
       nlohmann::ordered_json c;
       c["controller"] = s.name;
@@ -492,7 +510,8 @@ int run_mc(const McOptions& opt) {
       c["runs_with_inplace_turns"] = s.runs_with_inplace;
       c["retries"] = s.retries;
       c["runs_with_retries"] = s.runs_with_retries;
-      c["min_clearance_m"] = std::isfinite(s.min_clearance_m) ? nlohmann::ordered_json(r6(s.min_clearance_m)) : nlohmann::ordered_json();
+      c["min_clearance_m"] =
+          std::isfinite(s.min_clearance_m) ? nlohmann::ordered_json(r6(s.min_clearance_m)) : nlohmann::ordered_json();
       nlohmann::ordered_json f = nlohmann::ordered_json::object();
       for (const auto& kv : s.faults) f[std::to_string(kv.first)] = kv.second;
       c["faults"] = f;
@@ -528,8 +547,10 @@ void register_run(CLI::App& app) {
           ->check(docksim::non_negative_integer());
   sub->add_option("--svg", o->svg, "Write trajectory, robot outline, dock and last scan as SVG to this file");
   sub->add_flag("--json", o->json, "Print one JSON object (outcome and timeline) instead of text");
-  sub->add_option("--start", o->start, "Fixed start: DISTANCE_M BEARING_DEG HEADING_DEG (default: drawn from the "
-                                      "scenario's envelope with the seed)")->expected(3);
+  sub->add_option("--start", o->start,
+                  "Fixed start: DISTANCE_M BEARING_DEG HEADING_DEG (default: drawn from the "
+                  "scenario's envelope with the seed)")
+      ->expected(3);
   sub->add_flag("--trace", o->trace, "Also print the trajectory (every 50 ms: true pose, commanded vx, task state)");
   sub->callback([o, seed]() {
     o->seed_set = seed->count() > 0;

@@ -49,7 +49,9 @@ using dockcore::TaskState;
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 constexpr int kStepsPerTick = 4;  // 4 x 5 ms = 50 Hz, as run_docking and dockd
 
-double r6(double v) { return std::round(v * 1e6) / 1e6; }
+double r6(double v) {
+  return std::round(v * 1e6) / 1e6;
+}
 
 struct SoakOptions {
   std::string scenario;
@@ -71,26 +73,27 @@ struct SoakOptions {
 struct Cycle {
   int index = 0;
   docksim::StartPose start{};
-  bool docked = false;     ///< Charging confirmed.
-  bool charged = false;    ///< Stayed in FINISH_TASKING for charge_s.
-  bool undocked = false;   ///< NOT_TASKING with result UNDOCKED.
+  bool docked = false;                                    ///< Charging confirmed.
+  bool charged = false;                                   ///< Stayed in FINISH_TASKING for charge_s.
+  bool undocked = false;                                  ///< NOT_TASKING with result UNDOCKED.
   double lateral_m = 0, longitudinal_m = 0, yaw_rad = 0;  ///< Pads at charging confirmation (truth).
-  double dock_time_s = 0;   ///< Dock command to charging confirmed (simulated).
-  double cycle_time_s = 0;  ///< Settle start to the end of the undock (simulated).
-  double wall_s = 0;        ///< Wall-clock time of the cycle.
+  double dock_time_s = 0;                                 ///< Dock command to charging confirmed (simulated).
+  double cycle_time_s = 0;                                ///< Settle start to the end of the undock (simulated).
+  double wall_s = 0;                                      ///< Wall-clock time of the cycle.
   std::map<int, int> faults;
-  std::string failure;      ///< Empty when the cycle succeeded.
+  std::string failure;  ///< Empty when the cycle succeeded.
   std::uint64_t core_allocs = 0, sim_allocs = 0;
   std::size_t heap_bytes = 0;  ///< malloc heap in use after the cycle.
   long rss_kib = -1;
-  double soc = 0;              ///< Battery state of charge after the cycle.
-  double odom_error_m = 0;     ///< |odometry displacement − true displacement| accumulated over the soak so far.
+  double soc = 0;           ///< Battery state of charge after the cycle.
+  double odom_error_m = 0;  ///< |odometry displacement − true displacement| accumulated over the soak so far.
   bool success() const { return docked && charged && undocked; }
 };
 
 /// The four controllers (DockingController has no public destructor: owned by value, chosen by name).
 struct Controllers {
-  explicit Controllers(const docksim::Scenario& sc) : s000(sc.seed000), s004(sc.seed004), s003(sc.seed003), smooth(sc.smooth) {}
+  explicit Controllers(const docksim::Scenario& sc)
+      : s000(sc.seed000), s004(sc.seed004), s003(sc.seed003), smooth(sc.smooth) {}
   dockcore::Seed000Controller s000;
   dockcore::Seed004Controller s004;
   dockcore::Seed003Controller s003;
@@ -235,7 +238,8 @@ class SoakWorld {
     const docksim::ChassisState& a = chassis_.state();
     // Displacement error of this step in the body frame (truth vs odometry): the odometry's drift per metre.
     const Pose2 dt_true = tb.inverse().compose(a.true_pose), dt_odom = ob.inverse().compose(a.odom_pose);
-    odom_err_m_ += std::hypot(static_cast<double>(dt_true.x_m - dt_odom.x_m), static_cast<double>(dt_true.y_m - dt_odom.y_m));
+    odom_err_m_ +=
+        std::hypot(static_cast<double>(dt_true.x_m - dt_odom.x_m), static_cast<double>(dt_true.y_m - dt_odom.y_m));
     ++k_;
     return ticked;
   }
@@ -289,7 +293,9 @@ double slope(const std::vector<double>& x, const std::vector<double>& y) {
 
 nlohmann::ordered_json stats_json(const std::vector<double>& v) {
   if (v.empty()) return nlohmann::ordered_json();
-  return {{"p50", r6(pct(v, 50))}, {"p95", r6(pct(v, 95))}, {"max", r6(*std::max_element(v.begin(), v.end()))},
+  return {{"p50", r6(pct(v, 50))},
+          {"p95", r6(pct(v, 95))},
+          {"max", r6(*std::max_element(v.begin(), v.end()))},
           {"mean", r6(mean(v))}};
 }
 
@@ -302,7 +308,8 @@ Cycle run_cycle(SoakWorld& w, const docksim::Scenario& sc, const SoakOptions& op
   const double t0 = w.t_s();
   dockcore::FaultCode prev_fault = w.last().status.fault;
   auto watch = [&](const dockcore::TickOutput& o) {
-    if (o.status.fault != prev_fault && o.status.fault != dockcore::FaultCode::kNone) ++c.faults[static_cast<int>(o.status.fault)];
+    if (o.status.fault != prev_fault && o.status.fault != dockcore::FaultCode::kNone)
+      ++c.faults[static_cast<int>(o.status.fault)];
     prev_fault = o.status.fault;
   };
   auto idle = [&](double s) {
@@ -343,7 +350,8 @@ Cycle run_cycle(SoakWorld& w, const docksim::Scenario& sc, const SoakOptions& op
       return o.status.state != TaskState::kFinishTasking;
     });
     c.charged = !left;
-    if (!c.charged) c.failure = std::string("left FINISH_TASKING while charging: ") + dockcore::to_string(w.last().status.state);
+    if (!c.charged)
+      c.failure = std::string("left FINISH_TASKING while charging: ") + dockcore::to_string(w.last().status.state);
   }
   if (c.charged) {
     watch(w.run_tick(HostCommandType::kUndock));
@@ -375,7 +383,8 @@ int run_soak(const SoakOptions& opt) {
     return 2;
   }
   if (!sc.events.empty()) {
-    std::cerr << "dock-sim soak: scenario '" << sc.name << "' has scripted events; soak runs event-free scenarios only\n";
+    std::cerr << "dock-sim soak: scenario '" << sc.name
+              << "' has scripted events; soak runs event-free scenarios only\n";
     return 2;
   }
   const std::string ctl_name = opt.controller.empty() ? sc.controller : opt.controller;
@@ -568,9 +577,10 @@ int run_soak(const SoakOptions& opt) {
       std::snprintf(b, sizeof b, ff.c_str(), pct(v, 50), pct(v, 95), *std::max_element(v.begin(), v.end()));
       return std::string(b);
     };
-    std::printf("soak: scenario %s, controller %s, seed %llu: %d dock -> charge (%.1f s) -> undock cycles of one robot, "
-                "%.0f s simulated\n",
-                sc.name.c_str(), ctl_name.c_str(), static_cast<unsigned long long>(base), opt.cycles, opt.charge_s, w.t_s());
+    std::printf(
+        "soak: scenario %s, controller %s, seed %llu: %d dock -> charge (%.1f s) -> undock cycles of one robot, "
+        "%.0f s simulated\n",
+        sc.name.c_str(), ctl_name.c_str(), static_cast<unsigned long long>(base), opt.cycles, opt.charge_s, w.t_s());
     std::printf("success          %d/%d\n", successes, opt.cycles);
     std::string fs;
     for (const auto& kv : faults) {
@@ -582,25 +592,28 @@ int run_soak(const SoakOptions& opt) {
     std::printf("lateral mm       %s (p50/p95/max of |.|)\n", tri(lat_mm, "%.2f").c_str());
     std::printf("longitudinal mm  %s\n", tri(lon_mm, "%.2f").c_str());
     std::printf("yaw deg          %s\n", tri(yaw_deg, "%.3f").c_str());
-    std::printf("drift            first %zu vs last %zu cycles: lateral %.2f -> %.2f mm (%+.2f, limit %.2f), yaw %.3f -> "
-                "%.3f deg (%+.3f, limit %.2f); slope %+.3f mm, %+.4f deg per 1000 cycles: %s\n",
-                win, win, mean(lat_first), mean(lat_last), d_lat, opt.max_drift_lateral_mm, mean(yaw_first),
-                mean(yaw_last), d_yaw, opt.max_drift_yaw_deg, lat_slope, yaw_slope, drift_ok ? "ok" : "DRIFT");
+    std::printf(
+        "drift            first %zu vs last %zu cycles: lateral %.2f -> %.2f mm (%+.2f, limit %.2f), yaw %.3f -> "
+        "%.3f deg (%+.3f, limit %.2f); slope %+.3f mm, %+.4f deg per 1000 cycles: %s\n",
+        win, win, mean(lat_first), mean(lat_last), d_lat, opt.max_drift_lateral_mm, mean(yaw_first), mean(yaw_last),
+        d_yaw, opt.max_drift_yaw_deg, lat_slope, yaw_slope, drift_ok ? "ok" : "DRIFT");
     std::printf("dock time s      %s\n", tri(dock_s, "%.1f").c_str());
     std::printf("cycle time s     %s (simulated)\n", tri(cycle_s, "%.1f").c_str());
     std::printf("wall s / cycle   %s\n", tri(wall_s, "%.3f").c_str());
     if (counted) {
-      std::printf("heap             core: %llu allocations after the first cycle (%llu in it): %s; simulator: %llu "
-                  "after the first cycle (max %llu in a cycle)\n",
-                  static_cast<unsigned long long>(core_after_first), static_cast<unsigned long long>(first.core_allocs),
-                  heap_ok ? "ok" : (counter_works ? "CORE ALLOCATES" : "COUNTER BROKEN"), static_cast<unsigned long long>(sim_after_first),
-                  static_cast<unsigned long long>(sim_max_cycle));
+      std::printf(
+          "heap             core: %llu allocations after the first cycle (%llu in it): %s; simulator: %llu "
+          "after the first cycle (max %llu in a cycle)\n",
+          static_cast<unsigned long long>(core_after_first), static_cast<unsigned long long>(first.core_allocs),
+          heap_ok ? "ok" : (counter_works ? "CORE ALLOCATES" : "COUNTER BROKEN"),
+          static_cast<unsigned long long>(sim_after_first), static_cast<unsigned long long>(sim_max_cycle));
       std::printf("                 malloc heap in use %zu B after cycle 2, %zu B after the last\n", heap_second,
                   lastc.heap_bytes);
     } else {
       std::printf("heap             not counted (sanitizer build: the runtime owns malloc)\n");
     }
-    std::printf("rss KiB          %ld after cycle 2, %ld after the last, max %ld\n", rss_second, lastc.rss_kib, rss_max);
+    std::printf("rss KiB          %ld after cycle 2, %ld after the last, max %ld\n", rss_second, lastc.rss_kib,
+                rss_max);
     std::printf("battery soc      %.4f after the first cycle, %.4f after the last; odometry vs truth drift %.3f m\n",
                 first.soc, lastc.soc, lastc.odom_error_m);
     std::printf("%s\n", all_ok ? "soak: ok" : "soak: FAILED");
@@ -629,14 +642,18 @@ void register_soak(CLI::App& app) {
                           ->check(docksim::non_negative_integer());
   sub->add_option("--charge-s", o->charge_s, "Time on the charger per cycle, s")->capture_default_str();
   sub->add_option("--gap-s", o->gap_s, "Idle time after the robot is carried to its start, s")->capture_default_str();
-  sub->add_option("--settle-s", o->settle_s, "Idle time after an undock before the robot is carried, s")->capture_default_str();
-  sub->add_option("--undock-timeout-s", o->undock_timeout_s, "Undock not done within this: failed cycle")->capture_default_str();
+  sub->add_option("--settle-s", o->settle_s, "Idle time after an undock before the robot is carried, s")
+      ->capture_default_str();
+  sub->add_option("--undock-timeout-s", o->undock_timeout_s, "Undock not done within this: failed cycle")
+      ->capture_default_str();
   sub->add_option("--drift-window", o->drift_window, "Cycles compared at the start and the end (at most half each)")
       ->capture_default_str();
   sub->add_option("--max-drift-lateral-mm", o->max_drift_lateral_mm,
-                  "Largest allowed change of the mean |lateral| error, last window vs first")->capture_default_str();
+                  "Largest allowed change of the mean |lateral| error, last window vs first")
+      ->capture_default_str();
   sub->add_option("--max-drift-yaw-deg", o->max_drift_yaw_deg,
-                  "Largest allowed change of the mean |yaw| error, last window vs first")->capture_default_str();
+                  "Largest allowed change of the mean |yaw| error, last window vs first")
+      ->capture_default_str();
   sub->add_flag("--json", o->json, "Print one JSON object (summary and per-cycle results) instead of text");
   sub->callback([o, seed]() {
     o->seed_set = seed->count() > 0;

@@ -20,22 +20,32 @@ namespace docksim {
 
 const char* to_string(EventKind k) {
   switch (k) {
-    case EventKind::kPush: return "push";
-    case EventKind::kOccludeDock: return "occlude_dock";
-    case EventKind::kObstacle: return "obstacle";
-    case EventKind::kLidarDropout: return "lidar_dropout";
-    case EventKind::kChargingNeverStarts: return "charging_never_starts";
-    case EventKind::kChassisSilent: return "chassis_silent";
-    case EventKind::kHostStall: return "host_stall";
+    case EventKind::kPush:
+      return "push";
+    case EventKind::kOccludeDock:
+      return "occlude_dock";
+    case EventKind::kObstacle:
+      return "obstacle";
+    case EventKind::kLidarDropout:
+      return "lidar_dropout";
+    case EventKind::kChargingNeverStarts:
+      return "charging_never_starts";
+    case EventKind::kChassisSilent:
+      return "chassis_silent";
+    case EventKind::kHostStall:
+      return "host_stall";
   }
   return "?";
 }
 
 const char* to_string(FurnitureKind k) {
   switch (k) {
-    case FurnitureKind::kBox: return "box";
-    case FurnitureKind::kBin: return "bin";
-    case FurnitureKind::kChair: return "chair";
+    case FurnitureKind::kBox:
+      return "box";
+    case FurnitureKind::kBin:
+      return "bin";
+    case FurnitureKind::kChair:
+      return "chair";
   }
   return "?";
 }
@@ -117,7 +127,9 @@ void place_furniture(Scenario& sc) {
     max_y = i == 0 ? static_cast<double>(v.y()) : std::max(max_y, static_cast<double>(v.y()));
   }
   const double back_x = sc.wall ? min_x - sc.wall_gap_m + kFurnitureWallClearanceM : min_x;
-  auto world = [&](double x, double y) { return sc.dock_pose.transform(Vec2(static_cast<Real>(x), static_cast<Real>(y))); };
+  auto world = [&](double x, double y) {
+    return sc.dock_pose.transform(Vec2(static_cast<Real>(x), static_cast<Real>(y)));
+  };
   for (const DockFurniture& f : sc.furniture) {
     const double near = (f.side > 0 ? max_y : -min_y) + f.gap_m;  // nearest point's |y|, dock frame
     const double sgn = f.side > 0 ? 1.0 : -1.0;
@@ -173,8 +185,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   // dockcore's parameters: the keys, bounds and defaults of the parameter table, the same as dockd's config. The
   // obstacle footprint's body is derived from the chassis below.
   namespace params = dockcore::params;
-  const params::ParamTargets targets{nullptr,      &sc.limits,  &sc.safety,  &sc.task,  &sc.estimator,
-                                     &sc.seed000,  &sc.seed004, &sc.seed003, &sc.smooth};
+  const params::ParamTargets targets{nullptr,     &sc.limits,  &sc.safety,  &sc.task,  &sc.estimator,
+                                     &sc.seed000, &sc.seed004, &sc.seed003, &sc.smooth};
   params::apply_defaults(targets, params::kScenario);
   auto table_keys = [&](const std::string& table, Handlers h) {
     params::add_params(p, h, table, targets, params::kScenario);
@@ -196,16 +208,18 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
     h.emplace_back("footprint", p.sub("robot.footprint.", [&]() {
       FootprintParams& f = c.footprint;
       // The table's keys (shape, check area, margins) plus the chassis outline the obstacle check's body comes from.
-      return table_keys("robot.footprint", Handlers{
-          {"length_m", p.num(&f.length_m, 0.05, 5.0)},
-          {"width_m", p.num(&f.width_m, 0.05, 5.0)},
-          {"radius_m", params::bounded_by(p, "robot.footprint", "radius_m", &f.radius_m)},
-          {"centre_x_m", p.num(&f.centre_x_m, -2.0, 2.0)},
-          {"pads", [&](const toml::node& n) {
-             f.pad_side = p.choice(n, {"front", "rear"}) == "rear" ? PadSide::kRear : PadSide::kFront;
-           }},
-          {"pad_offset_y_m", p.num(&f.pad_offset_y_m, -1.0, 1.0)},
-      });
+      return table_keys("robot.footprint",
+                        Handlers{
+                            {"length_m", p.num(&f.length_m, 0.05, 5.0)},
+                            {"width_m", p.num(&f.width_m, 0.05, 5.0)},
+                            {"radius_m", params::bounded_by(p, "robot.footprint", "radius_m", &f.radius_m)},
+                            {"centre_x_m", p.num(&f.centre_x_m, -2.0, 2.0)},
+                            {"pads",
+                             [&](const toml::node& n) {
+                               f.pad_side = p.choice(n, {"front", "rear"}) == "rear" ? PadSide::kRear : PadSide::kFront;
+                             }},
+                            {"pad_offset_y_m", p.num(&f.pad_offset_y_m, -1.0, 1.0)},
+                        });
     }));
     h.emplace_back("lidar", p.sub("robot.lidar.", [&]() {
       return Handlers{{"x_m", p.real(&sc.lidar_mount.x_m, -2, 2)},
@@ -244,21 +258,25 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
     }));
     h.emplace_back("odometry", p.sub("robot.odometry.", [&]() {
       NoiseParams& o = c.noise;
-      return Handlers{{"slip_sigma", p.num(&o.slip_sigma, 0, 0.5)},
-                      {"slip_correlation_s", p.num(&o.slip_correlation_s, 0, 100)},
-                      {"encoder_cpr", [&](const toml::node& n) {
-                         o.encoder_cpr = static_cast<std::int32_t>(p.integer(n, 1, 1 << 24));
-                       }},
-                      {"radius_error", p.num(&o.odom_radius_error, -0.5, 0.5)},
-                      {"radius_diff", p.num(&o.odom_radius_diff, -0.5, 0.5)},
-                      {"base_error", p.num(&o.odom_base_error, -0.5, 0.5)}};
+      return Handlers{
+          {"slip_sigma", p.num(&o.slip_sigma, 0, 0.5)},
+          {"slip_correlation_s", p.num(&o.slip_correlation_s, 0, 100)},
+          {"encoder_cpr",
+           [&](const toml::node& n) { o.encoder_cpr = static_cast<std::int32_t>(p.integer(n, 1, 1 << 24)); }},
+          {"radius_error", p.num(&o.odom_radius_error, -0.5, 0.5)},
+          {"radius_diff", p.num(&o.odom_radius_diff, -0.5, 0.5)},
+          {"base_error", p.num(&o.odom_base_error, -0.5, 0.5)}};
     }));
     return h;
   };
 
   auto lidar_handlers = [&]() {
     return Handlers{
-        {"model", [&](const toml::node& n) { st.lidar_model = p.string(n); st.lidar_model_node = &n; }},
+        {"model",
+         [&](const toml::node& n) {
+           st.lidar_model = p.string(n);
+           st.lidar_model_node = &n;
+         }},
         {"sigma_range_m", [&](const toml::node& n) { st.lidar_sigma_m = p.number(n, 0, 1); }},
         {"sigma_prop", [&](const toml::node& n) { st.lidar_sigma_prop = p.number(n, 0, 1); }},
         {"dropout", [&](const toml::node& n) { st.lidar_dropout = p.number(n, 0, 1); }},
@@ -274,7 +292,11 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   auto dock_handlers = [&]() {
     ContactParams& k = sc.chassis.contact;
     return Handlers{
-        {"profile", [&](const toml::node& n) { st.profile = p.string(n); st.profile_node = &n; }},
+        {"profile",
+         [&](const toml::node& n) {
+           st.profile = p.string(n);
+           st.profile_node = &n;
+         }},
         {"x_m", p.real(&sc.dock_pose.x_m, -1e3, 1e3)},
         {"y_m", p.real(&sc.dock_pose.y_m, -1e3, 1e3)},
         {"yaw_deg", p.real_deg(&sc.dock_pose.yaw_rad, -180, 180)},
@@ -283,11 +305,13 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         {"wall_gap_m", p.num(&sc.wall_gap_m, 0, static_cast<double>(dockcore::kMaxWallGapM))},
         {"wall_glass", p.flag(&sc.wall_glass)},
         {"wall_half_length_m", p.num(&sc.wall_half_length_m, 0.1, 100)},
-        {"mounting", [&](const toml::node& n) {
+        {"mounting",
+         [&](const toml::node& n) {
            st.mounting = dockcore::params::profile_toml::read_mounting(p, n, "dock.mounting.");
            st.mounting_set = true;
          }},
-        {"furniture", [&](const toml::node& n) {
+        {"furniture",
+         [&](const toml::node& n) {
            const toml::array* a = n.as_array();
            if (a == nullptr) p.fail(n.source(), "dock.furniture must be an array of tables ([[dock.furniture]])");
            for (const toml::node& e : *a) {
@@ -298,14 +322,18 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
              DockFurniture f;
              const toml::value<std::string>* kind_str = kind_node->as_string();
              if (kind_str == nullptr) {
-               p.fail(kind_node->source(), std::string("dock.furniture.kind must be a string, not ") + type_name(*kind_node));
+               p.fail(kind_node->source(),
+                      std::string("dock.furniture.kind must be a string, not ") + type_name(*kind_node));
              }
              const std::string kind = kind_str->get();
              if (kind != "box" && kind != "bin" && kind != "chair") {
                p.fail(kind_node->source(), "dock.furniture.kind = \"" + kind + "\" is not one of box, bin, chair");
              }
              Handlers h{{"kind", [](const toml::node&) {}},
-                        {"side", [&](const toml::node& v) { f.side = p.choice(v, {"left", "right"}) == "left" ? 1 : -1; }},
+                        {"side",
+                         [&](const toml::node& v) {
+                           f.side = p.choice(v, {"left", "right"}) == "left" ? 1 : -1;
+                         }},
                         {"gap_m", p.num(&f.gap_m, 0, 3)},
                         {"x_m", [&](const toml::node& v) {
                            f.x_m = p.number(v, -3, 3);
@@ -327,14 +355,15 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
              sc.furniture.push_back(f);
            }
          }},
-        {"contacts", p.sub("dock.contacts.", [&]() {
-           return Handlers{{"lateral_tolerance_m", p.num(&k.lateral_tolerance_m, 0, 0.5)},
-                           {"yaw_tolerance_deg", p.deg(&k.yaw_tolerance_rad, 0, 45)},
-                           {"min_press_m", p.num(&k.min_press_m, 0, 0.1)},
-                           {"press_limit_m", p.num(&k.press_limit_m, 0, 0.1)},
-                           {"charge_delay_s", p.num(&k.charge_delay_s, 0, 60)},
-                           {"charge_current_a", p.num(&k.charge_current_a, 0, 1000)}};
-         })},
+        {"contacts", p.sub("dock.contacts.",
+                           [&]() {
+                             return Handlers{{"lateral_tolerance_m", p.num(&k.lateral_tolerance_m, 0, 0.5)},
+                                             {"yaw_tolerance_deg", p.deg(&k.yaw_tolerance_rad, 0, 45)},
+                                             {"min_press_m", p.num(&k.min_press_m, 0, 0.1)},
+                                             {"press_limit_m", p.num(&k.press_limit_m, 0, 0.1)},
+                                             {"charge_delay_s", p.num(&k.charge_delay_s, 0, 60)},
+                                             {"charge_current_a", p.num(&k.charge_current_a, 0, 1000)}};
+                           })},
     };
   };
 
@@ -350,22 +379,26 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
       }
     };
     return Handlers{
-        {"polylines", [&, array_of_tables](const toml::node& n) {
+        {"polylines",
+         [&, array_of_tables](const toml::node& n) {
            array_of_tables(n, "polylines", [&](const toml::table& t) {
              WorldPolyline pl;
-             p.each(t, "world.polylines.", {{"points", [&](const toml::node& pn) {
-                                               const toml::array* a = pn.as_array();
-                                               if (a == nullptr || a->size() < 2) {
-                                                 p.fail(pn.source(), "points must be an array of >= 2 [x_m, y_m]");
-                                               }
-                                               for (const toml::node& q : *a) pl.points.push_back(p.point(q));
-                                             }},
-                                            {"closed", p.flag(&pl.closed)}});
+             p.each(t, "world.polylines.",
+                    {{"points",
+                      [&](const toml::node& pn) {
+                        const toml::array* a = pn.as_array();
+                        if (a == nullptr || a->size() < 2) {
+                          p.fail(pn.source(), "points must be an array of >= 2 [x_m, y_m]");
+                        }
+                        for (const toml::node& q : *a) pl.points.push_back(p.point(q));
+                      }},
+                     {"closed", p.flag(&pl.closed)}});
              if (pl.points.size() < 2) p.fail(t.source(), "a polyline needs points");
              sc.polylines.push_back(pl);
            });
          }},
-        {"boxes", [&, array_of_tables](const toml::node& n) {
+        {"boxes",
+         [&, array_of_tables](const toml::node& n) {
            array_of_tables(n, "boxes", [&](const toml::table& t) {
              WorldBox b;
              p.each(t, "world.boxes.",
@@ -377,7 +410,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
              sc.boxes.push_back(b);
            });
          }},
-        {"circles", [&, array_of_tables](const toml::node& n) {
+        {"circles",
+         [&, array_of_tables](const toml::node& n) {
            array_of_tables(n, "circles", [&](const toml::table& t) {
              WorldCircle c;
              p.each(t, "world.circles.",
@@ -393,17 +427,20 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   auto start_handlers = [&]() {
     StartEnvelope& s = sc.start;
     return Handlers{
-        {"distance_m", [&](const toml::node& n) {
+        {"distance_m",
+         [&](const toml::node& n) {
            const auto r = p.range(n, 0.05, 50);
            s.distance_min_m = r.first;
            s.distance_max_m = r.second;
          }},
-        {"bearing_deg", [&](const toml::node& n) {
+        {"bearing_deg",
+         [&](const toml::node& n) {
            const auto r = p.range(n, -90, 90);
            s.bearing_min_rad = r.first * kDeg;
            s.bearing_max_rad = r.second * kDeg;
          }},
-        {"heading_deg", [&](const toml::node& n) {
+        {"heading_deg",
+         [&](const toml::node& n) {
            const auto r = p.range(n, -180, 180);
            s.heading_min_rad = r.first * kDeg;
            s.heading_max_rad = r.second * kDeg;
@@ -450,7 +487,9 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
       } else {
         ev.kind = EventKind::kChassisSilent;
         h.emplace_back("duration_s", dur);
-        h.emplace_back("motion", [&](const toml::node& m) { ev.hold_last_command = p.choice(m, {"stop", "hold"}) == "hold"; });
+        h.emplace_back("motion", [&](const toml::node& m) {
+          ev.hold_last_command = p.choice(m, {"stop", "hold"}) == "hold";
+        });
       }
       p.each(*t, "events." + kind + ".", h);
       sc.events.push_back(ev);
@@ -460,14 +499,15 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   auto host_handlers = [&]() {
     HostSpec& h = sc.host;
     return Handlers{{"chassis_stale_s", p.num(&h.chassis_stale_s, 0.001, 100)},
-                    {"redock_after_fault", [&](const toml::node& n) { h.redock_after_fault = static_cast<int>(p.integer(n, 0, 100)); }},
+                    {"redock_after_fault",
+                     [&](const toml::node& n) { h.redock_after_fault = static_cast<int>(p.integer(n, 0, 100)); }},
                     {"redock_delay_s", p.num(&h.redock_delay_s, 0, 100)}};
   };
 
   auto controller_handlers = [&]() {
-    Handlers h = table_keys("controller", Handlers{{"name", [&](const toml::node& n) {
-                                                      sc.controller = p.choice(n, controller_names());
-                                                    }}});
+    Handlers h =
+        table_keys("controller",
+                   Handlers{{"name", [&](const toml::node& n) { sc.controller = p.choice(n, controller_names()); }}});
     for (const std::string& name : controller_names()) {
       h.emplace_back(name, params::param_sub(p, "controller." + name, targets, params::kScenario));
     }
@@ -486,10 +526,12 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
       {"start", p.sub("start.", start_handlers)},
       {"events", events_handler},
       {"task", params::param_sub(p, "task", targets, params::kScenario)},
-      {"estimator", p.sub("estimator.", [&]() {
-         return table_keys("estimator", Handlers{
-             {"segments", params::param_sub(p, "estimator.segments", targets, params::kScenario)}});
-       })},
+      {"estimator", p.sub("estimator.",
+                          [&]() {
+                            return table_keys("estimator",
+                                              Handlers{{"segments", params::param_sub(p, "estimator.segments", targets,
+                                                                                      params::kScenario)}});
+                          })},
       {"host", p.sub("host.", host_handlers)},
       {"controller", p.sub("controller.", controller_handlers)},
   };
@@ -497,8 +539,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
 
   // --- Derived values and cross-checks ---
   ChassisParams& c = sc.chassis;
-  c.footprint.shape = sc.safety.shape == dockcore::FootprintShape::kCircular ? FootprintShape::kCircle
-                                                                             : FootprintShape::kRectangle;
+  c.footprint.shape =
+      sc.safety.shape == dockcore::FootprintShape::kCircular ? FootprintShape::kCircle : FootprintShape::kRectangle;
   if (st.motor_latency_s >= 0) {
     c.motor.latency_steps = static_cast<std::size_t>(std::lround(st.motor_latency_s / c.dt_s));
   }
@@ -522,13 +564,14 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   {
     // A relative profile path is relative to the scenario file.
     std::string ref = st.profile;
-    const bool is_file = ref.find('/') != std::string::npos ||
-                         (ref.size() > 5 && ref.compare(ref.size() - 5, 5, ".toml") == 0);
+    const bool is_file =
+        ref.find('/') != std::string::npos || (ref.size() > 5 && ref.compare(ref.size() - 5, 5, ".toml") == 0);
     if (is_file && !ref.empty() && ref[0] != '/') ref = dir_of(source_name) + ref;
     try {
       sc.profile = resolve_profile(ref);
     } catch (const ProfileFileError& e) {
-      p.fail(st.profile_node != nullptr ? st.profile_node->source() : root.source(), std::string("dock.profile: ") + e.what());
+      p.fail(st.profile_node != nullptr ? st.profile_node->source() : root.source(),
+             std::string("dock.profile: ") + e.what());
     }
   }
   // What the detector is told is independent of the world: [dock.mounting] replaces the profile file's.
@@ -552,7 +595,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
     f.shape = dockcore::FootprintShape::kSquare;
     f.half_length_m = static_cast<Real>(std::fabs(c.footprint.centre_x_m) + c.footprint.length_m / 2);
     f.half_width_m = static_cast<Real>(c.footprint.width_m / 2);
-    f.circumscribed_radius_m = static_cast<Real>(std::hypot(static_cast<double>(f.half_length_m), c.footprint.width_m / 2));
+    f.circumscribed_radius_m =
+        static_cast<Real>(std::hypot(static_cast<double>(f.half_length_m), c.footprint.width_m / 2));
   }
 
   const bool mecanum = c.geometry.kind == DriveKind::kMecanum;

@@ -31,8 +31,12 @@ std::uint64_t mix64(std::uint64_t z) {
   return z ^ (z >> 31);
 }
 
-Vec2 v2(double x, double y) { return Vec2(static_cast<Real>(x), static_cast<Real>(y)); }
-double dd(Real r) { return static_cast<double>(r); }
+Vec2 v2(double x, double y) {
+  return Vec2(static_cast<Real>(x), static_cast<Real>(y));
+}
+double dd(Real r) {
+  return static_cast<double>(r);
+}
 
 double wrapd(double a) {
   double r = std::remainder(a, 2.0 * kPiD);
@@ -44,8 +48,12 @@ double wrapd(double a) {
 struct P {
   double x, y;
 };
-P pd(const Vec2& v) { return P{dd(v.x()), dd(v.y())}; }
-double cross(P a, P b, P c) { return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x); }
+P pd(const Vec2& v) {
+  return P{dd(v.x()), dd(v.y())};
+}
+double cross(P a, P b, P c) {
+  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
 double point_seg(P p, P a, P b) {
   const double vx = b.x - a.x, vy = b.y - a.y;
   const double l2 = vx * vx + vy * vy;
@@ -90,7 +98,8 @@ double clearance(const std::vector<P>& poly, bool is_disc, P disc_c, double disc
       d = std::max(0.0, point_seg(disc_c, s.first, s.second) - disc_r);
     } else {
       d = std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i < poly.size(); ++i) d = std::min(d, seg_seg(poly[i], poly[(i + 1) % poly.size()], s.first, s.second));
+      for (std::size_t i = 0; i < poly.size(); ++i)
+        d = std::min(d, seg_seg(poly[i], poly[(i + 1) % poly.size()], s.first, s.second));
       if (d > 0 && inside_poly(s.first, poly)) d = 0;
     }
     best = std::min(best, d);
@@ -103,7 +112,8 @@ double clearance(const std::vector<P>& poly, bool is_disc, P disc_c, double disc
       d = 0;
     } else {
       d = std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i < poly.size(); ++i) d = std::min(d, point_seg(c.c, poly[i], poly[(i + 1) % poly.size()]) - c.r);
+      for (std::size_t i = 0; i < poly.size(); ++i)
+        d = std::min(d, point_seg(c.c, poly[i], poly[(i + 1) % poly.size()]) - c.r);
     }
     best = std::min(best, std::max(0.0, d));
   }
@@ -133,12 +143,18 @@ std::string fault_text(int code) {
 
 const char* to_string(TimelineKind k) {
   switch (k) {
-    case TimelineKind::kState: return "state";
-    case TimelineKind::kPhase: return "phase";
-    case TimelineKind::kFault: return "fault";
-    case TimelineKind::kEvent: return "event";
-    case TimelineKind::kContact: return "contact";
-    case TimelineKind::kHost: return "host";
+    case TimelineKind::kState:
+      return "state";
+    case TimelineKind::kPhase:
+      return "phase";
+    case TimelineKind::kFault:
+      return "fault";
+    case TimelineKind::kEvent:
+      return "event";
+    case TimelineKind::kContact:
+      return "contact";
+    case TimelineKind::kHost:
+      return "host";
   }
   return "?";
 }
@@ -166,9 +182,13 @@ CameraSimParams camera_sim_params(const Scenario& sc) {
   return camp;
 }
 
-std::uint64_t seed_stream(std::uint64_t seed, std::uint64_t salt) { return mix64(seed ^ salt); }
+std::uint64_t seed_stream(std::uint64_t seed, std::uint64_t salt) {
+  return mix64(seed ^ salt);
+}
 
-std::uint64_t trial_seed(std::uint64_t base, std::uint64_t index) { return mix64(mix64(base) ^ (index * 0xD1B54A32D192ED03ull)); }
+std::uint64_t trial_seed(std::uint64_t base, std::uint64_t index) {
+  return mix64(mix64(base) ^ (index * 0xD1B54A32D192ED03ull));
+}
 
 StartPose start_from(const Scenario& sc, double distance_m, double bearing_rad, double heading_rad) {
   StartPose s;
@@ -344,7 +364,8 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       switch (ev.kind) {
         case EventKind::kPush:
           chassis.apply_pose_jump(ev.dx_m, ev.dy_m, ev.dyaw_rad);
-          std::snprintf(buf, sizeof buf, "push dx %.3f m dy %.3f m dyaw %.1f deg", ev.dx_m, ev.dy_m, ev.dyaw_rad * 180 / kPiD);
+          std::snprintf(buf, sizeof buf, "push dx %.3f m dy %.3f m dyaw %.1f deg", ev.dx_m, ev.dy_m,
+                        ev.dyaw_rad * 180 / kPiD);
           break;
         case EventKind::kOccludeDock:
           occluded_until = std::max(occluded_until, t + ev.duration_s);
@@ -352,7 +373,8 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
           break;
         case EventKind::kObstacle:
           active_obs.push_back({v2(ev.x_m, ev.y_m), ev.r_m, ev.duration_s > 0 ? t + ev.duration_s : 1e300});
-          std::snprintf(buf, sizeof buf, "obstacle r %.2f m at (%.2f, %.2f) for %.2f s", ev.r_m, ev.x_m, ev.y_m, ev.duration_s);
+          std::snprintf(buf, sizeof buf, "obstacle r %.2f m at (%.2f, %.2f) for %.2f s", ev.r_m, ev.x_m, ev.y_m,
+                        ev.duration_s);
           break;
         case EventKind::kLidarDropout:
           dropout_until = std::max(dropout_until, t + ev.duration_s);
@@ -386,9 +408,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       host_stalled = false;
       add(t, TimelineKind::kEvent, static_cast<int>(EventKind::kHostStall), "host runs again");
     }
-    active_obs.erase(std::remove_if(active_obs.begin(), active_obs.end(),
-                                    [&](const ActiveObstacle& o) { return t >= o.until_s; }),
-                     active_obs.end());
+    active_obs.erase(
+        std::remove_if(active_obs.begin(), active_obs.end(), [&](const ActiveObstacle& o) { return t >= o.until_s; }),
+        active_obs.end());
     const bool occluded = t < occluded_until;
 
     const ChassisState& cs = chassis.state();
@@ -486,11 +508,13 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       }
       prev_fault = s.fault;
       if (o.blocked != prev_blocked) {
-        add(t, TimelineKind::kHost, o.blocked ? 1 : 0, o.blocked ? "motion blocked by an obstacle" : "motion free again");
+        add(t, TimelineKind::kHost, o.blocked ? 1 : 0,
+            o.blocked ? "motion blocked by an obstacle" : "motion free again");
         prev_blocked = o.blocked;
       }
       if (o.target_lost != prev_lost) {
-        add(t, TimelineKind::kHost, o.target_lost ? 1 : 0, o.target_lost ? "target lost: holding" : "target reacquired");
+        add(t, TimelineKind::kHost, o.target_lost ? 1 : 0,
+            o.target_lost ? "target lost: holding" : "target reacquired");
         prev_lost = o.target_lost;
       }
       if (s.state == dockcore::TaskState::kFault) {
@@ -521,10 +545,12 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
         std::vector<P> poly;
         for (const auto& q : outline) poly.push_back(pd(cs.true_pose.transform(q)));
         const P centre = pd(cs.true_pose.transform(v2(sc.chassis.footprint.centre_x_m, 0)));
-        out.min_clearance_m = std::min(out.min_clearance_m, clearance(poly, disc, centre, sc.chassis.footprint.radius_m, obs));
+        out.min_clearance_m =
+            std::min(out.min_clearance_m, clearance(poly, disc, centre, sc.chassis.footprint.radius_m, obs));
       }
       if (opt.record_trajectory && t + 1e-9 >= next_traj_t) {
-        run.trajectory.push_back(TrajectorySample{t, cs.true_pose, dd(core->drive_cmd().vx_mps), static_cast<std::uint8_t>(prev_state)});
+        run.trajectory.push_back(
+            TrajectorySample{t, cs.true_pose, dd(core->drive_cmd().vx_mps), static_cast<std::uint8_t>(prev_state)});
         next_traj_t += opt.trajectory_period_s;
       }
     }
@@ -545,7 +571,8 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       prev_contact = after.contact;
     }
     if (after.charging != prev_charging) {
-      add(t + dt, TimelineKind::kContact, after.charging ? 3 : 2, after.charging ? "charging current on" : "charging current off");
+      add(t + dt, TimelineKind::kContact, after.charging ? 3 : 2,
+          after.charging ? "charging current on" : "charging current off");
       prev_charging = after.charging;
     }
   }

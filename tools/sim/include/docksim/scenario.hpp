@@ -39,14 +39,14 @@ class ScenarioError : public std::runtime_error {
 
 /// Disturbances on the timeline ([[events]] type = ...).
 enum class EventKind : std::uint8_t {
-  kPush,                ///< "push": true pose jumps by (dx, dy) world metres and dyaw; odometry does not see it.
-  kOccludeDock,         ///< "occlude_dock": the dock is invisible to lidar and camera for duration_s.
-  kObstacle,            ///< "obstacle": a disc (x, y, r) in the world for duration_s (<= 0: for good).
-  kLidarDropout,        ///< "lidar_dropout": no scans for duration_s.
-  kChargingNeverStarts, ///< "charging_never_starts": the charger delivers no current from t_s on.
-  kChassisSilent,       ///< "chassis_silent": the chassis stops answering for duration_s.
-  kHostStall,           ///< "host_stall": the control host (dockd and dockcore) does not run for duration_s: no scan
-                        ///< is read, no tick runs, the motors keep the last command (up to their command timeout).
+  kPush,                 ///< "push": true pose jumps by (dx, dy) world metres and dyaw; odometry does not see it.
+  kOccludeDock,          ///< "occlude_dock": the dock is invisible to lidar and camera for duration_s.
+  kObstacle,             ///< "obstacle": a disc (x, y, r) in the world for duration_s (<= 0: for good).
+  kLidarDropout,         ///< "lidar_dropout": no scans for duration_s.
+  kChargingNeverStarts,  ///< "charging_never_starts": the charger delivers no current from t_s on.
+  kChassisSilent,        ///< "chassis_silent": the chassis stops answering for duration_s.
+  kHostStall,            ///< "host_stall": the control host (dockd and dockcore) does not run for duration_s: no scan
+                         ///< is read, no tick runs, the motors keep the last command (up to their command timeout).
 };
 
 /// Stable TOML name of an event kind ("push", ...). Never null.
@@ -65,15 +65,15 @@ struct ScenarioEvent {
 
 /// Simulated camera that sees one target point on the dock (seed 003's vision process).
 struct CameraSpec {
-  bool enabled = false;         ///< false: ControlInput::camera is never valid.
-  dockcore::CameraModel model{};///< fx, cx, image width and mount (robot frame).
-  double rate_hz = 20.0;        ///< Frames per second.
-  double latency_s = 0.05;      ///< Image time to delivery.
-  double sigma_px = 1.0;        ///< Gaussian pixel noise on u, 1 sigma.
-  double dropout_prob = 0.0;    ///< Chance a frame has no detection.
-  double min_depth_m = 0.05;    ///< Target closer than this along the optical axis: not seen (blind zone).
-  double max_depth_m = 4.0;     ///< Farther: not seen.
-  double v_px = 240.0;          ///< Row reported for the target (2D world: constant).
+  bool enabled = false;           ///< false: ControlInput::camera is never valid.
+  dockcore::CameraModel model{};  ///< fx, cx, image width and mount (robot frame).
+  double rate_hz = 20.0;          ///< Frames per second.
+  double latency_s = 0.05;        ///< Image time to delivery.
+  double sigma_px = 1.0;          ///< Gaussian pixel noise on u, 1 sigma.
+  double dropout_prob = 0.0;      ///< Chance a frame has no detection.
+  double min_depth_m = 0.05;      ///< Target closer than this along the optical axis: not seen (blind zone).
+  double max_depth_m = 4.0;       ///< Farther: not seen.
+  double v_px = 240.0;            ///< Row reported for the target (2D world: constant).
   dockcore::Vec2 target_in_dock = dockcore::Vec2::Zero();  ///< The target point, dock frame (default: contacts).
 };
 
@@ -113,13 +113,13 @@ const char* to_string(FurnitureKind k);
 
 struct DockFurniture {
   FurnitureKind kind = FurnitureKind::kBox;
-  int side = 1;             ///< +1: on the dock's left (+y), -1: on its right (-y).
-  double gap_m = 0.3;       ///< Free space along the dock's y from the dock's outermost vertex on that side to the
-                            ///< object's nearest point, m.
-  double depth_m = 0.4;     ///< box: extent along the dock's x, m.
-  double width_m = 0.4;     ///< box: extent along the dock's y, m.
-  double radius_m = 0.15;   ///< bin, m.
-  double seat_m = 0.45;     ///< chair: seat side, m (leg centres lie leg_radius_m inside its corners).
+  int side = 1;                 ///< +1: on the dock's left (+y), -1: on its right (-y).
+  double gap_m = 0.3;           ///< Free space along the dock's y from the dock's outermost vertex on that side to the
+                                ///< object's nearest point, m.
+  double depth_m = 0.4;         ///< box: extent along the dock's x, m.
+  double width_m = 0.4;         ///< box: extent along the dock's y, m.
+  double radius_m = 0.15;       ///< bin, m.
+  double seat_m = 0.45;         ///< chair: seat side, m (leg centres lie leg_radius_m inside its corners).
   double leg_radius_m = 0.015;  ///< chair, m.
   /// Centre along the dock's x, m. Default (x_set false): the object's back stands kFurnitureWallClearanceM in front
   /// of the wall's face, or on the dock's back plane when there is no wall.
@@ -142,7 +142,7 @@ struct Scenario {
   std::string name;    ///< Scenario name (default: the file name without .toml).
   std::string source;  ///< File it came from.
   std::uint64_t seed = 1;
-  double max_time_s = 120.0;     ///< A run that has not ended by then is a timeout.
+  double max_time_s = 120.0;        ///< A run that has not ended by then is a timeout.
   double settle_after_end_s = 0.3;  ///< Keep simulating this long after charging is confirmed / a final fault.
 
   // Robot.
@@ -159,12 +159,12 @@ struct Scenario {
   // Dock and world. profile.mounting is what the detector is told ([dock.mounting], else the profile file's).
   dockcore::DockProfile profile{};
   std::string profile_name = "plate-v";
-  Pose2 dock_pose{};                ///< Dock frame in the world.
+  Pose2 dock_pose{};  ///< Dock frame in the world.
   double dock_face_half_width_m = 0.15;
   /// The world behind the dock (what the lidar sees, whatever the detector is told: that is profile.mounting):
-  bool wall = true;                 ///< A wall behind the dock, parallel to its face; false: free-standing.
-  double wall_gap_m = 0;            ///< The wall's face lies this far behind the profile's minimum x, m, [0, 0.5].
-  bool wall_glass = false;          ///< Glass: lidar beams pass through it (absent from the lidar's world).
+  bool wall = true;         ///< A wall behind the dock, parallel to its face; false: free-standing.
+  double wall_gap_m = 0;    ///< The wall's face lies this far behind the profile's minimum x, m, [0, 0.5].
+  bool wall_glass = false;  ///< Glass: lidar beams pass through it (absent from the lidar's world).
   double wall_half_length_m = 2.0;
   std::vector<DockFurniture> furniture;  ///< Beside the dock; also expanded into boxes / circles below.
   std::vector<WorldPolyline> polylines;

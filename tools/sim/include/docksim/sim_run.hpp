@@ -14,9 +14,9 @@
 
 #include "dockcore/geometry.hpp"
 #include "dockcore/kinematics.hpp"
+#include "dockcore/task_manager.hpp"
 #include "docksim/camera_sim.hpp"
 #include "docksim/chassis.hpp"
-#include "dockcore/task_manager.hpp"
 #include "docksim/scenario.hpp"
 
 namespace docksim {
@@ -51,8 +51,8 @@ const char* to_string(TimelineKind k);
 struct TimelineEntry {
   double t_s = 0;
   TimelineKind kind = TimelineKind::kState;
-  int code = 0;       ///< State code, phase code, fault code, event kind, 1/0 for contact/charging changes.
-  std::string text;   ///< Human-readable ("ALIGN", "fault 178 distance_deviation", ...).
+  int code = 0;      ///< State code, phase code, fault code, event kind, 1/0 for contact/charging changes.
+  std::string text;  ///< Human-readable ("ALIGN", "fault 178 distance_deviation", ...).
 };
 
 struct TrajectorySample {
@@ -64,22 +64,22 @@ struct TrajectorySample {
 
 /// The outcome of one run.
 struct SimOutcome {
-  bool charging_confirmed = false;  ///< The task manager reached FINISH_TASKING.
+  bool charging_confirmed = false;                                       ///< The task manager reached FINISH_TASKING.
   double time_to_charging_s = std::numeric_limits<double>::quiet_NaN();  ///< From the first dock command.
   /// Pads at the end (at charging confirmation when it happened): lateral = pad y in the dock frame, longitudinal =
   /// pad x in the dock frame (negative = pressed past the contact plane), yaw = pad heading error. Ground truth.
   double lateral_m = 0, longitudinal_m = 0, yaw_rad = 0;
-  double path_length_m = 0;        ///< Of the robot centre, true motion.
-  int reversals = 0;               ///< Sign changes of the commanded vx (|vx| > 1 mm/s).
-  int inplace_turns_45 = 0;        ///< Stretches of turning with |v| < 1 cm/s whose cumulative |yaw| exceeded 45°.
-  double max_inplace_turn_rad = 0; ///< Largest such stretch.
+  double path_length_m = 0;         ///< Of the robot centre, true motion.
+  int reversals = 0;                ///< Sign changes of the commanded vx (|vx| > 1 mm/s).
+  int inplace_turns_45 = 0;         ///< Stretches of turning with |v| < 1 cm/s whose cumulative |yaw| exceeded 45°.
+  double max_inplace_turn_rad = 0;  ///< Largest such stretch.
   /// Smallest distance between the robot outline and any obstacle (world objects and obstacle events; the dock and
   /// its wall are not obstacles). +inf when there is none.
   double min_clearance_m = std::numeric_limits<double>::infinity();
-  std::map<int, int> faults;       ///< Fault code -> times raised.
+  std::map<int, int> faults;  ///< Fault code -> times raised.
   dockcore::TaskState final_state = dockcore::TaskState::kNotTasking;
-  bool timed_out = false;          ///< max_time_s reached without charging or a final fault.
-  int retries = 0;                 ///< Charging retries used (task manager).
+  bool timed_out = false;  ///< max_time_s reached without charging or a final fault.
+  int retries = 0;         ///< Charging retries used (task manager).
   double end_time_s = 0;
   /// seed003 only: when its own success test (phase SEED_SUCCESS) first held, from the first dock command, and the
   /// true camera-to-target errors then: depth along the optical axis minus goal_z_m, and lateral offset (positive =

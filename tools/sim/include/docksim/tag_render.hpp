@@ -21,8 +21,8 @@ struct PinholeView {
   std::uint32_t width_px = 640, height_px = 480;
   double rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< Tag frame → camera frame, row-major.
   double translation_m[3] = {0, 0, 1};               ///< Tag centre in the camera frame.
-  std::uint8_t background = 128;                      ///< Grey where the ray misses the tag.
-  std::uint32_t supersample = 3;                      ///< Samples per pixel side (anti-aliasing; 1..8).
+  std::uint8_t background = 128;                     ///< Grey where the ray misses the tag.
+  std::uint32_t supersample = 3;                     ///< Samples per pixel side (anti-aliasing; 1..8).
 };
 
 /// Renders the tag into `grey` (width × height, `stride_bytes` per row), replacing every pixel. Pixels whose rays
