@@ -51,6 +51,30 @@ void CameraPipeline::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
+const TagDetection* select_target_tag(const TagDetection* detections, std::size_t count, std::int32_t target_id,
+                                      double full_confidence_margin, std::uint64_t stamp_us, TagFrameResult* out) {
+  *out = TagFrameResult{};
+  const TagDetection* tag = nullptr;
+  for (std::size_t i = 0; i < count && tag == nullptr; ++i) {
+    if (target_id < 0 || detections[i].id == target_id) tag = &detections[i];
+  }
+  if (tag == nullptr) return nullptr;
+  out->target.valid = true;
+  out->target.u_px = static_cast<Real>(tag->u_px);
+  out->target.v_px = static_cast<Real>(tag->v_px);
+  out->target.confidence = static_cast<Real>(std::min(1.0, std::max(0.0, tag->decision_margin / full_confidence_margin)));
+  out->target.stamp_us = stamp_us;
+  if (tag->has_pose) {
+    out->has_pose = true;
+    out->tag.id = tag->id;
+    out->tag.decision_margin = static_cast<Real>(tag->decision_margin);
+    out->tag.stamp_us = stamp_us;
+    for (int k = 0; k < 9; ++k) out->tag.rotation(k / 3, k % 3) = static_cast<Real>(tag->rotation[k]);
+    for (int k = 0; k < 3; ++k) out->tag.translation_m(k) = static_cast<Real>(tag->translation_m[k]);
+  }
+  return tag;
+}
+
 bool CameraPipeline::push(const Result& r) {
   const std::size_t head = head_.load(std::memory_order_relaxed);
   const std::size_t tail = tail_.load(std::memory_order_acquire);
@@ -74,27 +98,10 @@ void CameraPipeline::run() {
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t n = detector_.detect(f.grey, f.width_px, f.height_px, f.stride_bytes, dets, kMaxTagDetections);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    // The target: the wanted id (or any), strongest decision margin first (detect() sorts).
-    const TagDetection* tag = nullptr;
-    for (std::size_t i = 0; i < n && tag == nullptr; ++i) {
-      if (opt_.target_id < 0 || dets[i].id == opt_.target_id) tag = &dets[i];
-    }
+    Result r;
+    const TagDetection* tag = select_target_tag(dets, n, opt_.target_id, opt_.full_confidence_margin, f.stamp_us, &r);
     bool dropped = false;
     if (tag != nullptr) {
-      Result r;
-      r.target.valid = true;
-      r.target.u_px = static_cast<Real>(tag->u_px);
-      r.target.v_px = static_cast<Real>(tag->v_px);
-      r.target.confidence = static_cast<Real>(std::min(1.0, std::max(0.0, tag->decision_margin / opt_.full_confidence_margin)));
-      r.target.stamp_us = f.stamp_us;
-      if (tag->has_pose) {
-        r.has_pose = true;
-        r.tag.id = tag->id;
-        r.tag.decision_margin = static_cast<Real>(tag->decision_margin);
-        r.tag.stamp_us = f.stamp_us;
-        for (int k = 0; k < 9; ++k) r.tag.rotation(k / 3, k % 3) = static_cast<Real>(tag->rotation[k]);
-        for (int k = 0; k < 3; ++k) r.tag.translation_m(k) = static_cast<Real>(tag->translation_m[k]);
-      }
       if (push(r)) {
         const std::uint64_t one = 1;
         // The counter only saturates after 2^64 - 2 unread writes; EAGAIN then means "already readable".

@@ -20,6 +20,7 @@
 #include "docksim/scenario.hpp"
 #include "docksim/sim_run.hpp"
 #include "docksim/svg.hpp"
+#include "frame_camera.hpp"
 
 namespace docksim_cli {
 namespace {
@@ -95,6 +96,10 @@ bool write_svg(const docksim::SvgCanvas& c, const std::string& path, const char*
 }
 
 // ---------------------------------------------------------------------------------------------------------------------
+constexpr const char* kCameraRenderHelp =
+    "Render the scenario's camera frames (the dock's AprilTag, [dock.tag]) and run them through the tag detector, "
+    "fusing the tag poses with the lidar: robot.camera.render = true";
+
 struct RunOptions {
   std::string scenario;
   std::string controller;  // empty: the scenario's
@@ -103,7 +108,8 @@ struct RunOptions {
   std::string svg;
   bool json = false;
   bool trace = false;
-  std::vector<double> start;  // distance m, bearing deg, heading deg; empty: drawn from the seed
+  std::vector<double> start;   // distance m, bearing deg, heading deg; empty: drawn from the seed
+  bool camera_render = false;  // --camera-render
 };
 
 void draw_run(const docksim::Scenario& sc, const docksim::SimRun& r, const std::string& path) {
@@ -170,6 +176,12 @@ nlohmann::ordered_json outcome_json(const docksim::SimRun& r) {
     j["seed_success"] = {
         {"t_s", r6(o.seed_success_t_s)}, {"z_err_m", r6(o.seed_success_z_err_m)}, {"x_m", r6(o.seed_success_x_m)}};
   }
+  if (o.camera_rendered) {
+    j["camera"] = {{"frames", o.camera_frames},
+                   {"detections", o.camera_detections},
+                   {"tags_fused", o.tags_fused},
+                   {"tags_refused", o.tags_refused}};
+  }
   return j;
 }
 
@@ -188,6 +200,11 @@ int run_one(const RunOptions& opt) {
   }
   const std::uint64_t seed = opt.seed_set ? opt.seed : sc.seed;
   docksim::SimOptions so;
+  std::string camera_error;
+  if (!docksim_cli::use_rendered_camera(sc, opt.camera_render, so, camera_error)) {
+    std::cerr << "dock-sim run: " << opt.scenario << ": " << camera_error << "\n";
+    return 2;
+  }
   docksim::StartPose fixed;
   if (opt.start.size() == 3) {
     fixed = docksim::start_from(sc, opt.start[0], opt.start[1] / kRadToDeg, opt.start[2] / kRadToDeg);
@@ -252,6 +269,7 @@ struct McOptions {
   int jobs = 1;
   bool json = false;
   std::string svg;
+  bool camera_render = false;  // --camera-render
 };
 
 double pct(std::vector<double> v, double p) {
@@ -450,6 +468,11 @@ int run_mc(const McOptions& opt) {
   std::atomic<std::size_t> next{0}, done{0};
   std::mutex progress_mutex;
   docksim::SimOptions so;
+  std::string camera_error;
+  if (!docksim_cli::use_rendered_camera(sc, opt.camera_render, so, camera_error)) {
+    std::cerr << "dock-sim montecarlo: " << opt.scenario << ": " << camera_error << "\n";
+    return 2;
+  }
   so.record_trajectory = !opt.svg.empty();
   so.trajectory_period_s = 0.25;
   so.keep_last_scan = false;
@@ -552,6 +575,7 @@ void register_run(CLI::App& app) {
                   "scenario's envelope with the seed)")
       ->expected(3);
   sub->add_flag("--trace", o->trace, "Also print the trajectory (every 50 ms: true pose, commanded vx, task state)");
+  sub->add_flag("--camera-render", o->camera_render, kCameraRenderHelp);
   sub->callback([o, seed]() {
     o->seed_set = seed->count() > 0;
     const int rc = run_one(*o);
@@ -573,6 +597,7 @@ void register_montecarlo(CLI::App& app) {
       sub->add_option("--seed", o->seed, "Base seed (default: the scenario's)")->check(docksim::non_negative_integer());
   sub->add_option("--jobs", o->jobs, "Worker threads")->capture_default_str();
   sub->add_flag("--json", o->json, "Print JSON (summary and per-run outcomes) instead of the table");
+  sub->add_flag("--camera-render", o->camera_render, kCameraRenderHelp);
   sub->add_option("--svg", o->svg,
                   "Draw all trajectories and the success/time map over the start envelope (one file per controller: "
                   "NAME-<controller>.svg when several)");

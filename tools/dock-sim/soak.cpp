@@ -387,6 +387,12 @@ int run_soak(const SoakOptions& opt) {
               << "' has scripted events; soak runs event-free scenarios only\n";
     return 2;
   }
+  if (sc.camera.enabled && sc.camera.render) {
+    std::cerr << "dock-sim soak: scenario '" << sc.name
+              << "' renders camera frames (robot.camera.render); soak runs the target-level camera only: use run or "
+                 "montecarlo\n";
+    return 2;
+  }
   const std::string ctl_name = opt.controller.empty() ? sc.controller : opt.controller;
   auto ctls = std::make_unique<Controllers>(sc);
   dockcore::DockingController* ctl = ctls->get(ctl_name);

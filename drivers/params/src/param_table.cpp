@@ -223,17 +223,18 @@ const ParamSpec kTable[] = {
            segments.merge_max_skipped_points, "Points a merge may skip."),
     DC_INT("estimator.segments", "max_clusters", "–", 1, 100000, kBoth, estimator, segments.max_clusters,
            "Clusters processed per scan (later ones are counted and dropped)."),
-    // [camera.fusion] (dockd): TagFusionParams, the tag pose as a dock-pose measurement (docs/camera.md, "Fusion").
-    DC_REAL("camera.fusion", "sigma_px", "px", 0.01, 20, kDockd, tag_fusion, sigma_px,
+    // [camera.fusion] (dockd, and scenarios with a rendered camera): TagFusionParams, the tag pose as a dock-pose
+    // measurement (docs/camera.md, "Fusion").
+    DC_REAL("camera.fusion", "sigma_px", "px", 0.01, 20, kBoth, tag_fusion, sigma_px,
             "Effective corner noise of the tag detector: the covariance model's free parameter (measure it with "
             "`camera-check tag-pose`)."),
-    DC_REAL("camera.fusion", "sigma_scale", "–", 0.1, 100, kDockd, tag_fusion, sigma_scale,
+    DC_REAL("camera.fusion", "sigma_scale", "–", 0.1, 100, kBoth, tag_fusion, sigma_scale,
             "Multiplies every σ of the tag's covariance model."),
-    DC_REAL("camera.fusion", "min_decision_margin", "–", 0, 1000, kDockd, tag_fusion, min_decision_margin,
+    DC_REAL("camera.fusion", "min_decision_margin", "–", 0, 1000, kBoth, tag_fusion, min_decision_margin,
             "Tag detections with a smaller decision margin are not fused (`weak`)."),
-    DC_REAL("camera.fusion", "max_range_m", "m", 0.1, 20, kDockd, tag_fusion, max_range_m,
+    DC_REAL("camera.fusion", "max_range_m", "m", 0.1, 20, kBoth, tag_fusion, max_range_m,
             "Tags deeper than this along the optical axis are not fused (`far`)."),
-    DC_REAL("camera.fusion", "max_lag_s", "s", 0.001, 1, kDockd, tag_fusion, max_lag_s,
+    DC_REAL("camera.fusion", "max_lag_s", "s", 0.001, 1, kBoth, tag_fusion, max_lag_s,
             "A tag frame older than the newest scan by more than this is not fused (`stale`)."),
     DC_INT("estimator.segments", "max_split_iterations", "–", 1, 1000000, kBoth, estimator,
            segments.max_split_iterations, "Split-step evaluations per scan."),

@@ -24,27 +24,46 @@ dockcore::CameraTarget project_target(const CameraSimParams& p, const dockcore::
 }
 
 void CameraSim::update(std::uint64_t t_us, const dockcore::Pose2& robot_world, const dockcore::Vec2& target_world,
-                       bool visible) {
+                       bool visible, const dockcore::Pose2& odom_pose) {
   const std::uint64_t period_us = static_cast<std::uint64_t>(std::llround(1e6 / p_.rate_hz));
   const std::uint64_t latency_us = static_cast<std::uint64_t>(std::llround(p_.latency_s * 1e6));
   if (t_us >= next_capture_us_) {
-    dockcore::CameraTarget f = visible ? project_target(p_, robot_world, target_world) : dockcore::CameraTarget{};
-    // Draws happen for every frame, in a fixed order, so the stream does not depend on visibility.
-    const double noise = rng_.normal() * p_.sigma_px;
-    const bool dropped = rng_.bernoulli(p_.dropout_prob);
-    if (f.valid) {
-      f.u_px = static_cast<Real>(static_cast<double>(f.u_px) + noise);
-      if (dropped) f = dockcore::CameraTarget{};
+    InFlight f{CameraFrameOutput{}, odom_pose};
+    if (frame_camera_ != nullptr) {
+      f.frame = frame_camera_->capture(robot_world, visible, rng_);
+    } else {
+      dockcore::CameraTarget& c = f.frame.target;
+      c = visible ? project_target(p_, robot_world, target_world) : dockcore::CameraTarget{};
+      // Draws happen for every frame, in a fixed order, so the stream does not depend on visibility.
+      const double noise = rng_.normal() * p_.sigma_px;
+      const bool dropped = rng_.bernoulli(p_.dropout_prob);
+      if (c.valid) {
+        c.u_px = static_cast<Real>(static_cast<double>(c.u_px) + noise);
+        if (dropped) c = dockcore::CameraTarget{};
+      }
     }
-    f.stamp_us = t_us;
+    f.frame.target.stamp_us = t_us;
+    f.frame.tag.stamp_us = t_us;
     in_flight_.push_back(f);
     next_capture_us_ += period_us;
     if (next_capture_us_ <= t_us) next_capture_us_ = t_us + period_us;
   }
-  while (!in_flight_.empty() && in_flight_.front().stamp_us + latency_us <= t_us) {
-    latest_ = in_flight_.front();
+  while (!in_flight_.empty() && in_flight_.front().frame.target.stamp_us + latency_us <= t_us) {
+    const InFlight& f = in_flight_.front();
+    latest_ = f.frame.target;
+    ++frames_delivered_;
+    if (latest_.valid) ++frames_with_target_;
+    if (f.frame.has_tag) tags_.emplace_back(f.frame.tag, f.odom);
     in_flight_.pop_front();
   }
+}
+
+bool CameraSim::pop_tag(dockcore::TagObservation& tag, dockcore::Pose2& odom_at_stamp) {
+  if (tags_.empty()) return false;
+  tag = tags_.front().first;
+  odom_at_stamp = tags_.front().second;
+  tags_.pop_front();
+  return true;
 }
 
 }  // namespace docksim

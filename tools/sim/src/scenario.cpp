@@ -185,8 +185,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   // dockcore's parameters: the keys, bounds and defaults of the parameter table, the same as dockd's config. The
   // obstacle footprint's body is derived from the chassis below.
   namespace params = dockcore::params;
-  const params::ParamTargets targets{nullptr,     &sc.limits,  &sc.safety,  &sc.task,  &sc.estimator,
-                                     &sc.seed000, &sc.seed004, &sc.seed003, &sc.smooth};
+  const params::ParamTargets targets{nullptr,     &sc.limits,  &sc.safety,  &sc.task,   &sc.estimator,
+                                     &sc.seed000, &sc.seed004, &sc.seed003, &sc.smooth, &sc.tag_fusion};
   params::apply_defaults(targets, params::kScenario);
   auto table_keys = [&](const std::string& table, Handlers h) {
     params::add_params(p, h, table, targets, params::kScenario);
@@ -245,6 +245,15 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
           {"max_depth_m", p.num(&cam.max_depth_m, 0, 100)},
           {"target_x_m", [&](const toml::node& n) { cam.target_in_dock.x() = static_cast<Real>(p.number(n, -2, 2)); }},
           {"target_y_m", [&](const toml::node& n) { cam.target_in_dock.y() = static_cast<Real>(p.number(n, -2, 2)); }},
+          {"render", p.flag(&cam.render)},
+          {"fuse_tags", p.flag(&cam.fuse_tags)},
+          {"z_m", p.num(&cam.z_m, 0, 3)},
+          {"height_px",
+           [&](const toml::node& n) { cam.height_px = static_cast<std::uint32_t>(p.integer(n, 16, 8192)); }},
+          {"cy_px", p.num(&cam.cy_px, 0, 8192)},
+          {"blur_px", p.num(&cam.blur_px, 0, 5)},
+          {"noise_grey", p.num(&cam.noise_grey, 0, 64)},
+          {"decimate", p.num(&cam.decimate, 1, 8)},
       };
     }));
     h.emplace_back("motor", p.sub("robot.motor.", [&]() {
@@ -355,6 +364,15 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
              sc.furniture.push_back(f);
            }
          }},
+        {"tag", p.sub("dock.tag.",
+                      [&]() {
+                        DockTagSpec& t = sc.dock_tag;
+                        return Handlers{
+                            {"id", [&](const toml::node& n) { t.id = static_cast<int>(p.integer(n, 0, 65535)); }},
+                            {"family", [&](const toml::node& n) { t.family = p.string(n); }},
+                            {"size_m", p.num(&t.size_m, 0.005, 5)},
+                            {"z_m", p.num(&t.z_m, 0, 3)}};
+                      })},
         {"contacts", p.sub("dock.contacts.",
                            [&]() {
                              return Handlers{{"lateral_tolerance_m", p.num(&k.lateral_tolerance_m, 0, 0.5)},
@@ -534,6 +552,10 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
                           })},
       {"host", p.sub("host.", host_handlers)},
       {"controller", p.sub("controller.", controller_handlers)},
+      {"camera", p.sub("camera.",
+                       [&]() {
+                         return Handlers{{"fusion", params::param_sub(p, "camera.fusion", targets, params::kScenario)}};
+                       })},
   };
   p.each(root, "", top);
 

@@ -270,6 +270,27 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   cfg.drive = core_drive_geometry(sc.chassis.geometry);
   cfg.limits = sc.limits;
   cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
+  // A rendered camera: images of the dock's tag through the detector; its tag poses fused with the lidar.
+  std::unique_ptr<FrameCamera> frame_camera;
+  const bool rendered = sc.camera.enabled && sc.camera.render;
+  if (rendered) {
+    if (!opt.make_frame_camera) {
+      throw ScenarioError("robot.camera.render needs a tag detector: this dock-sim was built without libapriltag");
+    }
+    frame_camera = opt.make_frame_camera(sc);
+    if (sc.camera.fuse_tags) {
+      cfg.tag = sc.tag_fusion;
+      const dockcore::CameraModel& m = sc.camera.model;
+      cfg.tag.mount =
+          dockcore::CameraMount3{m.mount.x_m, m.mount.y_m, static_cast<Real>(sc.camera.z_m), m.mount.yaw_rad, 0, 0};
+      cfg.tag.fx_px = m.fx_px;
+      cfg.tag.tag_size_m = static_cast<Real>(sc.dock_tag.size_m);
+      cfg.tag.dock_tag.id = sc.dock_tag.id;
+      cfg.tag.dock_tag.x_m = sc.camera.target_in_dock.x();
+      cfg.tag.dock_tag.y_m = sc.camera.target_in_dock.y();
+      cfg.tag.dock_tag.z_m = static_cast<Real>(std::isnan(sc.dock_tag.z_m) ? sc.camera.z_m : sc.dock_tag.z_m);
+    }
+  }
   if (!core->configure(sc.profile, cfg)) throw ScenarioError("dock profile has no segments");
 
   Chassis chassis(sc.chassis, mix64(seed ^ 0x43484153ull));
@@ -281,7 +302,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   chassis.reset_odometry(Pose2{});
   Rng lidar_rng(mix64(seed ^ 0x4C494441ull));
 
-  CameraSim camera(camera_sim_params(sc), mix64(seed ^ 0x43414dull));
+  CameraSim camera(camera_sim_params(sc), mix64(seed ^ 0x43414dull), frame_camera.get());
   const Vec2 target_world = sc.dock_pose.transform(sc.camera.target_in_dock);
 
   const dockcore::DriveGeometry geom = core_drive_geometry(sc.chassis.geometry);
@@ -443,7 +464,18 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     }
 
     // 3. Camera.
-    if (sc.camera.enabled) camera.update(now_us, cs.true_pose, target_world, !occluded);
+    if (sc.camera.enabled) camera.update(now_us, cs.true_pose, target_world, !occluded, reported.odom_pose);
+    // The tag poses delivered, in frame order, through the odometry pose at each frame's capture (as dockd does).
+    dockcore::TagObservation tag_obs;
+    Pose2 tag_odom;
+    while (!host_stalled && camera.pop_tag(tag_obs, tag_odom)) {
+      if (!rendered || !sc.camera.fuse_tags) continue;
+      if (core->on_tag(tag_obs, tag_odom) == dockcore::TagStatus::kFused) {
+        ++out.tags_fused;
+      } else {
+        ++out.tags_refused;
+      }
+    }
 
     // 4. Control tick.
     if (k % kStepsPerTick == 0 && !host_stalled) {
@@ -577,6 +609,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     }
   }
   close_inplace();
+  out.camera_rendered = rendered;
+  out.camera_frames = camera.frames_delivered();
+  out.camera_detections = camera.frames_with_target();
   const ChassisState& fs = chassis.state();
   out.end_time_s = static_cast<double>(k) * dt;
   out.final_state = prev_state;

@@ -27,6 +27,22 @@ struct CameraPipelineOptions {
   int frame_timeout_ms = 100;          ///< Longest wait for a frame before the thread checks for stop.
 };
 
+/// What one frame's detections give the control tick: seed 003's camera target and, when the detector had
+/// intrinsics, the target tag's pose for the fusion.
+struct TagFrameResult {
+  CameraTarget target{};  ///< Invalid when the frame holds no target tag.
+  bool has_pose = false;
+  TagObservation tag{};  ///< Valid when has_pose.
+};
+
+/// The target tag among a frame's `count` detections (sorted strongest first, as TagDetector::detect gives them):
+/// the first with id `target_id`, or the strongest when it is −1. Its centre becomes the target (confidence =
+/// decision margin / `full_confidence_margin`, at most 1), its pose the observation, both stamped `stamp_us`.
+/// Returns the chosen detection, or nullptr (and `out` reset: target invalid, no pose) when none is the target. The
+/// one conversion dockd's pipeline and the simulator's rendered camera share. O(count).
+const TagDetection* select_target_tag(const TagDetection* detections, std::size_t count, std::int32_t target_id,
+                                      double full_confidence_margin, std::uint64_t stamp_us, TagFrameResult* out);
+
 /// Results the thread can queue before the tick collects them.
 constexpr std::size_t kCameraQueueCapacity = 8;
 
@@ -71,11 +87,7 @@ class CameraPipeline final : public hal::CameraTargetSource, public hal::TagPose
   void stop();
 
  private:
-  struct Result {
-    CameraTarget target{};
-    bool has_pose = false;
-    TagObservation tag{};
-  };
+  using Result = TagFrameResult;
   /// Moves every queued result into pending_target_ and the tag buffer. Tick side only.
   void drain();
   CameraPipeline(hal::CameraFrameSource& s, TagDetector& d, const CameraPipelineOptions& o, int efd);

@@ -1,13 +1,19 @@
 #pragma once
-// Pinhole camera simulation of seed 003's vision process: one target point on the dock (e.g. a marker above the
-// charging contacts) projected through dockcore::CameraModel, with pixel noise, frame dropouts, a frame rate and a
-// delivery latency. 2D world: only the column u is geometric; the row v is a constant.
+// Camera simulation of seed 003's vision process, at a frame rate and with a delivery latency. Two models of what
+// a frame yields:
+// - target level (the default): one target point on the dock (e.g. a marker above the charging contacts) projected
+//   through dockcore::CameraModel, with pixel noise and frame dropouts. 2D world: only the column u is geometric;
+//   the row v is a constant;
+// - rendered (a FrameCamera): an image of the dock's tag at the camera's true pose, run through a tag detector; the
+//   frame gives the detected target and the tag's pose.
 // Host-side; deterministic for a given seed (docksim::Rng only).
 #include <cstdint>
 #include <deque>
+#include <utility>
 
 #include "dockcore/controller.hpp"
 #include "dockcore/geometry.hpp"
+#include "dockcore/tag_measurement.hpp"
 #include "docksim/rng.hpp"
 
 namespace docksim {
@@ -29,25 +35,61 @@ struct CameraSimParams {
 dockcore::CameraTarget project_target(const CameraSimParams& p, const dockcore::Pose2& robot_world,
                                       const dockcore::Vec2& target_world);
 
+/// What one frame gives: seed 003's target (invalid when nothing was found) and, from a rendered camera, the
+/// target tag's pose.
+struct CameraFrameOutput {
+  dockcore::CameraTarget target{};
+  bool has_tag = false;
+  dockcore::TagObservation tag{};
+};
+
+/// A camera that sees through images: renders the frame at the camera's true pose and runs a detector on it.
+/// Implemented outside dockcore_sim (the detector is libapriltag's: tools/sim/vision). One per run: not shared
+/// between threads.
+class FrameCamera {
+ public:
+  virtual ~FrameCamera() = default;
+  /// The frame captured with the robot at `robot_world`; `dock_visible` false: the dock and its tag are hidden.
+  /// Noise comes from `rng`. Stamps are left 0 (the caller stamps the frame).
+  virtual CameraFrameOutput capture(const dockcore::Pose2& robot_world, bool dock_visible, Rng& rng) = 0;
+};
+
 /// A camera producing frames at rate_hz, delivered latency_s later.
 class CameraSim {
  public:
-  CameraSim(const CameraSimParams& p, std::uint64_t seed) : p_(p), rng_(seed) {}
+  /// `frame_camera` (optional, not owned, must outlive this): rendered frames instead of the target-level model.
+  CameraSim(const CameraSimParams& p, std::uint64_t seed, FrameCamera* frame_camera = nullptr)
+      : p_(p), rng_(seed), frame_camera_(frame_camera) {}
 
-  /// Advances to time t_us: captures a frame when one is due (from `robot_world`; `visible` false = the target is
-  /// hidden) and delivers every frame whose latency has passed. Call at least once per frame period. O(1) amortised.
-  void update(std::uint64_t t_us, const dockcore::Pose2& robot_world, const dockcore::Vec2& target_world, bool visible);
+  /// Advances to time t_us: captures a frame when one is due (from `robot_world`, with the host's odometry pose
+  /// `odom_pose` at that moment; `visible` false = the target is hidden) and delivers every frame whose latency has
+  /// passed. Call at least once per frame period. O(1) amortised (plus a render and a detection per rendered frame).
+  void update(std::uint64_t t_us, const dockcore::Pose2& robot_world, const dockcore::Vec2& target_world, bool visible,
+              const dockcore::Pose2& odom_pose = dockcore::Pose2{});
   /// The most recently delivered frame (invalid until the first one; an empty frame is delivered as invalid with
   /// its stamp).
   const dockcore::CameraTarget& latest() const { return latest_; }
+  /// The oldest delivered tag pose not yet taken, with the odometry pose at its frame's capture. False when none.
+  bool pop_tag(dockcore::TagObservation& tag, dockcore::Pose2& odom_at_stamp);
+  /// Frames delivered so far, and those that carried a valid target.
+  std::uint64_t frames_delivered() const { return frames_delivered_; }
+  std::uint64_t frames_with_target() const { return frames_with_target_; }
   const CameraSimParams& params() const { return p_; }
 
  private:
+  struct InFlight {
+    CameraFrameOutput frame;
+    dockcore::Pose2 odom;
+  };
   CameraSimParams p_;
   Rng rng_;
+  FrameCamera* frame_camera_ = nullptr;
   std::uint64_t next_capture_us_ = 0;
-  std::deque<dockcore::CameraTarget> in_flight_;
+  std::deque<InFlight> in_flight_;
+  std::deque<std::pair<dockcore::TagObservation, dockcore::Pose2>> tags_;
   dockcore::CameraTarget latest_{};
+  std::uint64_t frames_delivered_ = 0;
+  std::uint64_t frames_with_target_ = 0;
 };
 
 }  // namespace docksim

@@ -7,6 +7,7 @@
 // message starts with "<source>:<line>:<column>: " (1-based, the TOML source region of the offending key or value).
 // Host-side (tools/): heap and exceptions are fine here.
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "dockcore/geometry.hpp"
 #include "dockcore/kinematics.hpp"
 #include "dockcore/safety.hpp"
+#include "dockcore/tag_measurement.hpp"
 #include "dockcore/task_manager.hpp"
 #include "docksim/chassis.hpp"
 #include "docksim/lidar_sim.hpp"
@@ -75,6 +77,27 @@ struct CameraSpec {
   double max_depth_m = 4.0;       ///< Farther: not seen.
   double v_px = 240.0;            ///< Row reported for the target (2D world: constant).
   dockcore::Vec2 target_in_dock = dockcore::Vec2::Zero();  ///< The target point, dock frame (default: contacts).
+  // Rendered frames (render = true): each frame is a pinhole image of the dock's tag ([dock.tag]) at the camera's
+  // true pose, run through the AprilTag detector dockd uses; the target is the detected tag's centre and, with
+  // fuse_tags, the tag's pose goes into the dock filter (Dockcore::on_tag). sigma_px, dropout and the depth range
+  // then play no part: the image noise and the detector decide.
+  bool render = false;
+  bool fuse_tags = true;  ///< Rendered: tag poses fused into the dock filter.
+  double z_m = 0.2;       ///< Camera height above the floor; the camera is level.
+  std::uint32_t height_px = 480;
+  double cy_px = 239.5;   ///< Principal point row (fy = fx).
+  double blur_px = 0.8;   ///< Gaussian blur σ of the optics.
+  double noise_grey = 4;  ///< Gaussian pixel noise σ, grey levels.
+  double decimate = 2;    ///< The detector's quad_decimate.
+};
+
+/// The AprilTag on the dock ([dock.tag]), seen by a rendered camera and fused with the lidar.
+struct DockTagSpec {
+  int id = 3;
+  std::string family = "tag36h11";
+  double size_m = 0.08;  ///< Side of the tag's black square.
+  /// Height of the tag's centre above the floor; NaN: the camera's height. Its x, y are the camera target's.
+  double z_m = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Start poses are drawn uniformly from these ranges: the robot centre at `distance` from the dock origin at
@@ -151,6 +174,8 @@ struct Scenario {
   dockcore::FootprintParams safety{};  ///< Obstacle check (derived from the footprint plus check areas).
   Pose2 lidar_mount{};                 ///< Lidar in the robot frame.
   CameraSpec camera{};
+  DockTagSpec dock_tag{};
+  dockcore::TagFusionParams tag_fusion{};  ///< [camera.fusion]: the tag covariance model (the parameter table).
 
   // Lidar.
   LidarModel lidar{};

@@ -7,8 +7,10 @@
 // Host-side. Deterministic: the same scenario, controller and seed give bit-identical results (every random draw
 // comes from docksim::Rng streams derived from the seed).
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -87,6 +89,13 @@ struct SimOutcome {
   double seed_success_t_s = std::numeric_limits<double>::quiet_NaN();
   double seed_success_z_err_m = std::numeric_limits<double>::quiet_NaN();
   double seed_success_x_m = std::numeric_limits<double>::quiet_NaN();
+  bool camera_rendered = false;  ///< The camera rendered frames through the tag detector (robot.camera.render).
+  /// Camera frames delivered and those that carried the target; tag poses fused into the dock filter / refused by
+  /// it (Dockcore::on_tag; rendered camera only). All 0 without a camera.
+  std::uint64_t camera_frames = 0;
+  std::uint64_t camera_detections = 0;
+  std::uint64_t tags_fused = 0;
+  std::uint64_t tags_refused = 0;
 };
 
 struct SimRun {
@@ -105,6 +114,9 @@ struct SimOptions {
   double trajectory_period_s = 0.05;
   bool keep_last_scan = true;
   const StartPose* start = nullptr;  ///< Fixed start instead of draw_start(seed).
+  /// Makes the run's rendered camera for a scenario whose camera renders (robot.camera.render); dock-sim sets it
+  /// when it is built with the tag detector. Without it such a scenario is refused (ScenarioError).
+  std::function<std::unique_ptr<FrameCamera>(const Scenario&)> make_frame_camera;
 };
 
 /// Runs one docking of `sc` with `controller` (one of controller_names()). Throws ScenarioError for an unknown

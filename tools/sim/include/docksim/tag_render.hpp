@@ -6,6 +6,9 @@
 // has its z along the camera's z).
 #include <cstdint>
 
+#include "dockcore/geometry.hpp"
+#include "dockcore/tag_measurement.hpp"
+
 namespace docksim {
 
 /// The tag's printed pattern: `cells` × `cells` values (row-major, 0 = black, 255 = white), the outermost ring
@@ -25,10 +28,32 @@ struct PinholeView {
   std::uint32_t supersample = 3;                     ///< Samples per pixel side (anti-aliasing; 1..8).
 };
 
-/// Renders the tag into `grey` (width × height, `stride_bytes` per row), replacing every pixel. Pixels whose rays
-/// miss the tag or meet it from behind get the background. False (image untouched) for an empty pattern, a zero
-/// focal length or supersample outside 1..8. O(width · height · supersample²).
-bool render_tag(const TagPattern& tag, const PinholeView& view, std::uint8_t* grey, std::uint32_t stride_bytes);
+/// A rectangle of pixels: columns [col0, col1), rows [row0, row1).
+struct PixelRect {
+  std::uint32_t col0 = 0, row0 = 0, col1 = 0, row1 = 0;
+};
+
+/// Renders the tag into `grey` (width × height, `stride_bytes` per row), replacing every pixel (or only those in
+/// `region`, clipped to the image, when given). Pixels whose rays miss the tag or meet it from behind get the
+/// background. False (image untouched) for an empty pattern, a zero focal length or supersample outside 1..8.
+/// O(pixels rendered · supersample²).
+bool render_tag(const TagPattern& tag, const PinholeView& view, std::uint8_t* grey, std::uint32_t stride_bytes,
+                const PixelRect* region = nullptr);
+
+/// The pixels the tag's pattern covers in `view`, grown by `margin_px` and clipped to the image; false when a
+/// corner is behind the camera or the tag lies wholly outside the image. O(1).
+bool tag_pixel_bounds(const TagPattern& tag, const PinholeView& view, std::uint32_t margin_px, PixelRect& out);
+
+/// Separable Gaussian blur of σ `sigma_px` (kernel ±3σ, edges clamped) over `region` of a grey image (the whole
+/// image without one), in place; σ ≤ 0 leaves it alone. O(region pixels · σ).
+void blur_grey(std::uint8_t* grey, std::uint32_t width_px, std::uint32_t height_px, std::uint32_t stride_bytes,
+               double sigma_px, const PixelRect* region = nullptr);
+
+/// Places the dock's tag in `view` (its rotation and translation): the camera at `camera` and the dock at `dock`,
+/// both in one frame (the robot's, or the world's), the tag on the dock at `tag` — the chain
+/// dockcore::tag_to_dock_measurement inverts. O(1).
+void place_tag_in_view(PinholeView& view, const dockcore::CameraMount3& camera, const dockcore::Pose2& dock,
+                       const dockcore::DockTag& tag);
 
 /// The rotation (row-major) of a tag facing the camera, turned by `yaw_rad` about the camera's y axis (a tag on a
 /// dock seen from a robot off the dock's axis). O(1).
