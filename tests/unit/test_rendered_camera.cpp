@@ -169,7 +169,7 @@ TEST(RenderedCamera, FramesShowTheTagWhereItIsAndNothingWhenHidden) {
   for (const double x : {0.6, 1.0, 1.4}) {
     for (const double y : {-0.15, 0.1}) {
       const Pose2 robot{static_cast<Real>(x), static_cast<Real>(y), static_cast<Real>(dockcore::kPi + 0.1)};
-      const docksim::CameraFrameOutput f = cam->capture(robot, true, rng);
+      const docksim::CameraFrameOutput f = cam->capture(robot, true, nullptr, rng);
       CHECK(f.target.valid);
       CHECK(f.has_tag);
       // The centre column where the pinhole puts the tag's centre (the tag at the contacts, camera height).
@@ -185,13 +185,32 @@ TEST(RenderedCamera, FramesShowTheTagWhereItIsAndNothingWhenHidden) {
       DOUBLES_EQUAL(static_cast<double>(truth.y_m), static_cast<double>(m.dock_in_robot.y_m), 0.01);
       DOUBLES_EQUAL(static_cast<double>(truth.x_m), static_cast<double>(m.dock_in_robot.x_m), 0.03);
       // Hidden: no frame content, and the noise stream advances the same.
-      const docksim::CameraFrameOutput h = cam->capture(robot, false, hidden_rng);
+      const docksim::CameraFrameOutput h = cam->capture(robot, false, nullptr, hidden_rng);
       CHECK_FALSE(h.target.valid);
       CHECK_FALSE(h.has_tag);
       reference.uniform();
     }
   }
   DOUBLES_EQUAL(reference.uniform(), hidden_rng.uniform(), 0);
+}
+
+TEST(RenderedCamera, APoleInTheLineOfSightHidesTheTagAndOneBesideItDoesNot) {
+  docksim::Scenario sc = docksim::load_scenario_file(repo_file("tools/scenarios/default.toml"));
+  sc.camera.render = true;
+  std::string err;
+  auto cam = docksim::RenderedTagCamera::create(sc, err);
+  CHECK_TEXT(cam != nullptr, err.c_str());
+  const Pose2 robot{1.0, 0.0, static_cast<Real>(dockcore::kPi)};  // 1 m out, facing the dock at the origin
+  docksim::Rng rng(5);
+  docksim::World in_sight, beside;
+  in_sight.add_circle(dockcore::Vec2(static_cast<Real>(0.5), 0), 0.03);
+  beside.add_circle(dockcore::Vec2(static_cast<Real>(0.5), static_cast<Real>(0.3)), 0.03);
+  CHECK(cam->capture(robot, true, &beside, rng).target.valid);
+  CHECK_FALSE(cam->capture(robot, true, &in_sight, rng).target.valid);
+  // Half the tag hidden is no detection either: the detector needs the whole border.
+  docksim::World half;
+  half.add_circle(dockcore::Vec2(static_cast<Real>(0.5), static_cast<Real>(0.02)), 0.015);
+  CHECK_FALSE(cam->capture(robot, true, &half, rng).target.valid);
 }
 
 TEST(RenderedCamera, UnknownTagIsRefusedByName) {

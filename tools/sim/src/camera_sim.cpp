@@ -24,13 +24,13 @@ dockcore::CameraTarget project_target(const CameraSimParams& p, const dockcore::
 }
 
 void CameraSim::update(std::uint64_t t_us, const dockcore::Pose2& robot_world, const dockcore::Vec2& target_world,
-                       bool visible, const dockcore::Pose2& odom_pose) {
+                       bool visible, const dockcore::Pose2& odom_pose, const World* occluders) {
   const std::uint64_t period_us = static_cast<std::uint64_t>(std::llround(1e6 / p_.rate_hz));
   const std::uint64_t latency_us = static_cast<std::uint64_t>(std::llround(p_.latency_s * 1e6));
   if (t_us >= next_capture_us_) {
     InFlight f{CameraFrameOutput{}, odom_pose};
     if (frame_camera_ != nullptr) {
-      f.frame = frame_camera_->capture(robot_world, visible, rng_);
+      f.frame = frame_camera_->capture(robot_world, visible, occluders, rng_);
     } else {
       dockcore::CameraTarget& c = f.frame.target;
       c = visible ? project_target(p_, robot_world, target_world) : dockcore::CameraTarget{};

@@ -312,12 +312,14 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   const World world_with_dock = scenario_world(sc, true);
   const World world_no_dock = scenario_world(sc, false);
   Obstacles static_obs;
+  World occluders;  // what may hide the dock's tag from the camera: everything but the dock and its wall
   {
-    World o;
+    World& o = occluders;
     for (const auto& pl : sc.polylines) o.add_polyline(pl.points, pl.closed);
     for (const auto& b : sc.boxes) o.add_box(b.centre, b.size_x_m, b.size_y_m, b.yaw_rad);
     for (const auto& s : o.segments) static_obs.segments.push_back({pd(s.a), pd(s.b)});
     for (const auto& c : sc.circles) static_obs.discs.push_back({pd(c.centre), c.r_m});
+    for (const auto& c : sc.circles) o.add_circle(c.centre, c.r_m);
   }
   struct ActiveObstacle {
     Vec2 c;
@@ -464,7 +466,15 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     }
 
     // 3. Camera.
-    if (sc.camera.enabled) camera.update(now_us, cs.true_pose, target_world, !occluded, reported.odom_pose);
+    if (sc.camera.enabled) {
+      if (rendered && !active_obs.empty()) {
+        World frame_occluders = occluders;
+        for (const auto& o : active_obs) frame_occluders.add_circle(o.c, o.r);
+        camera.update(now_us, cs.true_pose, target_world, !occluded, reported.odom_pose, &frame_occluders);
+      } else {
+        camera.update(now_us, cs.true_pose, target_world, !occluded, reported.odom_pose, &occluders);
+      }
+    }
     // The tag poses delivered, in frame order, through the odometry pose at each frame's capture (as dockd does).
     dockcore::TagObservation tag_obs;
     Pose2 tag_odom;

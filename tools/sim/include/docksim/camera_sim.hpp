@@ -14,6 +14,7 @@
 #include "dockcore/controller.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/tag_measurement.hpp"
+#include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 
 namespace docksim {
@@ -50,8 +51,11 @@ class FrameCamera {
  public:
   virtual ~FrameCamera() = default;
   /// The frame captured with the robot at `robot_world`; `dock_visible` false: the dock and its tag are hidden.
+  /// `occluders` (optional): what may stand between the camera and the dock, in the world frame (not the dock or
+  /// its wall); the 2D world's objects are taken to be taller than the camera, so each hides whole image columns.
   /// Noise comes from `rng`. Stamps are left 0 (the caller stamps the frame).
-  virtual CameraFrameOutput capture(const dockcore::Pose2& robot_world, bool dock_visible, Rng& rng) = 0;
+  virtual CameraFrameOutput capture(const dockcore::Pose2& robot_world, bool dock_visible, const World* occluders,
+                                    Rng& rng) = 0;
 };
 
 /// A camera producing frames at rate_hz, delivered latency_s later.
@@ -62,10 +66,11 @@ class CameraSim {
       : p_(p), rng_(seed), frame_camera_(frame_camera) {}
 
   /// Advances to time t_us: captures a frame when one is due (from `robot_world`, with the host's odometry pose
-  /// `odom_pose` at that moment; `visible` false = the target is hidden) and delivers every frame whose latency has
-  /// passed. Call at least once per frame period. O(1) amortised (plus a render and a detection per rendered frame).
+  /// `odom_pose` at that moment; `visible` false = the target is hidden; `occluders` as FrameCamera::capture, used
+  /// by rendered frames only) and delivers every frame whose latency has passed. Call at least once per frame
+  /// period. O(1) amortised (plus a render and a detection per rendered frame).
   void update(std::uint64_t t_us, const dockcore::Pose2& robot_world, const dockcore::Vec2& target_world, bool visible,
-              const dockcore::Pose2& odom_pose = dockcore::Pose2{});
+              const dockcore::Pose2& odom_pose = dockcore::Pose2{}, const World* occluders = nullptr);
   /// The most recently delivered frame (invalid until the first one; an empty frame is delivered as invalid with
   /// its stamp).
   const dockcore::CameraTarget& latest() const { return latest_; }

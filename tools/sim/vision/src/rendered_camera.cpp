@@ -78,7 +78,8 @@ std::unique_ptr<RenderedTagCamera> RenderedTagCamera::create(const Scenario& sc,
   return c;
 }
 
-CameraFrameOutput RenderedTagCamera::capture(const dockcore::Pose2& robot_world, bool dock_visible, Rng& rng) {
+CameraFrameOutput RenderedTagCamera::capture(const dockcore::Pose2& robot_world, bool dock_visible,
+                                             const World* occluders, Rng& rng) {
   // One draw per frame whatever happens, so the run's stream does not depend on what the camera saw.
   const auto offset = static_cast<std::size_t>(rng.uniform() * static_cast<double>(image_.size()));
   CameraFrameOutput out;
@@ -91,6 +92,7 @@ CameraFrameOutput RenderedTagCamera::capture(const dockcore::Pose2& robot_world,
   if (!tag_pixel_bounds(tag_.pattern, view_, blur_margin, box)) return out;
   std::fill(image_.begin(), image_.end(), view_.background);
   render_tag(tag_.pattern, view_, image_.data(), view_.width_px, &box);
+  if (occluders != nullptr && !occluders->segments.empty()) occlude_columns(*occluders, cam2, box);
   blur_grey(image_.data(), view_.width_px, view_.height_px, view_.width_px, blur_px_, &box);
   const std::int8_t* noise = noise_.data() + offset;
   for (std::size_t i = 0; i < image_.size(); ++i) {
@@ -106,6 +108,28 @@ CameraFrameOutput RenderedTagCamera::capture(const dockcore::Pose2& robot_world,
   out.has_tag = r.has_pose;
   out.tag = r.tag;
   return out;
+}
+
+void RenderedTagCamera::occlude_columns(const World& occluders, const dockcore::Pose2& camera_world,
+                                        const PixelRect& box) {
+  // The tag's plane in the world, seen from above: through the tag's centre, normal along the dock's x axis.
+  const dockcore::Vec2 tag = dock_world_.transform(dockcore::Vec2(dock_tag_.x_m, dock_tag_.y_m));
+  const dockcore::Vec2 normal(std::cos(dock_world_.yaw_rad), std::sin(dock_world_.yaw_rad));
+  const dockcore::Vec2 origin(camera_world.x_m, camera_world.y_m);
+  for (std::uint32_t c = box.col0; c < box.col1; ++c) {
+    // The column's ray in the camera body frame (x forward, y left), then in the world.
+    const double left = -(c - view_.cx_px) / view_.fx_px;
+    const dockcore::Vec2 body(static_cast<Real>(1 / std::hypot(1.0, left)),
+                              static_cast<Real>(left / std::hypot(1.0, left)));
+    const dockcore::Vec2 dir = dockcore::Pose2{0, 0, camera_world.yaw_rad}.transform(body);
+    const double along = static_cast<double>(normal.dot(dir));
+    if (std::fabs(along) < 1e-6) continue;
+    const double to_tag = static_cast<double>(normal.dot(tag - origin)) / along;
+    double range = 0;
+    if (to_tag > 0 && occluders.raycast(origin, dir, to_tag, &range)) {
+      for (std::uint32_t r = box.row0; r < box.row1; ++r) image_[static_cast<std::size_t>(r) * view_.width_px + c] = 60;
+    }
+  }
 }
 
 }  // namespace docksim
