@@ -213,6 +213,25 @@ TEST(RenderedCamera, APoleInTheLineOfSightHidesTheTagAndOneBesideItDoesNot) {
   CHECK_FALSE(cam->capture(robot, true, &half, rng).target.valid);
 }
 
+TEST(RenderedCamera, ExposureDecidesWhetherTheTagCanBeRead) {
+  docksim::Scenario sc = docksim::load_scenario_file(repo_file("tools/scenarios/default.toml"));
+  sc.camera.render = true;
+  const Pose2 robot{1.0, 0.0, static_cast<Real>(dockcore::kPi)};
+  auto detected = [&](double exposure) {
+    sc.camera.exposure = exposure;
+    std::string err;
+    auto cam = docksim::RenderedTagCamera::create(sc, err);
+    docksim::Rng rng(5);
+    return cam->capture(robot, true, nullptr, rng).target.valid;
+  };
+  CHECK(detected(1.0));
+  CHECK(detected(0.5));
+  // Over-exposed, the white ring merges with the saturated wall, but the black border still stands out: read.
+  CHECK(detected(4.0));
+  // So dark that the tag's contrast is within the sensor noise: lost.
+  CHECK_FALSE(detected(0.06));
+}
+
 TEST(RenderedCamera, UnknownTagIsRefusedByName) {
   docksim::Scenario sc = docksim::load_scenario_file(repo_file("tools/scenarios/default.toml"));
   sc.dock_tag.family = "tag99h99";

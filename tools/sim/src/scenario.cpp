@@ -253,6 +253,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
           {"cy_px", p.num(&cam.cy_px, 0, 8192)},
           {"blur_px", p.num(&cam.blur_px, 0, 5)},
           {"noise_grey", p.num(&cam.noise_grey, 0, 64)},
+          {"exposure", p.num(&cam.exposure, 0.05, 8)},
           {"decimate", p.num(&cam.decimate, 1, 8)},
       };
     }));

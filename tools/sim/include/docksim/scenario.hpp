@@ -88,6 +88,7 @@ struct CameraSpec {
   double cy_px = 239.5;   ///< Principal point row (fy = fx).
   double blur_px = 0.8;   ///< Gaussian blur σ of the optics.
   double noise_grey = 4;  ///< Gaussian pixel noise σ, grey levels.
+  double exposure = 1;    ///< Gain on the scene's grey levels before the noise (saturates at white).
   double decimate = 2;    ///< The detector's quad_decimate.
 };
 

@@ -55,6 +55,7 @@ std::unique_ptr<RenderedTagCamera> RenderedTagCamera::create(const Scenario& sc,
   c->dock_tag_.y_m = cam.target_in_dock.y();
   c->dock_tag_.z_m = static_cast<Real>(std::isnan(sc.dock_tag.z_m) ? cam.z_m : sc.dock_tag.z_m);
   c->blur_px_ = cam.blur_px;
+  c->exposure_q8_ = static_cast<int>(std::lround(cam.exposure * 256));
   c->tag_id_ = sc.dock_tag.id;
 
   dockcore::drivers::TagDetectorOptions o;
@@ -95,8 +96,11 @@ CameraFrameOutput RenderedTagCamera::capture(const dockcore::Pose2& robot_world,
   if (occluders != nullptr && !occluders->segments.empty()) occlude_columns(*occluders, cam2, box);
   blur_grey(image_.data(), view_.width_px, view_.height_px, view_.width_px, blur_px_, &box);
   const std::int8_t* noise = noise_.data() + offset;
+  // Exposure scales the light that reaches the sensor (saturating at white), then the sensor adds its noise.
+  const int gain_q8 = exposure_q8_;
   for (std::size_t i = 0; i < image_.size(); ++i) {
-    image_[i] = static_cast<std::uint8_t>(std::clamp(image_[i] + noise[i], 0, 255));
+    const int exposed = std::min(255, (image_[i] * gain_q8 + 128) >> 8);
+    image_[i] = static_cast<std::uint8_t>(std::clamp(exposed + noise[i], 0, 255));
   }
   dockcore::drivers::TagDetection dets[4];
   const std::size_t n = detector_->detect(image_.data(), view_.width_px, view_.height_px, view_.width_px, dets, 4);

@@ -32,9 +32,9 @@ class RenderedTagCamera final : public FrameCamera {
   static std::unique_ptr<RenderedTagCamera> create(const Scenario& sc, std::string& error);
 
   /// Renders the frame (background grey 128; only the tag's pixels are drawn and blurred), paints the image columns
-  /// in which an occluder stands between the camera and the tag's plane dark grey (60), adds the noise, detects.
-  /// A hidden dock, or a tag behind the camera or wholly outside the image, gives an empty frame without a
-  /// detection run. Cost: the tag's pixels × 9 samples, a ray per tag column, plus one detection (≈ 2 ms at
+  /// in which an occluder stands between the camera and the tag's plane dark grey (60), scales by the exposure, adds
+  /// the noise, detects. A hidden dock, or a tag behind the camera or wholly outside the image, gives an empty frame
+  /// without a detection run. Cost: the tag's pixels × 9 samples, a ray per tag column, plus one detection (≈ 2 ms at
   /// 640×480, decimate 2).
   CameraFrameOutput capture(const dockcore::Pose2& robot_world, bool dock_visible, const World* occluders,
                             Rng& rng) override;
@@ -50,6 +50,7 @@ class RenderedTagCamera final : public FrameCamera {
   dockcore::Pose2 dock_world_{};
   dockcore::DockTag dock_tag_{};
   double blur_px_ = 0;
+  int exposure_q8_ = 256;  ///< Exposure gain in 1/256.
   std::int32_t tag_id_ = 0;
   std::unique_ptr<dockcore::drivers::TagDetector> detector_;
   std::vector<std::uint8_t> image_;
