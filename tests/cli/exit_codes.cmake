@@ -81,4 +81,13 @@ math(EXPR sum "${lx_mm} + ${rx_mm}")
 if(sum LESS 99 OR sum GREATER 101)
   message(FATAL_ERROR "mount: lidar-frame x ${lx} and robot-frame x ${rx} should add up to 0.100")
 endif()
+# The rendered camera: asked of a scenario without a camera, with a tag family libapriltag lacks, or of soak: exit 2
+# naming the key (a dock-sim without libapriltag names that instead).
+set(scenarios "${DIR}/../../tools/scenarios")
+expect_run(2 "--camera-render: the scenario has no camera" run "${scenarios}/pushed.toml" --camera-render)
+file(WRITE "${WORK}/bad_tag.toml" "[robot.camera]\nenabled = true\nrender = true\n[dock.tag]\nfamily = \"tag99h99\"\n")
+expect_run(2 "bad_tag.toml: (dock.tag: .*tag99h99|.*libapriltag)" run "${WORK}/bad_tag.toml")
+expect_run(2 "bad_tag.toml: (dock.tag: .*tag99h99|.*libapriltag)" montecarlo "${WORK}/bad_tag.toml" --trials 1)
+file(WRITE "${WORK}/rendered.toml" "[robot.camera]\nenabled = true\nrender = true\n")
+expect_run(2 "renders camera frames" soak "${WORK}/rendered.toml" --cycles 1)
 message(STATUS "exit codes and messages as documented")
