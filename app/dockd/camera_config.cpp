@@ -31,7 +31,8 @@ void add_camera_device_keys(const ConfigReader& reader, Handlers& h, CameraDevic
                     {"buffers", p.integ(&k.buffers, 2, dockcore::drivers::kMaxV4l2Buffers)},
                     {"late_ms", p.integ(&k.late_ms, 1, 10000)},
                     {"reconnect_min_ms", p.integ(&k.reconnect_min_ms, 10, 60000)},
-                    {"reconnect_max_ms", p.integ(&k.reconnect_max_ms, 10, 600000)}});
+                    {"reconnect_max_ms", p.integ(&k.reconnect_max_ms, 10, 600000)},
+                    {"stall_ms", p.integ(&c.stall_ms, 50, 10000)}});
   });
   h.emplace_back("intrinsics", [pr, pc](const toml::node& n) {
     const ConfigReader& p = *pr;
@@ -135,6 +136,12 @@ void finish_camera_device(const ConfigReader& p, const toml::source_region& root
   if (cap.format == dockcore::drivers::CameraPixelFormat::kYuyv && cap.width_px % 2 != 0) {
     p.fail(at("camera.device.width_px"), "camera.device.width_px must be even for format = \"yuyv\"");
   }
+  // A stall is a missing frame, not a slow one: the window must hold at least two frame periods.
+  if (cap.fps > 0 && static_cast<std::uint64_t>(d.stall_ms) * cap.fps < 2000u) {
+    s << "camera.device.stall_ms = " << d.stall_ms << " is shorter than two frame periods at fps = " << cap.fps
+      << " (at least " << (2000u + cap.fps - 1u) / cap.fps << ")";
+    p.fail(at("camera.device.stall_ms"), s.str());
+  }
   if (cap.reconnect_max_ms < cap.reconnect_min_ms) {
     p.fail(at("camera.device.reconnect_max_ms"), "camera.device.reconnect_max_ms must be >= reconnect_min_ms");
   }
@@ -180,7 +187,8 @@ void camera_device_restart_changes(const CameraDeviceConfig& a, const CameraDevi
   check(a.enabled == b.enabled, "camera.device");
   check(ca.device == cb.device && ca.format == cb.format && ca.width_px == cb.width_px &&
             ca.height_px == cb.height_px && ca.fps == cb.fps && ca.buffers == cb.buffers && ca.late_ms == cb.late_ms &&
-            ca.reconnect_min_ms == cb.reconnect_min_ms && ca.reconnect_max_ms == cb.reconnect_max_ms,
+            ca.reconnect_min_ms == cb.reconnect_min_ms && ca.reconnect_max_ms == cb.reconnect_max_ms &&
+            a.stall_ms == b.stall_ms,
         "camera.device.*");
   const auto& ka = a.tag.intrinsics;
   const auto& kb = b.tag.intrinsics;

@@ -71,6 +71,7 @@ void CameraPipeline::run() {
       stats_.connected = source_.connected();
       continue;
     }
+    last_frame_us_.store(mono_us(), std::memory_order_relaxed);
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t n = detector_.detect(f.grey, f.width_px, f.height_px, f.stride_bytes, dets, kMaxTagDetections);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -85,7 +86,8 @@ void CameraPipeline::run() {
       r.target.valid = true;
       r.target.u_px = static_cast<Real>(tag->u_px);
       r.target.v_px = static_cast<Real>(tag->v_px);
-      r.target.confidence = static_cast<Real>(std::min(1.0, std::max(0.0, tag->decision_margin / opt_.full_confidence_margin)));
+      r.target.confidence =
+          static_cast<Real>(std::min(1.0, std::max(0.0, tag->decision_margin / opt_.full_confidence_margin)));
       r.target.stamp_us = f.stamp_us;
       if (tag->has_pose) {
         r.has_pose = true;

@@ -50,6 +50,7 @@ TEST(DockdCameraConfig, ValuesArrive) {
         dockcore::drivers::CameraPixelFormat::kMjpeg);
   CHECK_EQUAL(640u, d.capture.width_px);
   CHECK_EQUAL(30u, d.capture.fps);
+  CHECK_EQUAL(200u, d.stall_ms);  // default
   DOUBLES_EQUAL(610.5, d.tag.intrinsics.fx_px, 0);
   DOUBLES_EQUAL(241, d.tag.intrinsics.cy_px, 0);
   DOUBLES_EQUAL(-0.1, d.tag.intrinsics.k1, 0);
@@ -110,6 +111,15 @@ TEST(DockdCameraConfig, BadValuesAreNamed) {
                   error_of("[camera.tag]\nfamily = \"tag37h11\"\n").c_str());
   STRCMP_CONTAINS("camera.device.format = \"mjpg\" is not one of grey, yuyv, mjpeg",
                   error_of("[camera.device]\nformat = \"mjpg\"\n").c_str());
+  STRCMP_CONTAINS("camera.device.stall_ms = 20 is out of range", error_of("[camera.device]\nstall_ms = 20\n").c_str());
+  // At 10 frames/s a 150 ms window would call every frame gap a stall.
+  std::string slow = kCamera;
+  slow.replace(slow.find("fps = 30"), 8, "fps = 10\nstall_ms = 150");
+  STRCMP_CONTAINS("camera.device.stall_ms = 150 is shorter than two frame periods at fps = 10 (at least 200)",
+                  error_of(slow).c_str());
+  slow.replace(slow.find("stall_ms = 150"), 14, "stall_ms = 200");
+  STRCMP_EQUAL("", error_of(slow).c_str());
+  CHECK_EQUAL(200u, dockd::parse_config_toml(slow, "t.toml").camera_device.stall_ms);
   STRCMP_CONTAINS("unknown key 'camera.intrinsics.f_px'", error_of("[camera.intrinsics]\nf_px = 1\n").c_str());
   STRCMP_CONTAINS("camera.intrinsics.fx_px = 0 is out of range", error_of("[camera.intrinsics]\nfx_px = 0\n").c_str());
   // Intrinsics without a device would do nothing: refused.
@@ -126,6 +136,12 @@ TEST(DockdCameraConfig, EveryCameraKeyIsRestartOnly) {
   CHECK_EQUAL(2u, changed.size());
   STRCMP_EQUAL("camera.device.*", changed[0].c_str());
   STRCMP_EQUAL("camera.tag.*", changed[1].c_str());
+  std::string stall = kCamera;
+  stall.replace(stall.find("fps = 30"), 8, "fps = 30\nstall_ms = 300");
+  const std::vector<std::string> stall_changed =
+      dockd::restart_only_changes(a, dockd::parse_config_toml(stall, "t.toml"));
+  CHECK_EQUAL(1u, stall_changed.size());
+  STRCMP_EQUAL("camera.device.*", stall_changed[0].c_str());
 }
 
 TEST(DockdCameraConfig, TagFusionKeysArrive) {

@@ -4,7 +4,8 @@
 ///    vision process (the UDP datagram of docs/dockd.md) or from dockd's own detector (docs/camera.md);
 ///  - TagPoseSource: the dock tag's pose per frame (DockcoreBase::on_tag's input), from dockd's own detector;
 ///  - CameraFrameSource: raw grey frames from a capture device (a V4L2 camera), stamped by the driver, for a
-///    detector that runs on the robot's board.
+///    detector that runs on the robot's board;
+///  - CameraFrameMonitor: when such a source last delivered a frame (the stall watchdog).
 
 #include <cstddef>
 #include <cstdint>
@@ -35,6 +36,17 @@ class TagPoseSource {
   ~TagPoseSource() = default;
 };
 
+/// When the camera last delivered a frame, for a watchdog on the control tick (dockd's camera stall, docs/camera.md).
+class CameraFrameMonitor {
+ public:
+  /// CLOCK_MONOTONIC µs at which the newest frame arrived from the device (whether or not it held a tag); 0 before
+  /// the first. Never blocks. O(1).
+  virtual std::uint64_t last_frame_us() const = 0;
+
+ protected:
+  ~CameraFrameMonitor() = default;
+};
+
 /// One captured frame as 8-bit grey, row-major. The pixels belong to the source and stay valid until the next
 /// next_frame() call on it.
 struct CameraFrame {
@@ -42,8 +54,8 @@ struct CameraFrame {
   std::uint32_t width_px = 0;
   std::uint32_t height_px = 0;
   std::uint32_t stride_bytes = 0;
-  std::uint64_t stamp_us = 0;   ///< Capture time on CLOCK_MONOTONIC, µs (the driver's stamp, not the read time).
-  std::uint32_t sequence = 0;   ///< The device's frame counter (gaps are dropped frames).
+  std::uint64_t stamp_us = 0;  ///< Capture time on CLOCK_MONOTONIC, µs (the driver's stamp, not the read time).
+  std::uint32_t sequence = 0;  ///< The device's frame counter (gaps are dropped frames).
 };
 
 /// Counters of a frame source since it was created (never reset, so a reader can take differences).
