@@ -14,7 +14,7 @@
 #include "dockcore/drivers/v4l2_camera.hpp"
 
 #if DOCKCORE_HAVE_JPEG
-#include <jpeglib.h>
+#include "jpeg_encode.hpp"
 #endif
 
 #include <CppUTest/TestHarness.h>
@@ -168,30 +168,7 @@ std::vector<double> luma(const std::vector<std::uint8_t>& px, int components) {
 /// Encodes with libjpeg (grey, or RGB stored as YCbCr 4:2:0) at quality 95.
 std::vector<std::uint8_t> encode(const std::vector<std::uint8_t>& px, int components, std::uint32_t w = kW,
                                  std::uint32_t h = kH) {
-  jpeg_compress_struct c{};
-  jpeg_error_mgr err{};
-  c.err = jpeg_std_error(&err);
-  jpeg_create_compress(&c);
-  unsigned char* buf = nullptr;
-  unsigned long len = 0;
-  jpeg_mem_dest(&c, &buf, &len);
-  c.image_width = w;
-  c.image_height = h;
-  c.input_components = components;
-  c.in_color_space = components == 1 ? JCS_GRAYSCALE : JCS_RGB;
-  jpeg_set_defaults(&c);
-  jpeg_set_quality(&c, 95, TRUE);
-  jpeg_start_compress(&c, TRUE);
-  while (c.next_scanline < h) {
-    JSAMPROW row = const_cast<JSAMPROW>(px.data() + static_cast<std::size_t>(c.next_scanline) * w *
-                                                        static_cast<std::size_t>(components));
-    jpeg_write_scanlines(&c, &row, 1);
-  }
-  jpeg_finish_compress(&c);
-  jpeg_destroy_compress(&c);
-  std::vector<std::uint8_t> out(buf, buf + len);
-  std::free(buf);
-  return out;
+  return camera_test::encode_jpeg(px, components, w, h);
 }
 
 /// The same stream without its DHT segments, as UVC cameras send MJPEG (the decoder must use the standard tables).

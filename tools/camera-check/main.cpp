@@ -4,9 +4,11 @@
 //   camera-check detect --image photo.jpg --fx 600 ...               tags in one image, with pose
 //   camera-check bench --image photo.jpg --frames 200                detection time per 640×480 grey frame
 //   camera-check tag-pose --frames 300 --distance 1.0                 dock pose from a tag on rendered frames
+//   camera-check calib --distance 1.0 --fx 610 ... --image a.jpg      a calibration against a tag at a known distance
 // Output is JSON, one object per line. Exit status: 0 ok, 1 the check failed (capture: no frame, stamps not
-// increasing, --expect-reconnect without a loss and reopen; detect: no tag), 2 usage or option error, 3 the device
-// could not be used (refused, or no frame for --give-up-seconds).
+// increasing, --expect-reconnect without a loss and reopen; detect: no tag; calib: off by more than the tolerance),
+// 2 usage or option error, 3 the device could not be used (refused, or no frame for --give-up-seconds), 4 calib: no
+// frame held the tag.
 #include <fcntl.h>
 #include <linux/videodev2.h>
 #include <sys/ioctl.h>
@@ -23,6 +25,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "calib.hpp"
 #include "dockcore/drivers/apriltag_detector.hpp"
 #include "dockcore/drivers/jpeg_grey.hpp"
 #include "dockcore/drivers/v4l2_camera.hpp"
@@ -228,6 +231,31 @@ int main(int argc, char** argv) {
   tagpose->add_option("--focal", tp_fx, "focal length of the rendered 640×480 camera, px")->capture_default_str();
   tagpose->add_option("--seed", tp.seed)->capture_default_str();
 
+  camera_check::CalibOptions calib_opt;
+  std::vector<std::string> calib_images;
+  V4l2CameraOptions calib_cam;
+  std::string calib_format = "grey";
+  auto* calib = app.add_subcommand(
+      "calib", "check a calibration: a tag at a measured distance in a few frames (device or JPEG images)");
+  calib->add_option("--distance", calib_opt.distance_m, "lens to tag along the optical axis, m (measured)")->required();
+  calib->add_option("--lateral", calib_opt.lateral_m, "tag centre right of the optical axis, m (measured)")
+      ->capture_default_str();
+  calib->add_option("--frames", calib_opt.frames, "device: frames with the tag to average")->capture_default_str();
+  calib->add_option("--tag-id", calib_opt.tag_id, "the tag to use (-1: the strongest)")->capture_default_str();
+  calib->add_option("--tolerance", calib_opt.tolerance, "ok within this fraction of the distance")
+      ->capture_default_str();
+  calib->add_option("--image", calib_images, "JPEG frame (repeatable) instead of a device");
+  calib->add_option("--device", calib_cam.device, "V4L2 device")->capture_default_str();
+  calib->add_option("--format", calib_format, "grey | yuyv | mjpeg")
+      ->check(CLI::IsMember({"grey", "yuyv", "mjpeg"}))
+      ->capture_default_str();
+  calib->add_option("--width", calib_cam.width_px, "px")->capture_default_str();
+  calib->add_option("--height", calib_cam.height_px, "px")->capture_default_str();
+  calib->add_option("--give-up-seconds", calib_opt.give_up_s, "device: stop after this long without the tag")
+      ->capture_default_str();
+  add_detector_options(calib, nullptr);
+  add_intrinsics(calib);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -249,6 +277,21 @@ int main(int argc, char** argv) {
     k.k3 = d[4];
     det_opt.intrinsics = k;
   };
+  if (calib->parsed()) {
+    if (!calib_images.empty()) {
+      // The principal point defaults to the centre of the first image.
+      GreyImage first;
+      if (!read_jpeg_grey(calib_images.front(), first, err)) {
+        std::fprintf(stderr, "camera-check calib: %s\n", err.c_str());
+        return camera_check::kCalibUsage;
+      }
+      set_intrinsics(first.width_px, first.height_px);
+      return camera_check::run_calib_images(calib_images, calib_opt, det_opt);
+    }
+    calib_cam.format = *parse_camera_pixel_format(calib_format);
+    set_intrinsics(calib_cam.width_px, calib_cam.height_px);
+    return camera_check::run_calib_device(calib_cam, calib_opt, det_opt);
+  }
   if (cap->parsed()) {
     cam_opt.format = *parse_camera_pixel_format(format);
     std::unique_ptr<TagDetector> live;
