@@ -265,6 +265,9 @@ class V4l2CameraImpl final : public V4l2Camera {
         continue;
       }
       if (!ok) {
+        // Counted; the reason stays readable (camera-check prints it) until the next failure.
+        std::snprintf(error_, sizeof error_, "camera %s: frame %u skipped (corrupt): %s", opt_.device.c_str(),
+                      b.sequence, conv_.error());
         if (mono_us() >= deadline) return hal::CameraFrameStatus::kTimeout;
         continue;
       }

@@ -60,10 +60,11 @@ struct CameraFrame {
 
 /// Counters of a frame source since it was created (never reset, so a reader can take differences).
 struct CameraFrameCounters {
-  std::uint64_t frames = 0;       ///< Frames handed out by next_frame().
-  std::uint64_t dropped = 0;      ///< Frames the device numbered but never delivered (sequence gaps).
-  std::uint64_t late = 0;         ///< Frames older than the source's late threshold when dequeued (a backlog).
-  std::uint64_t corrupt = 0;      ///< Frames skipped: fewer bytes than the format needs, or flagged as errored.
+  std::uint64_t frames = 0;   ///< Frames handed out by next_frame().
+  std::uint64_t dropped = 0;  ///< Frames the device numbered but never delivered (sequence gaps).
+  std::uint64_t late = 0;     ///< Frames older than the source's late threshold when dequeued (a backlog).
+  std::uint64_t corrupt =
+      0;  ///< Frames skipped: flagged as errored, fewer bytes than the format needs, or undecodable.
   std::uint32_t disconnects = 0;  ///< Times the device went away (open failures not counted).
   std::uint32_t reconnects = 0;   ///< Times it was opened again after a disconnect.
 };
