@@ -1055,9 +1055,9 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
   }
   // The stall watchdog's fields, likewise.
   if (io_.camera_frames != nullptr) {
-    char extra[80];
-    const int k = std::snprintf(extra, sizeof extra, ",\"camera_stalled\":%s,\"camera_stalls\":%u}",
-                                camera_stalled_ ? "true" : "false", counters_.camera_stalls);
+    // The flag only, as for the lidar: the count is in the watchdog event (the status has no room to spare).
+    char extra[32];
+    const int k = std::snprintf(extra, sizeof extra, ",\"camera_stalled\":%s}", camera_stalled_ ? "true" : "false");
     append_if_fits(buf, size, len, extra, k, sizeof extra);
   }
   // The own camera's fields go before the closing brace when they fit; otherwise the status goes without them.

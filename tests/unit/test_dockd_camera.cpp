@@ -201,7 +201,7 @@ TEST(DockdCamera, AStalledCameraIsReportedAfterStallMsAndClearedWhenFramesResume
     CHECK_FALSE(r.daemon->camera_stalled());
   }
   r.daemon->status_json(st, sizeof st, r.clock.t);
-  STRCMP_CONTAINS(",\"camera_stalled\":false,\"camera_stalls\":0", st);
+  STRCMP_CONTAINS(",\"camera_stalled\":false}", st);
   // The frames stop: reported on the first tick more than stall_ms after the last one, and not before.
   const std::uint64_t last = r.frames.last;
   while (!r.daemon->camera_stalled()) {
@@ -211,7 +211,7 @@ TEST(DockdCamera, AStalledCameraIsReportedAfterStallMsAndClearedWhenFramesResume
   }
   CHECK_EQUAL(1u, r.daemon->counters().camera_stalls);
   r.daemon->status_json(st, sizeof st, r.clock.t);
-  STRCMP_CONTAINS(",\"camera_stalled\":true,\"camera_stalls\":1", st);
+  STRCMP_CONTAINS(",\"camera_stalled\":true}", st);
   // Still stalled a while later: one stall, counted once.
   for (int i = 0; i < 20; ++i) tick();
   CHECK_TRUE(r.daemon->camera_stalled());
@@ -248,9 +248,8 @@ TEST(DockdCamera, ACameraThatNeverDeliversStallsFromStartAndNoWatchdogWithoutOne
 
 TEST(DockdCamera, TheStallFlagComesBeforeTheCameraCountersInAFullStatus) {
   // The own camera's fields as main.cpp writes them after a week at 30 frames/s (18 million frames, a million of
-  // them dropped, late or corrupt), a week after boot. The status with the tag fusion's and the stall watchdog's
-  // fields is about 1.26 kB of its 1400 bytes: the stall flag is there, the camera's counters (about 180 bytes) are
-  // what is left out.
+  // them dropped, late or corrupt), a week after boot. With the tag fusion's fields and the stall flag the status is
+  // about 1.24 kB of its 1400 bytes: the capture counters (about 170 bytes) are what is left out, the flag stays.
   const std::string camera_fields =
       ",\"camera_connected\":false,\"camera_frames\":18144000,\"camera_dropped\":1000000,\"camera_late\":"
       "1000000,\"camera_corrupt\":1000000,\"camera_reconnects\":99999,\"camera_tag_id\":587";
@@ -264,7 +263,7 @@ TEST(DockdCamera, TheStallFlagComesBeforeTheCameraCountersInAFullStatus) {
   CHECK(len > 0);
   CHECK_EQUAL('}', st[len - 1]);
   STRCMP_CONTAINS(",\"tag_fused\":", st);
-  STRCMP_CONTAINS(",\"camera_stalled\":true,\"camera_stalls\":1", st);
+  STRCMP_CONTAINS(",\"camera_stalled\":true", st);
   std::printf("\nstatus: %zu bytes with the stall flag, %zu more for the camera counters, limit %zu\n", len,
               camera_fields.size(), sizeof st - 1);
 }
