@@ -2,7 +2,7 @@
 # Smoke test of camera-check without a camera: the benchmark on its drawn frame finds its four tags, detect on a real
 # photo of the realdata folder (skipped without it) prints its tags with poses, an unknown family is refused (exit 2,
 # naming it), capture from an absent device gives up with exit 3 naming the device and the call, and calib without a
-# distance or on a missing image is a usage error (exit 2).
+# distance or a tag size, or on a missing image, is a usage error (exit 2).
 # Usage: camera_check_smoke.sh <camera-check> <realdata dir> ($DOCKCORE_REALDATA wins when set).
 set -euo pipefail
 cc="$1"
@@ -32,4 +32,8 @@ set +e
 err="$("$cc" calib --distance 1 --image /nonexistent/a.jpg --fx 600 --tag-size 0.1 2>&1)"; rc=$?
 set -e
 [ $rc -eq 2 ] && grep -q '/nonexistent/a.jpg: cannot open' <<<"$err" || { echo "calib on a missing image: rc $rc, $err" >&2; exit 1; }
+set +e
+err="$("$cc" calib --distance 1 --image /nonexistent/a.jpg --fx 600 2>&1)"; rc=$?
+set -e
+[ $rc -eq 2 ] && grep -q -- '--tag-size .* is required' <<<"$err" || { echo "calib without --tag-size: rc $rc, $err" >&2; exit 1; }
 echo "camera-check smoke: ok"

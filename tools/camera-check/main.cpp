@@ -278,6 +278,11 @@ int main(int argc, char** argv) {
     det_opt.intrinsics = k;
   };
   if (calib->parsed()) {
+    // A default tag size would silently scale every distance: the size of the tag in front of the camera is required.
+    if (calib->get_option("--tag-size")->count() == 0) {
+      std::fprintf(stderr, "camera-check calib: --tag-size (the black square's side, camera.tag.size_m) is required\n");
+      return camera_check::kCalibUsage;
+    }
     if (!calib_images.empty()) {
       // The principal point defaults to the centre of the first image.
       GreyImage first;
