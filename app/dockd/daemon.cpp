@@ -612,7 +612,9 @@ void Daemon::camera_watchdog(std::uint64_t now_us) {
   char f[160];
   std::snprintf(f, sizeof f, "\"which\":\"camera\",\"stale\":%s,\"last_frame_age_ms\":%lld,\"camera_stalls\":%u",
                 stalled ? "true" : "false",
-                last == 0 || last > now_us ? -1LL : static_cast<long long>((now_us - last) / 1000u),
+                last == 0       ? -1LL
+                : last > now_us ? 0LL
+                                : static_cast<long long>((now_us - last) / 1000u),
                 counters_.camera_stalls);
   log_event(now_us, "watchdog", f, stalled ? LogLevel::kWarn : LogLevel::kInfo);
   camera_stalled_ = stalled;

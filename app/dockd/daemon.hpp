@@ -80,7 +80,7 @@ struct DaemonCounters {
   std::uint32_t detections = 0;
   std::uint32_t lidar_stale_trips = 0;
   std::uint32_t chassis_stale_trips = 0;
-  std::uint32_t camera_stalls = 0;  ///< Times the own camera went camera_stall_ms without a frame.
+  std::uint32_t camera_stalls = 0;  ///< Times the own camera went [camera.device] stall_ms without a frame.
   std::uint32_t resumes = 0;
   std::uint32_t wheel_send_failures = 0;
   std::uint32_t status_sent = 0;
