@@ -5,6 +5,7 @@
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
+#include <new>
 
 // jpeglib.h needs FILE and size_t declared before it.
 #include <jpeglib.h>
@@ -46,6 +47,8 @@ JpegGreyDecoder::JpegGreyDecoder() : s_(std::make_unique<jpeg_detail::DecoderSta
   s_->mgr.error_exit = on_error;
   s_->mgr.emit_message = on_message;
   s_->cinfo.client_data = s_.get();
+  // libjpeg's only failure here is running out of memory (its error handler jumps back): start-up code, so thrown.
+  if (setjmp(s_->jump) != 0) throw std::bad_alloc();
   jpeg_create_decompress(&s_->cinfo);
 }
 

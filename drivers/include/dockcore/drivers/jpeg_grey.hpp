@@ -33,6 +33,7 @@ struct DecoderState;  ///< libjpeg's structs (jpeglib.h stays out of this header
 /// decode, so decode on a thread that may allocate). Not thread-safe: one decoder per thread.
 class JpegGreyDecoder {
  public:
+  /// Creates libjpeg's decompressor; std::bad_alloc when it cannot allocate.
   JpegGreyDecoder();
   ~JpegGreyDecoder();
   JpegGreyDecoder(const JpegGreyDecoder&) = delete;
