@@ -21,8 +21,9 @@ void add_camera_device_keys(const ConfigReader& reader, Handlers& h, CameraDevic
     auto& k = c.capture;
     p.each(p.table(n), "camera.device.",
            Handlers{{"path", p.str(&k.device)},
-                    {"format", [&p, &k](const toml::node& v) {
-                       k.format = *dockcore::drivers::parse_camera_pixel_format(p.choice(v, {"grey", "yuyv"}));
+                    {"format",
+                     [&p, &k](const toml::node& v) {
+                       k.format = *dockcore::drivers::parse_camera_pixel_format(p.choice(v, {"grey", "yuyv", "mjpeg"}));
                      }},
                     {"width_px", p.integ(&k.width_px, 16, dockcore::drivers::kMaxCameraSidePx)},
                     {"height_px", p.integ(&k.height_px, 16, dockcore::drivers::kMaxCameraSidePx)},
@@ -30,7 +31,8 @@ void add_camera_device_keys(const ConfigReader& reader, Handlers& h, CameraDevic
                     {"buffers", p.integ(&k.buffers, 2, dockcore::drivers::kMaxV4l2Buffers)},
                     {"late_ms", p.integ(&k.late_ms, 1, 10000)},
                     {"reconnect_min_ms", p.integ(&k.reconnect_min_ms, 10, 60000)},
-                    {"reconnect_max_ms", p.integ(&k.reconnect_max_ms, 10, 600000)}});
+                    {"reconnect_max_ms", p.integ(&k.reconnect_max_ms, 10, 600000)},
+                    {"stall_ms", p.integ(&c.stall_ms, 50, 10000)}});
   });
   h.emplace_back("intrinsics", [pr, pc](const toml::node& n) {
     const ConfigReader& p = *pr;
@@ -73,7 +75,8 @@ void add_camera_device_keys(const ConfigReader& reader, Handlers& h, CameraDevic
     CameraDeviceConfig& c = *pc;
     auto& t = c.tag;
     p.each(p.table(n), "camera.tag.",
-           Handlers{{"family", [&p, &t](const toml::node& v) {
+           Handlers{{"family",
+                     [&p, &t](const toml::node& v) {
                        t.family = p.string(v);
                        if (!dockcore::drivers::is_tag_family(t.family)) {
                          std::string names;
@@ -116,11 +119,13 @@ void finish_camera_device(const ConfigReader& p, const toml::source_region& root
   const auto& cap = d.capture;
   std::ostringstream s;
   if (k.cx_px >= static_cast<double>(cap.width_px)) {
-    s << "camera.intrinsics.cx_px = " << k.cx_px << " is not inside the image (camera.device.width_px = " << cap.width_px << ")";
+    s << "camera.intrinsics.cx_px = " << k.cx_px
+      << " is not inside the image (camera.device.width_px = " << cap.width_px << ")";
     p.fail(at("camera.intrinsics.cx_px"), s.str());
   }
   if (k.cy_px >= static_cast<double>(cap.height_px)) {
-    s << "camera.intrinsics.cy_px = " << k.cy_px << " is not inside the image (camera.device.height_px = " << cap.height_px << ")";
+    s << "camera.intrinsics.cy_px = " << k.cy_px
+      << " is not inside the image (camera.device.height_px = " << cap.height_px << ")";
     p.fail(at("camera.intrinsics.cy_px"), s.str());
   }
   if (k.fy_px > 2 * k.fx_px || k.fx_px > 2 * k.fy_px) {
@@ -130,6 +135,12 @@ void finish_camera_device(const ConfigReader& p, const toml::source_region& root
   }
   if (cap.format == dockcore::drivers::CameraPixelFormat::kYuyv && cap.width_px % 2 != 0) {
     p.fail(at("camera.device.width_px"), "camera.device.width_px must be even for format = \"yuyv\"");
+  }
+  // A stall is a missing frame, not a slow one: the window must hold at least two frame periods.
+  if (cap.fps > 0 && static_cast<std::uint64_t>(d.stall_ms) * cap.fps < 2000u) {
+    s << "camera.device.stall_ms = " << d.stall_ms << " is shorter than two frame periods at fps = " << cap.fps
+      << " (at least " << (2000u + cap.fps - 1u) / cap.fps << ")";
+    p.fail(at("camera.device.stall_ms"), s.str());
   }
   if (cap.reconnect_max_ms < cap.reconnect_min_ms) {
     p.fail(at("camera.device.reconnect_max_ms"), "camera.device.reconnect_max_ms must be >= reconnect_min_ms");
@@ -166,21 +177,23 @@ void finish_camera_device(const ConfigReader& p, const toml::source_region& root
                             static_cast<dockcore::Real>(d.mount.yaw_rad)};
 }
 
-void camera_device_restart_changes(const CameraDeviceConfig& a, const CameraDeviceConfig& b, std::vector<std::string>& out) {
+void camera_device_restart_changes(const CameraDeviceConfig& a, const CameraDeviceConfig& b,
+                                   std::vector<std::string>& out) {
   auto check = [&out](bool equal, const char* key) {
     if (!equal) out.emplace_back(key);
   };
   const auto& ca = a.capture;
   const auto& cb = b.capture;
   check(a.enabled == b.enabled, "camera.device");
-  check(ca.device == cb.device && ca.format == cb.format && ca.width_px == cb.width_px && ca.height_px == cb.height_px &&
-            ca.fps == cb.fps && ca.buffers == cb.buffers && ca.late_ms == cb.late_ms &&
-            ca.reconnect_min_ms == cb.reconnect_min_ms && ca.reconnect_max_ms == cb.reconnect_max_ms,
+  check(ca.device == cb.device && ca.format == cb.format && ca.width_px == cb.width_px &&
+            ca.height_px == cb.height_px && ca.fps == cb.fps && ca.buffers == cb.buffers && ca.late_ms == cb.late_ms &&
+            ca.reconnect_min_ms == cb.reconnect_min_ms && ca.reconnect_max_ms == cb.reconnect_max_ms &&
+            a.stall_ms == b.stall_ms,
         "camera.device.*");
   const auto& ka = a.tag.intrinsics;
   const auto& kb = b.tag.intrinsics;
-  check(ka.fx_px == kb.fx_px && ka.fy_px == kb.fy_px && ka.cx_px == kb.cx_px && ka.cy_px == kb.cy_px && ka.k1 == kb.k1 &&
-            ka.k2 == kb.k2 && ka.p1 == kb.p1 && ka.p2 == kb.p2 && ka.k3 == kb.k3,
+  check(ka.fx_px == kb.fx_px && ka.fy_px == kb.fy_px && ka.cx_px == kb.cx_px && ka.cy_px == kb.cy_px &&
+            ka.k1 == kb.k1 && ka.k2 == kb.k2 && ka.p1 == kb.p1 && ka.p2 == kb.p2 && ka.k3 == kb.k3,
         "camera.intrinsics.*");
   check(a.mount.x_m == b.mount.x_m && a.mount.y_m == b.mount.y_m && a.mount.z_m == b.mount.z_m &&
             a.mount.yaw_rad == b.mount.yaw_rad && a.mount.pitch_rad == b.mount.pitch_rad &&

@@ -27,6 +27,9 @@ struct CameraDeviceConfig {
   dockcore::drivers::TagDetectorOptions tag{};  ///< Family, size, tuning and (copied in) the intrinsics.
   CameraMount mount{};
   double full_confidence_margin = 100;  ///< Decision margin reported as confidence 1.
+  /// No frame from the camera for this long → camera_stalled (a status flag and an event; the docking goes on with
+  /// the lidar). Checked on every control tick.
+  std::uint32_t stall_ms = 200;
 };
 
 }  // namespace dockd

@@ -25,29 +25,42 @@ constexpr std::uint64_t kNominalTickUs = 20000;
 constexpr std::uint64_t kResumeHoldUs = 500000;  // data fresh this long before an interrupted command is re-issued
 constexpr std::uint8_t kMaxResumes = 3;          // per task: a flapping link ends in the fault, not in a loop
 
-double deg(Real rad) { return static_cast<double>(rad) * 180.0 / 3.14159265358979323846; }
+double deg(Real rad) {
+  return static_cast<double>(rad) * 180.0 / 3.14159265358979323846;
+}
 
 const char* level_name(LogLevel l) {
   switch (l) {
-    case LogLevel::kError: return "error";
-    case LogLevel::kWarn: return "warn";
-    case LogLevel::kInfo: return "info";
-    case LogLevel::kDebug: return "debug";
+    case LogLevel::kError:
+      return "error";
+    case LogLevel::kWarn:
+      return "warn";
+    case LogLevel::kInfo:
+      return "info";
+    case LogLevel::kDebug:
+      return "debug";
   }
   return "?";
 }
 
-bool idle_state(TaskState s) { return s == TaskState::kNotTasking || s == TaskState::kFault; }
+bool idle_state(TaskState s) {
+  return s == TaskState::kNotTasking || s == TaskState::kFault;
+}
 
 }  // namespace
 
 const char* to_string_result(dockcore::TaskResult r) {
   switch (r) {
-    case dockcore::TaskResult::kNone: return "none";
-    case dockcore::TaskResult::kDocked: return "docked";
-    case dockcore::TaskResult::kUndocked: return "undocked";
-    case dockcore::TaskResult::kCancelled: return "cancelled";
-    case dockcore::TaskResult::kFaulted: return "faulted";
+    case dockcore::TaskResult::kNone:
+      return "none";
+    case dockcore::TaskResult::kDocked:
+      return "docked";
+    case dockcore::TaskResult::kUndocked:
+      return "undocked";
+    case dockcore::TaskResult::kCancelled:
+      return "cancelled";
+    case dockcore::TaskResult::kFaulted:
+      return "faulted";
   }
   return "?";
 }
@@ -69,10 +82,14 @@ void Daemon::build_core() {
   seed004_ = dockcore::Seed004Controller(cfg_.seed004);
   seed003_ = dockcore::Seed003Controller(cfg_.seed003);
   smooth_ = dockcore::SmoothController(cfg_.smooth);
-  if (cfg_.controller == "seed000") controller_ = &seed000_;
-  else if (cfg_.controller == "seed004") controller_ = &seed004_;
-  else if (cfg_.controller == "seed003") controller_ = &seed003_;
-  else controller_ = &smooth_;
+  if (cfg_.controller == "seed000")
+    controller_ = &seed000_;
+  else if (cfg_.controller == "seed004")
+    controller_ = &seed004_;
+  else if (cfg_.controller == "seed003")
+    controller_ = &seed003_;
+  else
+    controller_ = &smooth_;
   core_ = std::make_unique<dockcore::Dockcore>(*controller_);
   core_cfg_ = dockcore::DockcoreConfig{};
   core_cfg_.estimator = cfg_.estimator;
@@ -130,8 +147,8 @@ std::string json_escape(const std::string& in, std::size_t max) {
 }  // namespace
 
 void Daemon::log_reload(std::uint64_t now_us, const char* result, const std::string& message, LogLevel level) {
-  const std::string line = "{\"t_us\":" + std::to_string(now_us) + ",\"event\":\"config_reload\",\"result\":\"" + result +
-                           "\",\"message\":\"" + json_escape(message, 1024) + "\"}\n";
+  const std::string line = "{\"t_us\":" + std::to_string(now_us) + ",\"event\":\"config_reload\",\"result\":\"" +
+                           result + "\",\"message\":\"" + json_escape(message, 1024) + "\"}\n";
   emit_event(level, line.data(), line.size());
 }
 
@@ -196,8 +213,9 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
     configure_core(cfg_.default_dock_id, false, previous.get());
     if (io_.udp_host != nullptr) io_.udp_host->set_allowlist(cfg_.host.allowlist, err);
     ++counters_.config_reloads_rejected;
-    message = next->source + ": config reload rejected: dock profile refused by the estimator (the running "
-                             "configuration stays)";
+    message = next->source +
+              ": config reload rejected: dock profile refused by the estimator (the running "
+              "configuration stays)";
     log_reload(now_us, "rejected", message, LogLevel::kError);
     return false;
   }
@@ -208,8 +226,12 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
   return true;
 }
 
-dockcore::TaskState Daemon::state() const { return core_->task_manager().state(); }
-dockcore::FaultCode Daemon::fault() const { return core_->task_manager().fault(); }
+dockcore::TaskState Daemon::state() const {
+  return core_->task_manager().state();
+}
+dockcore::FaultCode Daemon::fault() const {
+  return core_->task_manager().fault();
+}
 
 bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile, const dockcore::DockcoreBase* scan_from) {
   const DockEntry* d = cfg_.find_dock(dock_id);
@@ -253,11 +275,12 @@ bool Daemon::start(std::string& error) {
   const StateLoadStatus st = load_state(cfg_.state_file, state_, msg);
   char line[768];
   if (st == StateLoadStatus::kRecoveredBackup || st == StateLoadStatus::kCorruptNoBackup) {
-    const int n = std::snprintf(line, sizeof line, "{\"t_us\":%llu,\"event\":\"state_file\",\"level\":\"%s\",\"message\":\"%s\"}\n",
-                                static_cast<unsigned long long>(now), st == StateLoadStatus::kCorruptNoBackup ? "error" : "warn",
-                                msg.c_str());
-    if (n > 0) emit_event(st == StateLoadStatus::kCorruptNoBackup ? LogLevel::kError : LogLevel::kWarn, line,
-                          static_cast<std::size_t>(n) < sizeof line ? static_cast<std::size_t>(n) : sizeof line - 1);
+    const int n = std::snprintf(
+        line, sizeof line, "{\"t_us\":%llu,\"event\":\"state_file\",\"level\":\"%s\",\"message\":\"%s\"}\n",
+        static_cast<unsigned long long>(now), st == StateLoadStatus::kCorruptNoBackup ? "error" : "warn", msg.c_str());
+    if (n > 0)
+      emit_event(st == StateLoadStatus::kCorruptNoBackup ? LogLevel::kError : LogLevel::kWarn, line,
+                 static_cast<std::size_t>(n) < sizeof line ? static_cast<std::size_t>(n) : sizeof line - 1);
   }
   if (!configure_core(cfg_.default_dock_id, false)) {
     error = "dock profile of dock " + std::to_string(cfg_.default_dock_id) + " refused by the estimator";
@@ -524,10 +547,18 @@ void Daemon::poll_hosts(std::uint64_t now_us) {
   }
 }
 
-void Daemon::on_lidar_readable(std::uint64_t now_us) { poll_lidar(now_us); }
-void Daemon::on_chassis_readable(std::uint64_t now_us) { poll_chassis(now_us); }
-void Daemon::on_host_readable(std::uint64_t now_us) { poll_hosts(now_us); }
-void Daemon::on_camera_readable(std::uint64_t now_us) { poll_camera(now_us); }
+void Daemon::on_lidar_readable(std::uint64_t now_us) {
+  poll_lidar(now_us);
+}
+void Daemon::on_chassis_readable(std::uint64_t now_us) {
+  poll_chassis(now_us);
+}
+void Daemon::on_host_readable(std::uint64_t now_us) {
+  poll_hosts(now_us);
+}
+void Daemon::on_camera_readable(std::uint64_t now_us) {
+  poll_camera(now_us);
+}
 
 // --- watchdogs -----------------------------------------------------------------------------------------------------
 
@@ -536,7 +567,8 @@ void Daemon::watchdogs(std::uint64_t now_us) {
   const std::uint64_t chassis_lim = static_cast<std::uint64_t>(cfg_.chassis_stale_ms) * 1000u;
   const bool lidar = !have_scan_ || now_us - last_scan_rx_us_ > lidar_lim;
   // A receive stamp after now_us is a frame read during this tick (now_us is taken when the tick starts): fresh.
-  const bool chassis = !have_wheels_ || (now_us > last_wheels_stamp_us_ && now_us - last_wheels_stamp_us_ > chassis_lim);
+  const bool chassis =
+      !have_wheels_ || (now_us > last_wheels_stamp_us_ && now_us - last_wheels_stamp_us_ > chassis_lim);
   if (lidar != lidar_stale_) {
     if (lidar) ++counters_.lidar_stale_trips;
     // Why it went stale, for a log read after the fact: how old the newest turn's end and the newest parse are
@@ -559,11 +591,33 @@ void Daemon::watchdogs(std::uint64_t now_us) {
                   static_cast<unsigned>(FaultCode::kChassisStale));
     log_event(now_us, "watchdog", f, chassis ? LogLevel::kWarn : LogLevel::kInfo);
   }
+  camera_watchdog(now_us);
   if (lidar && !lidar_stale_) lidar_stale_since_us_ = now_us;
   if (chassis && !chassis_stale_) chassis_stale_since_us_ = now_us;
   lidar_stale_ = lidar;
   chassis_stale_ = chassis;
   if (lidar || chassis) fresh_since_us_ = now_us;
+}
+
+void Daemon::camera_watchdog(std::uint64_t now_us) {
+  if (io_.camera_frames == nullptr) return;
+  if (camera_watch_from_us_ == 0) camera_watch_from_us_ = now_us;
+  const std::uint64_t last = io_.camera_frames->last_frame_us();
+  // Before the first frame the window runs from the first tick: a camera that never delivers is a stalled one too.
+  const std::uint64_t since = last != 0 ? last : camera_watch_from_us_;
+  const bool stalled =
+      now_us > since && now_us - since > static_cast<std::uint64_t>(cfg_.camera_device.stall_ms) * 1000u;
+  if (stalled == camera_stalled_) return;
+  if (stalled) ++counters_.camera_stalls;
+  char f[160];
+  std::snprintf(f, sizeof f, "\"which\":\"camera\",\"stale\":%s,\"last_frame_age_ms\":%lld,\"camera_stalls\":%u",
+                stalled ? "true" : "false",
+                last == 0       ? -1LL
+                : last > now_us ? 0LL
+                                : static_cast<long long>((now_us - last) / 1000u),
+                counters_.camera_stalls);
+  log_event(now_us, "watchdog", f, stalled ? LogLevel::kWarn : LogLevel::kInfo);
+  camera_stalled_ = stalled;
 }
 
 // --- teach ---------------------------------------------------------------------------------------------------------
@@ -662,18 +716,19 @@ void Daemon::finish_teach(bool ok, const char* why, std::uint64_t now_us) {
   configure_core(id, false);
   const Pose2 nom = nominal_docked_target(cfg_);
   char buf[512];
-  const int m = std::snprintf(buf, sizeof buf,
-                              "{\"ok\":true,\"cmd\":\"teach\",\"seq\":%u,\"dock_id\":%u,\"scans\":%u,\"target_x_m\":%.4f,"
-                              "\"target_y_m\":%.4f,\"target_yaw_deg\":%.3f,\"spread_mm\":%.2f,\"offset_x_mm\":%.1f,"
-                              "\"offset_y_mm\":%.1f,\"offset_yaw_deg\":%.3f}",
-                              r.seq, id, t.scans, static_cast<double>(t.target.x_m), static_cast<double>(t.target.y_m),
-                              deg(t.target.yaw_rad), spread * 1e3, static_cast<double>(t.target.x_m - nom.x_m) * 1e3,
-                              static_cast<double>(t.target.y_m - nom.y_m) * 1e3,
-                              deg(dockcore::wrap_angle(t.target.yaw_rad - nom.yaw_rad)));
+  const int m = std::snprintf(
+      buf, sizeof buf,
+      "{\"ok\":true,\"cmd\":\"teach\",\"seq\":%u,\"dock_id\":%u,\"scans\":%u,\"target_x_m\":%.4f,"
+      "\"target_y_m\":%.4f,\"target_yaw_deg\":%.3f,\"spread_mm\":%.2f,\"offset_x_mm\":%.1f,"
+      "\"offset_y_mm\":%.1f,\"offset_yaw_deg\":%.3f}",
+      r.seq, id, t.scans, static_cast<double>(t.target.x_m), static_cast<double>(t.target.y_m), deg(t.target.yaw_rad),
+      spread * 1e3, static_cast<double>(t.target.x_m - nom.x_m) * 1e3,
+      static_cast<double>(t.target.y_m - nom.y_m) * 1e3, deg(dockcore::wrap_angle(t.target.yaw_rad - nom.yaw_rad)));
   if (m > 0) reply_json(r, buf, static_cast<std::size_t>(m));
   char f[256];
-  std::snprintf(f, sizeof f, "\"dock_id\":%u,\"scans\":%u,\"target_x_m\":%.4f,\"target_y_m\":%.4f,\"target_yaw_deg\":%.3f",
-                id, t.scans, static_cast<double>(t.target.x_m), static_cast<double>(t.target.y_m), deg(t.target.yaw_rad));
+  std::snprintf(f, sizeof f,
+                "\"dock_id\":%u,\"scans\":%u,\"target_x_m\":%.4f,\"target_y_m\":%.4f,\"target_yaw_deg\":%.3f", id,
+                t.scans, static_cast<double>(t.target.x_m), static_cast<double>(t.target.y_m), deg(t.target.yaw_rad));
   log_event(now_us, "teach_done", f);
 }
 
@@ -736,8 +791,8 @@ void Daemon::on_tick(std::uint64_t now_us) {
     queue_head_ = (queue_head_ + 1) % kQueue;
     --queue_size_;
     have_cmd = true;
-  } else if (!teach_.active && interrupted_ != HostCommandType::kNone && before == TaskState::kFault &&
-             !lidar_stale_ && !chassis_stale_ && now_us - fresh_since_us_ >= kResumeHoldUs) {
+  } else if (!teach_.active && interrupted_ != HostCommandType::kNone && before == TaskState::kFault && !lidar_stale_ &&
+             !chassis_stale_ && now_us - fresh_since_us_ >= kResumeHoldUs) {
     if (resumes_this_task_ < kMaxResumes) {
       ++resumes_this_task_;
       ++counters_.resumes;
@@ -786,10 +841,11 @@ void Daemon::on_tick(std::uint64_t now_us) {
     if (cmd.from_udp) {
       if (accepted) {
         char buf[256];
-        const int m = std::snprintf(buf, sizeof buf,
-                                    "{\"ok\":true,\"cmd\":\"%s\",\"seq\":%u,\"result\":\"%s\",\"dock_id\":%u,\"state\":\"%s\"}",
-                                    to_string(cmd.request.kind), cmd.request.seq, dockcore::to_string(out.command_result),
-                                    cmd.dock_id, dockcore::to_string(after));
+        const int m =
+            std::snprintf(buf, sizeof buf,
+                          "{\"ok\":true,\"cmd\":\"%s\",\"seq\":%u,\"result\":\"%s\",\"dock_id\":%u,\"state\":\"%s\"}",
+                          to_string(cmd.request.kind), cmd.request.seq, dockcore::to_string(out.command_result),
+                          cmd.dock_id, dockcore::to_string(after));
         if (m > 0) reply_json(cmd.request, buf, static_cast<std::size_t>(m));
       } else {
         char msg[128];
@@ -855,21 +911,23 @@ void Daemon::on_tick(std::uint64_t now_us) {
     }
     log_event(now_us, "state", f);
   }
-  if (s.state == TaskState::kAlign && (!prev_status_valid_ || s.phase != prev_status_.phase ||
-                                       prev_status_.state != TaskState::kAlign)) {
+  if (s.state == TaskState::kAlign &&
+      (!prev_status_valid_ || s.phase != prev_status_.phase || prev_status_.state != TaskState::kAlign)) {
     char f[96];
     std::snprintf(f, sizeof f, "\"phase\":%u,\"name\":\"%s\"", s.phase, controller_->phase_name(s.phase));
     log_event(now_us, "phase", f, LogLevel::kDebug);
   }
   if (s.fault != FaultCode::kNone && (!prev_status_valid_ || s.fault != prev_status_.fault)) {
     char f[96];
-    std::snprintf(f, sizeof f, "\"code\":%u,\"name\":\"%s\"", static_cast<unsigned>(s.fault), dockcore::to_string(s.fault));
+    std::snprintf(f, sizeof f, "\"code\":%u,\"name\":\"%s\"", static_cast<unsigned>(s.fault),
+                  dockcore::to_string(s.fault));
     log_event(now_us, "fault", f, LogLevel::kWarn);
   }
   const bool changed = !prev_status_valid_ || s.state != prev_status_.state || s.fault != prev_status_.fault ||
                        s.phase != prev_status_.phase || s.retries != prev_status_.retries ||
                        s.last_command != prev_status_.last_command || lidar_stale_ != prev_lidar_stale_ ||
-                       chassis_stale_ != prev_chassis_stale_;
+                       chassis_stale_ != prev_chassis_stale_ || camera_stalled_ != prev_camera_stalled_;
+  prev_camera_stalled_ = camera_stalled_;
   prev_lidar_stale_ = lidar_stale_;
   prev_chassis_stale_ = chassis_stale_;
   last_out_ = out;
@@ -894,9 +952,9 @@ void Daemon::publish_status(std::uint64_t now_us) {
     m.align_phase = s.phase;
     // The watchdogs' codes are reported even while idle (the task manager faults only in active states).
     m.fault_code = static_cast<std::uint16_t>(s.fault != FaultCode::kNone ? s.fault
-                                              : chassis_stale_        ? FaultCode::kChassisStale
-                                              : lidar_stale_          ? FaultCode::kLidarStale
-                                                                      : FaultCode::kNone);
+                                              : chassis_stale_            ? FaultCode::kChassisStale
+                                              : lidar_stale_              ? FaultCode::kLidarStale
+                                                                          : FaultCode::kNone);
     m.retries = s.retries;
     m.last_result = static_cast<std::uint8_t>(s.last_command);
     m.dock_valid = s.dock_valid;
@@ -922,6 +980,17 @@ std::uint32_t Daemon::commands_rejected_total() const {
   return n;
 }
 
+namespace {
+/// Replaces the closing brace of the JSON object in `buf` (`len` bytes) by `extra` (`k` bytes from snprintf into a
+/// buffer of `extra_size`, ending in its own brace) when it fits in `size`; otherwise leaves the status as it is.
+void append_if_fits(char* buf, std::size_t size, std::size_t& len, const char* extra, int k, std::size_t extra_size) {
+  if (k > 0 && static_cast<std::size_t>(k) < extra_size && len - 1 + static_cast<std::size_t>(k) < size) {
+    std::memcpy(buf + len - 1, extra, static_cast<std::size_t>(k) + 1);
+    len += static_cast<std::size_t>(k) - 1;
+  }
+}
+}  // namespace
+
 std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_us) const {
   const dockcore::TaskStatus& s = last_out_.status;
   const FaultCode watchdog_fault = chassis_stale_ ? FaultCode::kChassisStale
@@ -931,7 +1000,9 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
   const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
   // The latest scan's detection decision: its evidence and each cue (for a miss, the best refused candidate's).
   const dockcore::DockEstimate& e = core_->last_estimate();
-  auto cue = [&e](dockcore::EvidenceCue c) { return static_cast<double>(e.evidence.cue_nats[static_cast<std::size_t>(c)]); };
+  auto cue = [&e](dockcore::EvidenceCue c) {
+    return static_cast<double>(e.evidence.cue_nats[static_cast<std::size_t>(c)]);
+  };
   const int n = std::snprintf(
       buf, size,
       "{\"type\":\"status\",\"stamp_us\":%llu,\"state\":\"%s\",\"state_code\":%u,\"phase\":%u,\"phase_name\":\"%s\","
@@ -958,12 +1029,12 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
       static_cast<double>(fb_.battery_current_a), static_cast<double>(fb_.battery_voltage_v),
       static_cast<double>(fb_.soc), fb_.estop ? "true" : "false", lidar_stale_ ? "true" : "false",
       chassis_stale_ ? "true" : "false", static_cast<double>(odom_.x_m), static_cast<double>(odom_.y_m),
-      deg(odom_.yaw_rad), static_cast<double>(core_->drive_cmd().vx_mps), static_cast<double>(core_->drive_cmd().wz_radps),
-      teach_.active ? "true" : "false", state_.find(s.dock_id) != nullptr ? "true" : "false",
-      static_cast<unsigned long long>(stats_.ticks), static_cast<unsigned long long>(stats_.worst_period_us),
-      static_cast<unsigned long long>(stats_.overruns), static_cast<unsigned long long>(stats_.worst_work_us),
-      counters_.scans, counters_.detections, lc.crc_errors, lc.resyncs, lc.dropped_bytes, lc.foreign_datagrams, lc.reconnects,
-      counters_.late_scans, cc.bad_frames,
+      deg(odom_.yaw_rad), static_cast<double>(core_->drive_cmd().vx_mps),
+      static_cast<double>(core_->drive_cmd().wz_radps), teach_.active ? "true" : "false",
+      state_.find(s.dock_id) != nullptr ? "true" : "false", static_cast<unsigned long long>(stats_.ticks),
+      static_cast<unsigned long long>(stats_.worst_period_us), static_cast<unsigned long long>(stats_.overruns),
+      static_cast<unsigned long long>(stats_.worst_work_us), counters_.scans, counters_.detections, lc.crc_errors,
+      lc.resyncs, lc.dropped_bytes, lc.foreign_datagrams, lc.reconnects, counters_.late_scans, cc.bad_frames,
       cc.send_failures, counters_.commands, commands_rejected_total(), counters_.resumes,
       io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u,
       io_.udp_host != nullptr ? io_.udp_host->counters().not_allowed : 0u, counters_.config_reloads,
@@ -982,10 +1053,14 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
     char extra[200];
     const int k = std::snprintf(extra, sizeof extra, ",\"tag_fused\":%u,\"tag_refused\":[%u,%u,%u,%u,%u,%u,%u,%u]}",
                                 t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8]);
-    if (k > 0 && static_cast<std::size_t>(k) < sizeof extra && len - 1 + static_cast<std::size_t>(k) < size) {
-      std::memcpy(buf + len - 1, extra, static_cast<std::size_t>(k) + 1);
-      len += static_cast<std::size_t>(k) - 1;
-    }
+    append_if_fits(buf, size, len, extra, k, sizeof extra);
+  }
+  // The stall watchdog's fields, likewise.
+  if (io_.camera_frames != nullptr) {
+    // The flag only, as for the lidar: the count is in the watchdog event (the status has no room to spare).
+    char extra[32];
+    const int k = std::snprintf(extra, sizeof extra, ",\"camera_stalled\":%s}", camera_stalled_ ? "true" : "false");
+    append_if_fits(buf, size, len, extra, k, sizeof extra);
   }
   // The own camera's fields go before the closing brace when they fit; otherwise the status goes without them.
   if (io_.camera_status != nullptr) {

@@ -21,16 +21,16 @@
 #include <string>
 
 #include "config.hpp"
-#include "session_record.hpp"
-#include "state_file.hpp"
 #include "dockcore/controllers.hpp"
 #include "dockcore/dockcore.hpp"
+#include "dockcore/drivers/udp_host_link.hpp"
 #include "dockcore/hal/camera.hpp"
 #include "dockcore/hal/chassis.hpp"
 #include "dockcore/hal/clock.hpp"
 #include "dockcore/hal/host_link.hpp"
 #include "dockcore/hal/lidar.hpp"
-#include "dockcore/drivers/udp_host_link.hpp"
+#include "session_record.hpp"
+#include "state_file.hpp"
 
 namespace dockd {
 
@@ -38,19 +38,21 @@ namespace dockd {
 struct DaemonIo {
   dockcore::hal::LidarSource* lidar = nullptr;
   dockcore::hal::ChassisLink* chassis = nullptr;
-  dockcore::hal::HostLink* can_host = nullptr;           ///< CAN host command / status frames.
-  dockcore::drivers::UdpHostLink* udp_host = nullptr;    ///< JSON requests and the status stream.
+  dockcore::hal::HostLink* can_host = nullptr;              ///< CAN host command / status frames.
+  dockcore::drivers::UdpHostLink* udp_host = nullptr;       ///< JSON requests and the status stream.
   dockcore::hal::CameraTargetSource* camera = nullptr;      ///< The UDP camera datagram (external detectors).
   dockcore::hal::CameraTargetSource* camera_own = nullptr;  ///< dockd's own capture + detector (docs/camera.md).
   /// dockd's own detector's tag poses, fused into the dock filter (docs/camera.md, "Fusion"); null: no fusion.
   dockcore::hal::TagPoseSource* tags = nullptr;
+  /// dockd's own camera's frame arrivals, for the stall watchdog (camera_stalled); null: no watchdog.
+  const dockcore::hal::CameraFrameMonitor* camera_frames = nullptr;
   /// Optional: writes the own camera's status fields (",\"camera_frames\":…", no heap, never blocking) into `buf`
   /// (`size` bytes with the NUL) and returns their length; 0 when they do not fit (the status then goes without
   /// them). `ctx` is camera_status_ctx.
   std::size_t (*camera_status)(const void* ctx, char* buf, std::size_t size) = nullptr;
   const void* camera_status_ctx = nullptr;
   const dockcore::hal::Clock* clock = nullptr;
-  RotatingLog* event_log = nullptr;                      ///< JSON-lines event log (may be closed).
+  RotatingLog* event_log = nullptr;  ///< JSON-lines event log (may be closed).
   /// Optional: the CAN link behind can_host, for its host_commands_rejected() (replays, out-of-order) in the status.
   const dockcore::drivers::CanLink* can_link = nullptr;
   /// Also print events at or above this level to stderr (journal). kError..kDebug.
@@ -68,7 +70,7 @@ struct TickStats {
 
 /// Counters the daemon itself keeps (the drivers keep theirs).
 struct DaemonCounters {
-  std::uint32_t commands = 0;          ///< Task commands handed to the task manager.
+  std::uint32_t commands = 0;  ///< Task commands handed to the task manager.
   /// By the task manager or dockd (unknown dock id, queue full), from CAN or UDP; the status field adds the UDP
   /// link's own refusals (commands_rejected_total()).
   std::uint32_t commands_rejected = 0;
@@ -78,11 +80,12 @@ struct DaemonCounters {
   std::uint32_t detections = 0;
   std::uint32_t lidar_stale_trips = 0;
   std::uint32_t chassis_stale_trips = 0;
+  std::uint32_t camera_stalls = 0;  ///< Times the own camera went [camera.device] stall_ms without a frame.
   std::uint32_t resumes = 0;
   std::uint32_t wheel_send_failures = 0;
   std::uint32_t status_sent = 0;
-  std::uint32_t config_reloads = 0;          ///< Reloads applied.
-  std::uint32_t config_reloads_rejected = 0; ///< Reloads refused (invalid file, restart-only key changed).
+  std::uint32_t config_reloads = 0;           ///< Reloads applied.
+  std::uint32_t config_reloads_rejected = 0;  ///< Reloads refused (invalid file, restart-only key changed).
   /// Tag poses handed to the core, by what became of them (index: dockcore::TagStatus; kFused = fused).
   std::uint32_t tags[dockcore::kTagStatusCount] = {};
 };
@@ -142,6 +145,9 @@ class Daemon {
   const dockcore::hal::WheelCommand& last_wheels() const { return last_wheels_; }
   bool lidar_stale() const { return lidar_stale_; }
   bool chassis_stale() const { return chassis_stale_; }
+  /// The own camera delivered no frame for [camera.device] stall_ms (false without DaemonIo::camera_frames). It
+  /// holds nothing and faults nothing: the docking goes on with the lidar.
+  bool camera_stalled() const { return camera_stalled_; }
   const TickStats& tick_stats() const { return stats_; }
   const DaemonCounters& counters() const { return counters_; }
   const dockcore::Pose2& odom_pose() const { return odom_; }
@@ -193,6 +199,8 @@ class Daemon {
   bool configure_core(std::uint16_t dock_id, bool raw_profile, const dockcore::DockcoreBase* scan_from = nullptr);
   dockcore::Pose2 odom_at(std::uint64_t stamp_us) const;
   void watchdogs(std::uint64_t now_us);
+  /// The own camera's stall watchdog (part of watchdogs): sets camera_stalled_, counts and logs its changes.
+  void camera_watchdog(std::uint64_t now_us);
   void start_teach(const dockcore::drivers::HostRequest& r, std::uint64_t now_us);
   void teach_sample(const dockcore::DockEstimate& e);
   void teach_progress(std::uint64_t now_us);
@@ -237,8 +245,9 @@ class Daemon {
   std::uint64_t last_scan_rx_us_ = 0;
   std::uint64_t last_scan_parsed_us_ = 0;  ///< When dockd last parsed a usable (not late) scan.
   std::uint64_t prev_scan_stamp_us_ = 0;
-  bool last_scan_late_ = false;       ///< The newest scan was late (not given to the core).
-  std::uint64_t scan_period_us_ = 0;  ///< Spacing of the last two scan stamps, if plausible (≤ 0.5 s or lidar_stale_ms); 0 = unknown.
+  bool last_scan_late_ = false;  ///< The newest scan was late (not given to the core).
+  std::uint64_t scan_period_us_ =
+      0;  ///< Spacing of the last two scan stamps, if plausible (≤ 0.5 s or lidar_stale_ms); 0 = unknown.
   dockcore::CameraTarget camera_{};
 
   // Commands.
@@ -248,6 +257,8 @@ class Daemon {
 
   // Watchdogs and resume.
   bool lidar_stale_ = true, chassis_stale_ = true;
+  bool camera_stalled_ = false, prev_camera_stalled_ = false;
+  std::uint64_t camera_watch_from_us_ = 0;  ///< First watchdog tick: a camera that never delivers stalls from here.
   std::uint64_t lidar_stale_since_us_ = 0, chassis_stale_since_us_ = 0;
   bool started_ = false;
   std::uint64_t start_us_ = 0;

@@ -30,10 +30,10 @@
 
 #include "config.hpp"
 #include "daemon.hpp"
-#include "session_record.hpp"
 #include "dockcore/drivers/can_link.hpp"
 #include "dockcore/drivers/lidar_driver.hpp"
 #include "dockcore/drivers/udp_camera.hpp"
+#include "session_record.hpp"
 #ifdef DOCKD_HAVE_VISION
 #include "dockcore/drivers/camera_pipeline.hpp"
 #include "dockcore/drivers/v4l2_camera.hpp"
@@ -127,7 +127,8 @@ class NoChassisBus final : public dockcore::hal::CanBus {
 // namespace), as sd_notify(3) documents.
 void sd_notify_fallback(const char* what) {
   const char* path = std::getenv("NOTIFY_SOCKET");
-  if (path == nullptr || (path[0] != '/' && path[0] != '@') || std::strlen(path) >= sizeof(sockaddr_un::sun_path)) return;
+  if (path == nullptr || (path[0] != '/' && path[0] != '@') || std::strlen(path) >= sizeof(sockaddr_un::sun_path))
+    return;
   const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (fd < 0) return;
   sockaddr_un addr{};
@@ -279,8 +280,9 @@ int main(int argc, char** argv) {
   NoChassisBus fake_bus;
   dockcore::hal::CanBus* raw_bus = nullptr;
   if (cfg.can_interface == "fake") {
-    std::fprintf(stderr, "dockd: WARNING: [can] interface = \"fake\": DEVELOPMENT ONLY, no chassis attached; the "
-                         "robot will not move and every task faults (184)\n");
+    std::fprintf(stderr,
+                 "dockd: WARNING: [can] interface = \"fake\": DEVELOPMENT ONLY, no chassis attached; the "
+                 "robot will not move and every task faults (184)\n");
     raw_bus = &fake_bus;
   } else {
     std::uint32_t ids[64];
@@ -358,8 +360,10 @@ int main(int argc, char** argv) {
   }
 #else
   if (cfg.camera_device.enabled) {
-    std::fprintf(stderr, "%s: [camera.device]: this dockd was built without libapriltag (tools/setup-deps installs "
-                         "libapriltag-dev)\n", config_path.c_str());
+    std::fprintf(stderr,
+                 "%s: [camera.device]: this dockd was built without libapriltag (tools/setup-deps installs "
+                 "libapriltag-dev)\n",
+                 config_path.c_str());
     return 2;
   }
 #endif
@@ -374,6 +378,7 @@ int main(int argc, char** argv) {
 #ifdef DOCKD_HAVE_VISION
   io.camera_own = camera_own.get();
   io.tags = camera_own.get();
+  io.camera_frames = camera_own.get();
   if (camera_own) {
     io.camera_status = own_camera_status;
     io.camera_status_ctx = camera_own.get();
@@ -474,8 +479,10 @@ int main(int argc, char** argv) {
         case kSignal: {
           signalfd_siginfo si{};
           while (::read(sfd, &si, sizeof si) == static_cast<ssize_t>(sizeof si)) {
-            if (si.ssi_signo == SIGTERM) stop_reason = "SIGTERM";
-            else if (si.ssi_signo == SIGINT) stop_reason = "SIGINT";
+            if (si.ssi_signo == SIGTERM)
+              stop_reason = "SIGTERM";
+            else if (si.ssi_signo == SIGINT)
+              stop_reason = "SIGINT";
             else if (si.ssi_signo == SIGHUP) {
               // Config reload (docs/dockd.md, "Config reload"): validated like --check-config, all or nothing,
               // applied only while the task is idle. The command-line overrides stay in force.
@@ -488,12 +495,21 @@ int main(int argc, char** argv) {
           }
           break;
         }
-        case kLidar: daemon->on_lidar_readable(now); break;
-        case kCan: daemon->on_chassis_readable(now); break;
-        case kHost: daemon->on_host_readable(now); break;
+        case kLidar:
+          daemon->on_lidar_readable(now);
+          break;
+        case kCan:
+          daemon->on_chassis_readable(now);
+          break;
+        case kHost:
+          daemon->on_host_readable(now);
+          break;
         case kCamera:
-        case kCameraOwn: daemon->on_camera_readable(now); break;
-        default: break;
+        case kCameraOwn:
+          daemon->on_camera_readable(now);
+          break;
+        default:
+          break;
       }
     }
   }

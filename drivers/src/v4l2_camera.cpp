@@ -2,6 +2,10 @@
 // stamps, reconnect with back-off, counters.
 #include "dockcore/drivers/v4l2_camera.hpp"
 
+#if DOCKCORE_HAVE_JPEG
+#include "dockcore/drivers/jpeg_grey.hpp"
+#endif
+
 #include <fcntl.h>
 #include <linux/videodev2.h>
 #include <poll.h>
@@ -15,6 +19,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 namespace dockcore::drivers {
@@ -22,13 +27,18 @@ namespace dockcore::drivers {
 std::optional<CameraPixelFormat> parse_camera_pixel_format(std::string_view name) {
   if (name == "grey") return CameraPixelFormat::kGrey;
   if (name == "yuyv") return CameraPixelFormat::kYuyv;
+  if (name == "mjpeg") return CameraPixelFormat::kMjpeg;
   return std::nullopt;
 }
 
 const char* to_string(CameraPixelFormat f) {
   switch (f) {
-    case CameraPixelFormat::kGrey: return "grey";
-    case CameraPixelFormat::kYuyv: return "yuyv";
+    case CameraPixelFormat::kGrey:
+      return "grey";
+    case CameraPixelFormat::kYuyv:
+      return "yuyv";
+    case CameraPixelFormat::kMjpeg:
+      return "mjpeg";
   }
   return "?";
 }
@@ -50,6 +60,79 @@ void copy_grey(const std::uint8_t* src, std::uint32_t stride_bytes, std::uint32_
     std::memcpy(grey + static_cast<std::size_t>(r) * width_px, src + static_cast<std::size_t>(r) * stride_bytes,
                 width_px);
   }
+}
+
+#if DOCKCORE_HAVE_JPEG
+struct FrameConverter::Jpeg {
+  JpegGreyDecoder decoder;
+};
+#else
+struct FrameConverter::Jpeg {};
+#endif
+
+FrameConverter::FrameConverter(CameraPixelFormat format, std::uint32_t width_px, std::uint32_t height_px)
+    : format_(format),
+      width_px_(width_px),
+      height_px_(height_px),
+      bytes_per_line_(format == CameraPixelFormat::kYuyv ? 2 * width_px : width_px),
+      a_(static_cast<std::size_t>(width_px) * height_px, 0) {
+  frame_ = a_.data();
+  if (format_ == CameraPixelFormat::kMjpeg) {
+    // A JPEG is decoded into the spare and the two swap on success: a damaged one leaves the frame as it was.
+    b_.assign(a_.size(), 0);
+    spare_ = b_.data();
+    jpeg_ = std::make_unique<Jpeg>();
+  }
+}
+
+FrameConverter::~FrameConverter() = default;
+
+void FrameConverter::set_bytes_per_line(std::uint32_t bytes_per_line) {
+  bytes_per_line_ = bytes_per_line;
+}
+
+std::uint32_t FrameConverter::min_bytes() const {
+  if (format_ == CameraPixelFormat::kMjpeg) return 0;
+  const std::uint32_t bpp = format_ == CameraPixelFormat::kYuyv ? 2u : 1u;
+  return bytes_per_line_ * (height_px_ - 1u) + width_px_ * bpp;
+}
+
+bool FrameConverter::reject(const char* why) {
+  ++corrupt_;
+  std::snprintf(error_, sizeof error_, "%s", why);
+  return false;
+}
+
+bool FrameConverter::convert(const std::uint8_t* data, std::uint32_t bytes_used, bool error_flag) {
+  if (error_flag) return reject("buffer flagged V4L2_BUF_FLAG_ERROR");
+  switch (format_) {
+    case CameraPixelFormat::kGrey:
+    case CameraPixelFormat::kYuyv:
+      if (!frame_complete(bytes_used, min_bytes(), false)) return reject("buffer shorter than a frame");
+      if (format_ == CameraPixelFormat::kGrey) {
+        copy_grey(data, bytes_per_line_, width_px_, height_px_, frame_);
+      } else {
+        yuyv_to_grey(data, bytes_per_line_, width_px_, height_px_, frame_);
+      }
+      break;
+    case CameraPixelFormat::kMjpeg: {
+#if DOCKCORE_HAVE_JPEG
+      if (!jpeg_->decoder.decode(data, bytes_used, width_px_, height_px_, spare_)) {
+        char why[sizeof error_];
+        std::snprintf(why, sizeof why, "JPEG: %s", jpeg_->decoder.error());
+        return reject(why);
+      }
+      std::swap(frame_, spare_);
+      break;
+#else
+      (void)data;
+      (void)bytes_used;
+      return reject("MJPEG: built without libjpeg");
+#endif
+    }
+  }
+  error_[0] = '\0';
+  return true;
 }
 
 }  // namespace v4l2_detail
@@ -80,7 +163,17 @@ v4l2_buffer mmap_capture_buffer(std::uint32_t index) {
   return b;
 }
 
-std::uint32_t fourcc(CameraPixelFormat f) { return f == CameraPixelFormat::kGrey ? V4L2_PIX_FMT_GREY : V4L2_PIX_FMT_YUYV; }
+std::uint32_t fourcc(CameraPixelFormat f) {
+  switch (f) {
+    case CameraPixelFormat::kGrey:
+      return V4L2_PIX_FMT_GREY;
+    case CameraPixelFormat::kYuyv:
+      return V4L2_PIX_FMT_YUYV;
+    case CameraPixelFormat::kMjpeg:
+      return V4L2_PIX_FMT_MJPEG;
+  }
+  return 0;
+}
 
 /// The four characters of a FourCC code, NUL-terminated, in `out`.
 const char* fourcc_name(std::uint32_t f, char (&out)[5]) {
@@ -95,7 +188,7 @@ enum class OpenResult : std::uint8_t { kOk, kAbsent, kFailed, kRefused };
 class V4l2CameraImpl final : public V4l2Camera {
  public:
   explicit V4l2CameraImpl(const V4l2CameraOptions& o)
-      : opt_(o), grey_(static_cast<std::size_t>(o.width_px) * o.height_px, 0), delay_ms_(o.reconnect_min_ms) {}
+      : opt_(o), conv_(o.format, o.width_px, o.height_px), delay_ms_(o.reconnect_min_ms) {}
   ~V4l2CameraImpl() override { close_device(false); }
 
   /// One open + negotiate + map + stream-on attempt. On failure everything opened is closed again.
@@ -155,34 +248,32 @@ class V4l2CameraImpl final : public V4l2Camera {
       }
       const std::uint64_t dq_us = mono_us();
       counters_.dropped += seq_.gap(b.sequence);
-      const bool ok = b.index < nbuf_ &&
-                      v4l2_detail::frame_complete(b.bytesused, size_image_, (b.flags & V4L2_BUF_FLAG_ERROR) != 0);
       std::uint64_t stamp = dq_us;
       if (driver_stamps_) {
-        stamp = static_cast<std::uint64_t>(b.timestamp.tv_sec) * 1000000u + static_cast<std::uint64_t>(b.timestamp.tv_usec);
+        stamp =
+            static_cast<std::uint64_t>(b.timestamp.tv_sec) * 1000000u + static_cast<std::uint64_t>(b.timestamp.tv_usec);
         if (stamp > dq_us) stamp = dq_us;  // never in the future of its own dequeue
       }
-      if (ok) {
-        const std::uint8_t* src = static_cast<const std::uint8_t*>(maps_[b.index].addr);
-        if (opt_.format == CameraPixelFormat::kGrey) {
-          v4l2_detail::copy_grey(src, bytes_per_line_, opt_.width_px, opt_.height_px, grey_.data());
-        } else {
-          v4l2_detail::yuyv_to_grey(src, bytes_per_line_, opt_.width_px, opt_.height_px, grey_.data());
-        }
-      }
-      // Back to the driver at once: the pixels were copied.
+      // An index outside the mapped buffers, or a bytesused beyond the buffer, is the driver's error: not a frame.
+      const bool in_range = b.index < nbuf_ && b.bytesused <= maps_[b.index].length;
+      const bool ok = conv_.convert(in_range ? static_cast<const std::uint8_t*>(maps_[b.index].addr) : nullptr,
+                                    b.bytesused, !in_range || (b.flags & V4L2_BUF_FLAG_ERROR) != 0);
+      counters_.corrupt = conv_.corrupt();
+      // Back to the driver at once: the pixels were copied (or decoded).
       if (xioctl(fd_, VIDIOC_QBUF, &b) < 0) {
         lose("VIDIOC_QBUF", errno);
         continue;
       }
       if (!ok) {
-        ++counters_.corrupt;
+        // Counted; the reason stays readable (camera-check prints it) until the next failure.
+        std::snprintf(error_, sizeof error_, "camera %s: frame %u skipped (corrupt): %s", opt_.device.c_str(),
+                      b.sequence, conv_.error());
         if (mono_us() >= deadline) return hal::CameraFrameStatus::kTimeout;
         continue;
       }
       if (dq_us - stamp > static_cast<std::uint64_t>(opt_.late_ms) * 1000u) ++counters_.late;
       ++counters_.frames;
-      out.grey = grey_.data();
+      out.grey = conv_.frame();
       out.width_px = opt_.width_px;
       out.height_px = opt_.height_px;
       out.stride_bytes = opt_.width_px;
@@ -257,14 +348,25 @@ class V4l2CameraImpl final : public V4l2Camera {
              opt_.width_px, opt_.height_px, f.fmt.pix.width, f.fmt.pix.height);
       return OpenResult::kRefused;
     }
-    const std::uint32_t bpp = opt_.format == CameraPixelFormat::kGrey ? 1u : 2u;
-    bytes_per_line_ = f.fmt.pix.bytesperline != 0 ? f.fmt.pix.bytesperline : opt_.width_px * bpp;
-    if (bytes_per_line_ < opt_.width_px * bpp) {
-      refuse("VIDIOC_S_FMT: bytesperline %u is less than a row of pixels", bytes_per_line_);
-      return OpenResult::kRefused;
+    if (opt_.format == CameraPixelFormat::kMjpeg) {
+      // Compressed: no rows; a buffer holds one JPEG of bytesused bytes, at most sizeimage.
+      bytes_per_line_ = 0;
+      size_image_ = f.fmt.pix.sizeimage;
+      if (size_image_ == 0) {
+        refuse("VIDIOC_S_FMT: MJPEG with sizeimage 0");
+        return OpenResult::kRefused;
+      }
+    } else {
+      const std::uint32_t bpp = opt_.format == CameraPixelFormat::kGrey ? 1u : 2u;
+      bytes_per_line_ = f.fmt.pix.bytesperline != 0 ? f.fmt.pix.bytesperline : opt_.width_px * bpp;
+      if (bytes_per_line_ < opt_.width_px * bpp) {
+        refuse("VIDIOC_S_FMT: bytesperline %u is less than a row of pixels", bytes_per_line_);
+        return OpenResult::kRefused;
+      }
+      conv_.set_bytes_per_line(bytes_per_line_);
+      // The bytes a complete frame fills: rows of bytesperline, the last one needing only its pixels.
+      size_image_ = conv_.min_bytes();
     }
-    // The bytes a complete frame fills: rows of bytesperline, the last one needing only its pixels.
-    size_image_ = bytes_per_line_ * (opt_.height_px - 1u) + opt_.width_px * bpp;
     if (opt_.fps > 0) {
       v4l2_streamparm sp{};
       sp.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
@@ -366,7 +468,7 @@ class V4l2CameraImpl final : public V4l2Camera {
   };
 
   V4l2CameraOptions opt_;
-  std::vector<std::uint8_t> grey_;
+  v4l2_detail::FrameConverter conv_;
   int fd_ = -1;
   bool streaming_ = false;
   bool was_connected_ = false;
@@ -394,6 +496,12 @@ std::unique_ptr<V4l2Camera> open_v4l2_camera(const V4l2CameraOptions& o, std::st
             " outside 1.." + std::to_string(kMaxCameraSidePx);
     return nullptr;
   }
+#if !DOCKCORE_HAVE_JPEG
+  if (o.format == CameraPixelFormat::kMjpeg) {
+    error = "camera " + o.device + ": format mjpeg: this build has no libjpeg (tools/setup-deps installs libjpeg-dev)";
+    return nullptr;
+  }
+#endif
   if (o.format == CameraPixelFormat::kYuyv && o.width_px % 2 != 0) {
     error = "camera " + o.device + ": YUYV needs an even width, not " + std::to_string(o.width_px);
     return nullptr;

@@ -95,6 +95,7 @@ void CameraPipeline::run() {
       stats_.connected = source_.connected();
       continue;
     }
+    last_frame_us_.store(mono_us(), std::memory_order_relaxed);
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t n = detector_.detect(f.grey, f.width_px, f.height_px, f.stride_bytes, dets, kMaxTagDetections);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

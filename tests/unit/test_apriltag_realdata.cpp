@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "dockcore/drivers/apriltag_detector.hpp"
-#include "jpeg_grey.hpp"
+#include "dockcore/drivers/jpeg_grey.hpp"
 
 #include <CppUTest/TestHarness.h>
 
@@ -29,7 +29,8 @@ struct TruthTag {
 
 std::string apriltag_dir(const char* what) {
   const char* env = std::getenv("DOCKCORE_REALDATA");
-  const std::string root = (env != nullptr && *env != '\0') ? std::string(env) : std::string(DOCKCORE_SOURCE_DIR) + "/../shared/realdata";
+  const std::string root =
+      (env != nullptr && *env != '\0') ? std::string(env) : std::string(DOCKCORE_SOURCE_DIR) + "/../shared/realdata";
   const std::string dir = root + "/apriltag";
   struct stat st {};
   if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
@@ -40,8 +41,8 @@ std::string apriltag_dir(const char* what) {
   return dir;
 }
 
-/// Lines "0, (277.9247 327.4884), (250.3570 329.7265), (251.6721 357.3356), (279.4720 354.6839)". The listed corners are
-/// in libapriltag's pixel convention (top-left pixel centred at (0.5, 0.5)); they are returned in the wrapper's
+/// Lines "0, (277.9247 327.4884), (250.3570 329.7265), (251.6721 357.3356), (279.4720 354.6839)". The listed corners
+/// are in libapriltag's pixel convention (top-left pixel centred at (0.5, 0.5)); they are returned in the wrapper's
 /// (calibration) convention, the top-left pixel centred at (0, 0): 0.5 px less on both axes.
 std::vector<TruthTag> read_truth(const std::string& path) {
   std::vector<TruthTag> out;
@@ -96,12 +97,13 @@ TEST(AprilTagRealPhotos, EveryListedTagFoundWithCornersWithin2px) {
   CHECK_TEXT(det != nullptr, err.c_str());
   std::size_t total = 0;
   for (const char* stem : kPhotos) {
-    camera_check::GreyImage img;
-    CHECK_TEXT(camera_check::decode_jpeg_grey(dir + "/" + stem + ".jpg", img, err), err.c_str());
+    dockcore::drivers::GreyImage img;
+    CHECK_TEXT(dockcore::drivers::read_jpeg_grey(dir + "/" + stem + ".jpg", img, err), err.c_str());
     const std::vector<TruthTag> truth = read_truth(dir + "/" + stem + ".txt");
     CHECK_TEXT(!truth.empty(), (std::string("no tags listed in ") + stem + ".txt").c_str());
     TagDetection found[kMaxTagDetections];
-    const std::size_t n = det->detect(img.pixels.data(), img.width_px, img.height_px, img.width_px, found, kMaxTagDetections);
+    const std::size_t n =
+        det->detect(img.pixels.data(), img.width_px, img.height_px, img.width_px, found, kMaxTagDetections);
     std::vector<bool> used(n, false);
     double worst = 0;
     for (const TruthTag& t : truth) {

@@ -4,8 +4,8 @@
 #include <cstddef>
 #include <string>
 
-#include "dockcore/drivers/v4l2_camera.hpp"
 #include "../support/malloc_count.hpp"
+#include "dockcore/drivers/v4l2_camera.hpp"
 
 #include "CppUTest/TestHarness.h"
 
@@ -14,8 +14,11 @@ using dockcore_test::g_armed;
 
 TEST_GROUP(V4l2Heap){};
 
-TEST(V4l2Heap, RetryingAnAbsentDeviceAllocatesNothing) {
+namespace {
+/// Retries an absent device of `format`: zero heap calls after the first attempt.
+void check_retries_allocate_nothing(dockcore::drivers::CameraPixelFormat format) {
   dockcore::drivers::V4l2CameraOptions o;
+  o.format = format;
   o.device = "/nonexistent/video9";
   o.reconnect_min_ms = 10;
   o.reconnect_max_ms = 10;
@@ -39,3 +42,15 @@ TEST(V4l2Heap, RetryingAnAbsentDeviceAllocatesNothing) {
   CHECK_EQUAL(0u, static_cast<unsigned>(g_allocs));
   STRCMP_CONTAINS("camera /nonexistent/video9: open: No such file or directory", cam->last_error());
 }
+}  // namespace
+
+TEST(V4l2Heap, RetryingAnAbsentDeviceAllocatesNothing) {
+  check_retries_allocate_nothing(dockcore::drivers::CameraPixelFormat::kGrey);
+}
+
+#if DOCKCORE_HAVE_JPEG
+// MJPEG's spare frame and decoder are made with the camera, not per open attempt.
+TEST(V4l2Heap, RetryingAnAbsentMjpegDeviceAllocatesNothing) {
+  check_retries_allocate_nothing(dockcore::drivers::CameraPixelFormat::kMjpeg);
+}
+#endif

@@ -1,5 +1,6 @@
-// dockd's two camera sources (the UDP datagram and its own camera, docs/camera.md) feeding one camera target, and
-// the own camera's status fields: appended when they fit, left out — never the status lost — when they do not.
+// dockd's two camera sources (the UDP datagram and its own camera, docs/camera.md) feeding one camera target, the
+// own camera's status fields (appended when they fit, left out — never the status lost — when they do not), and the
+// camera stall watchdog.
 #include <unistd.h>
 
 #include <cstdio>
@@ -53,6 +54,12 @@ struct FakeTags final : dockcore::hal::TagPoseSource {
   }
 };
 
+/// Frame arrivals of the own camera, as the detection thread would record them.
+struct FakeFrames final : dockcore::hal::CameraFrameMonitor {
+  std::uint64_t last = 0;
+  std::uint64_t last_frame_us() const override { return last; }
+};
+
 std::size_t fields(const void* ctx, char* buf, std::size_t size) {
   const int n = std::snprintf(buf, size, "%s", static_cast<const char*>(ctx));
   if (n < 0 || static_cast<std::size_t>(n) >= size) {
@@ -71,10 +78,11 @@ struct CameraRig {
   dockd_test::SimLidar lidar;
   FakeTargets udp, own;
   FakeTags tags;
+  FakeFrames frames;
   std::unique_ptr<dockd::Daemon> daemon;
   std::string state_file = "/tmp/dockd_test_camera_" + std::to_string(::getpid());
 
-  explicit CameraRig(const char* status_fields, int dock_tag_id = -1) {
+  explicit CameraRig(const char* status_fields, int dock_tag_id = -1, bool watch_frames = false) {
     cfg.state_file = state_file;
     cfg.docks[0].tag.id = dock_tag_id;
     chassis = dockd_test::scenario_chassis(sc, link, clock);
@@ -85,6 +93,7 @@ struct CameraRig {
     io.camera = &udp;
     io.camera_own = &own;
     io.tags = &tags;
+    if (watch_frames) io.camera_frames = &frames;
     io.stderr_level = dockd::LogLevel::kError;
     if (status_fields != nullptr) {
       io.camera_status = fields;
@@ -170,4 +179,91 @@ TEST(DockdCamera, TagPosesReachTheCoreAndAreCountedInTheStatus) {
   none.daemon->on_camera_readable(none.clock.t);
   none.daemon->status_json(st, sizeof st, 0);
   STRCMP_CONTAINS(",\"tag_fused\":0,\"tag_refused\":[1,", st);
+}
+
+TEST(DockdCamera, AStalledCameraIsReportedAfterStallMsAndClearedWhenFramesResume) {
+  CameraRig r(nullptr, -1, true);
+  const std::uint64_t stall_us = std::uint64_t{r.cfg.camera_device.stall_ms} * 1000u;
+  CHECK_EQUAL(200000u, stall_us);  // the default
+  char st[dockcore::drivers::kMaxHostReply];
+  auto tick = [&r] {
+    r.clock.t += 20000;  // dockd's 50 Hz tick
+    r.daemon->on_tick(r.clock.t);
+  };
+  // 30 frames/s for a second: never stalled.
+  std::uint64_t next_frame = r.clock.t;
+  for (int i = 0; i < 50; ++i) {
+    while (next_frame <= r.clock.t + 20000) {
+      r.frames.last = next_frame;
+      next_frame += 33333;
+    }
+    tick();
+    CHECK_FALSE(r.daemon->camera_stalled());
+  }
+  r.daemon->status_json(st, sizeof st, r.clock.t);
+  STRCMP_CONTAINS(",\"camera_stalled\":false}", st);
+  // The frames stop: reported on the first tick more than stall_ms after the last one, and not before.
+  const std::uint64_t last = r.frames.last;
+  while (!r.daemon->camera_stalled()) {
+    CHECK(r.clock.t - last <= stall_us);
+    tick();
+    CHECK(r.clock.t - last <= stall_us + 20000);
+  }
+  CHECK_EQUAL(1u, r.daemon->counters().camera_stalls);
+  r.daemon->status_json(st, sizeof st, r.clock.t);
+  STRCMP_CONTAINS(",\"camera_stalled\":true}", st);
+  // Still stalled a while later: one stall, counted once.
+  for (int i = 0; i < 20; ++i) tick();
+  CHECK_TRUE(r.daemon->camera_stalled());
+  CHECK_EQUAL(1u, r.daemon->counters().camera_stalls);
+  // A frame again: cleared on the next tick; a second stall counts again.
+  r.frames.last = r.clock.t + 5000;
+  tick();
+  CHECK_FALSE(r.daemon->camera_stalled());
+  for (int i = 0; i < 12; ++i) tick();
+  CHECK_TRUE(r.daemon->camera_stalled());
+  CHECK_EQUAL(2u, r.daemon->counters().camera_stalls);
+}
+
+TEST(DockdCamera, ACameraThatNeverDeliversStallsFromStartAndNoWatchdogWithoutOne) {
+  CameraRig r(nullptr, -1, true);
+  const std::uint64_t start = r.clock.t;
+  while (!r.daemon->camera_stalled() && r.clock.t - start < 1000000) {
+    r.clock.t += 20000;
+    r.daemon->on_tick(r.clock.t);
+  }
+  CHECK_TRUE(r.daemon->camera_stalled());
+  CHECK(r.clock.t - start <= 240000);  // the first tick plus stall_ms plus one tick
+  // Without a frame monitor (no own camera) there is no watchdog and no field.
+  CameraRig none(nullptr);
+  for (int i = 0; i < 30; ++i) {
+    none.clock.t += 20000;
+    none.daemon->on_tick(none.clock.t);
+  }
+  CHECK_FALSE(none.daemon->camera_stalled());
+  char st[dockcore::drivers::kMaxHostReply];
+  none.daemon->status_json(st, sizeof st, none.clock.t);
+  CHECK(std::strstr(st, "camera_stalled") == nullptr);
+}
+
+TEST(DockdCamera, TheStallFlagComesBeforeTheCameraCountersInAFullStatus) {
+  // The own camera's fields as main.cpp writes them after a week at 30 frames/s (18 million frames, a million of
+  // them dropped, late or corrupt), a week after boot. With the tag fusion's fields and the stall flag the status is
+  // about 1.24 kB of its 1400 bytes: the capture counters (about 170 bytes) are what is left out, the flag stays.
+  const std::string camera_fields =
+      ",\"camera_connected\":false,\"camera_frames\":18144000,\"camera_dropped\":1000000,\"camera_late\":"
+      "1000000,\"camera_corrupt\":1000000,\"camera_reconnects\":99999,\"camera_tag_id\":587";
+  CameraRig r(camera_fields.c_str(), 3, true);
+  for (int i = 0; i < 20; ++i) {
+    r.clock.t += 20000;
+    r.daemon->on_tick(r.clock.t);
+  }
+  char st[dockcore::drivers::kMaxHostReply];
+  const std::size_t len = r.daemon->status_json(st, sizeof st, 604800000000ull);
+  CHECK(len > 0);
+  CHECK_EQUAL('}', st[len - 1]);
+  STRCMP_CONTAINS(",\"tag_fused\":", st);
+  STRCMP_CONTAINS(",\"camera_stalled\":true", st);
+  std::printf("\nstatus: %zu bytes with the stall flag, %zu more for the camera counters, limit %zu\n", len,
+              camera_fields.size(), sizeof st - 1);
 }

@@ -23,7 +23,8 @@ std::string error_of(const std::string& text) {
 const char* const kCamera =
     "[camera]\ntarget_id = 3\n"
     "[camera.device]\npath = \"/dev/video2\"\nformat = \"yuyv\"\nwidth_px = 640\nheight_px = 480\nfps = 30\n"
-    "[camera.intrinsics]\nfx_px = 610.5\nfy_px = 612\ncx_px = 318\ncy_px = 241\ndistortion = [-0.1, 0.02, 0.001, -0.002]\n"
+    "[camera.intrinsics]\nfx_px = 610.5\nfy_px = 612\ncx_px = 318\ncy_px = 241\ndistortion = [-0.1, 0.02, 0.001, "
+    "-0.002]\n"
     "[camera.mount]\nx_m = 0.2\ny_m = -0.01\nz_m = 0.15\nyaw_deg = 2\npitch_deg = 10\n"
     "[camera.tag]\nfamily = \"tag36h11\"\nsize_m = 0.08\n";
 
@@ -43,8 +44,13 @@ TEST(DockdCameraConfig, ValuesArrive) {
   CHECK_TRUE(d.enabled);
   STRCMP_EQUAL("/dev/video2", d.capture.device.c_str());
   CHECK(d.capture.format == dockcore::drivers::CameraPixelFormat::kYuyv);
+  std::string mjpeg = kCamera;
+  mjpeg.replace(mjpeg.find("\"yuyv\""), 6, "\"mjpeg\"");
+  CHECK(dockd::parse_config_toml(mjpeg, "t.toml").camera_device.capture.format ==
+        dockcore::drivers::CameraPixelFormat::kMjpeg);
   CHECK_EQUAL(640u, d.capture.width_px);
   CHECK_EQUAL(30u, d.capture.fps);
+  CHECK_EQUAL(200u, d.stall_ms);  // default
   DOUBLES_EQUAL(610.5, d.tag.intrinsics.fx_px, 0);
   DOUBLES_EQUAL(241, d.tag.intrinsics.cy_px, 0);
   DOUBLES_EQUAL(-0.1, d.tag.intrinsics.k1, 0);
@@ -64,14 +70,19 @@ TEST(DockdCameraConfig, ValuesArrive) {
 TEST(DockdCameraConfig, MissingRequiredKeysAreNamed) {
   STRCMP_CONTAINS("t.toml:1:1: camera.intrinsics.fx_px is required with [camera.device]",
                   error_of("[camera.device]\npath = \"/dev/video0\"\n").c_str());
-  STRCMP_CONTAINS("camera.tag.size_m is required with [camera.device]",
-                  error_of("[camera.device]\n[camera.intrinsics]\nfx_px = 600\nfy_px = 600\ncx_px = 320\ncy_px = 240\n").c_str());
-  STRCMP_CONTAINS("camera.intrinsics.cy_px is required",
-                  error_of("[camera.device]\n[camera.intrinsics]\nfx_px = 600\nfy_px = 600\ncx_px = 320\n[camera.tag]\nsize_m = 0.1\n").c_str());
+  STRCMP_CONTAINS(
+      "camera.tag.size_m is required with [camera.device]",
+      error_of("[camera.device]\n[camera.intrinsics]\nfx_px = 600\nfy_px = 600\ncx_px = 320\ncy_px = 240\n").c_str());
+  STRCMP_CONTAINS(
+      "camera.intrinsics.cy_px is required",
+      error_of(
+          "[camera.device]\n[camera.intrinsics]\nfx_px = 600\nfy_px = 600\ncx_px = 320\n[camera.tag]\nsize_m = 0.1\n")
+          .c_str());
 }
 
 TEST(DockdCameraConfig, InconsistentKeysAreNamed) {
-  const std::string base = "[camera.device]\nwidth_px = 640\nheight_px = 480\n[camera.tag]\nsize_m = 0.1\n[camera.intrinsics]\n";
+  const std::string base =
+      "[camera.device]\nwidth_px = 640\nheight_px = 480\n[camera.tag]\nsize_m = 0.1\n[camera.intrinsics]\n";
   STRCMP_CONTAINS("t.toml:9:9: camera.intrinsics.cx_px = 700 is not inside the image (camera.device.width_px = 640)",
                   error_of(base + "fx_px = 600\nfy_px = 600\ncx_px = 700\ncy_px = 240\n").c_str());
   STRCMP_CONTAINS("camera.intrinsics.cy_px = 480 is not inside the image",
@@ -82,10 +93,13 @@ TEST(DockdCameraConfig, InconsistentKeysAreNamed) {
                   error_of(base + "fx_px = 600\nfy_px = 600\ncx_px = 320\ncy_px = 240\ndistortion = [0.1]\n").c_str());
   STRCMP_CONTAINS("camera.device.width_px must be even for format = \"yuyv\"",
                   error_of("[camera.device]\nformat = \"yuyv\"\nwidth_px = 641\n[camera.tag]\nsize_m = 0.1\n"
-                           "[camera.intrinsics]\nfx_px = 600\nfy_px = 600\ncx_px = 320\ncy_px = 240\n").c_str());
-  STRCMP_CONTAINS("camera.device.reconnect_max_ms must be >= reconnect_min_ms",
-                  error_of("[camera.device]\nreconnect_min_ms = 500\nreconnect_max_ms = 100\n[camera.tag]\nsize_m = 0.1\n"
-                           "[camera.intrinsics]\nfx_px = 600\nfy_px = 600\ncx_px = 320\ncy_px = 240\n").c_str());
+                           "[camera.intrinsics]\nfx_px = 600\nfy_px = 600\ncx_px = 320\ncy_px = 240\n")
+                      .c_str());
+  STRCMP_CONTAINS(
+      "camera.device.reconnect_max_ms must be >= reconnect_min_ms",
+      error_of("[camera.device]\nreconnect_min_ms = 500\nreconnect_max_ms = 100\n[camera.tag]\nsize_m = 0.1\n"
+               "[camera.intrinsics]\nfx_px = 600\nfy_px = 600\ncx_px = 320\ncy_px = 240\n")
+          .c_str());
   // seed003's camera keys may repeat the camera's values but not contradict them.
   STRCMP_CONTAINS("controller.seed003.fx_px = 500 contradicts camera.intrinsics.fx_px = 610.5",
                   error_of(std::string("[controller.seed003]\nfx_px = 500\n") + kCamera).c_str());
@@ -95,13 +109,21 @@ TEST(DockdCameraConfig, InconsistentKeysAreNamed) {
 TEST(DockdCameraConfig, BadValuesAreNamed) {
   STRCMP_CONTAINS("camera.tag.family = \"tag37h11\" is not a family libapriltag provides (tag16h5",
                   error_of("[camera.tag]\nfamily = \"tag37h11\"\n").c_str());
-  STRCMP_CONTAINS("camera.device.format = \"mjpeg\" is not one of grey, yuyv",
-                  error_of("[camera.device]\nformat = \"mjpeg\"\n").c_str());
+  STRCMP_CONTAINS("camera.device.format = \"mjpg\" is not one of grey, yuyv, mjpeg",
+                  error_of("[camera.device]\nformat = \"mjpg\"\n").c_str());
+  STRCMP_CONTAINS("camera.device.stall_ms = 20 is out of range", error_of("[camera.device]\nstall_ms = 20\n").c_str());
+  // At 10 frames/s a 150 ms window would call every frame gap a stall.
+  std::string slow = kCamera;
+  slow.replace(slow.find("fps = 30"), 8, "fps = 10\nstall_ms = 150");
+  STRCMP_CONTAINS("camera.device.stall_ms = 150 is shorter than two frame periods at fps = 10 (at least 200)",
+                  error_of(slow).c_str());
+  slow.replace(slow.find("stall_ms = 150"), 14, "stall_ms = 200");
+  STRCMP_EQUAL("", error_of(slow).c_str());
+  CHECK_EQUAL(200u, dockd::parse_config_toml(slow, "t.toml").camera_device.stall_ms);
   STRCMP_CONTAINS("unknown key 'camera.intrinsics.f_px'", error_of("[camera.intrinsics]\nf_px = 1\n").c_str());
   STRCMP_CONTAINS("camera.intrinsics.fx_px = 0 is out of range", error_of("[camera.intrinsics]\nfx_px = 0\n").c_str());
   // Intrinsics without a device would do nothing: refused.
-  STRCMP_CONTAINS("[camera.intrinsics] needs [camera.device]",
-                  error_of("[camera.intrinsics]\nfx_px = 600\n").c_str());
+  STRCMP_CONTAINS("[camera.intrinsics] needs [camera.device]", error_of("[camera.intrinsics]\nfx_px = 600\n").c_str());
 }
 
 TEST(DockdCameraConfig, EveryCameraKeyIsRestartOnly) {
@@ -114,6 +136,12 @@ TEST(DockdCameraConfig, EveryCameraKeyIsRestartOnly) {
   CHECK_EQUAL(2u, changed.size());
   STRCMP_EQUAL("camera.device.*", changed[0].c_str());
   STRCMP_EQUAL("camera.tag.*", changed[1].c_str());
+  std::string stall = kCamera;
+  stall.replace(stall.find("fps = 30"), 8, "fps = 30\nstall_ms = 300");
+  const std::vector<std::string> stall_changed =
+      dockd::restart_only_changes(a, dockd::parse_config_toml(stall, "t.toml"));
+  CHECK_EQUAL(1u, stall_changed.size());
+  STRCMP_EQUAL("camera.device.*", stall_changed[0].c_str());
 }
 
 TEST(DockdCameraConfig, TagFusionKeysArrive) {

@@ -11,15 +11,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <string>
 
 #include "dockcore/drivers/udp_host_link.hpp"
 #include "dockd_sim_rig.hpp"
-#include "session_record.hpp"
 #include "docksim/rng.hpp"
+#include "session_record.hpp"
 
 #include "CppUTest/TestHarness.h"
 
@@ -53,7 +53,15 @@ struct Rig {
   std::string record_dir;  ///< The session record's directory when `record`.
   dockd::RotatingLog event_log;
 
-  explicit Rig(const char* state_name, bool with_udp = false, double start_distance = 1.2, bool record = false) {
+  /// The own camera's frame arrivals (with `watch_camera`): every 33 ms while camera_live, then none.
+  struct Frames final : dockcore::hal::CameraFrameMonitor {
+    std::uint64_t last = 0;
+    std::uint64_t last_frame_us() const override { return last; }
+  } frames;
+  bool camera_live = true;
+
+  explicit Rig(const char* state_name, bool with_udp = false, double start_distance = 1.2, bool record = false,
+               bool watch_camera = false) {
     state_file = std::string("/tmp/dockd_test_") + std::to_string(::getpid()) + "_" + state_name;
     std::remove(state_file.c_str());
     std::remove((state_file + ".bak").c_str());
@@ -81,6 +89,7 @@ struct Rig {
     io.clock = &clock;
     io.stderr_level = std::getenv("DOCKD_TEST_LOG") ? dockd::LogLevel::kDebug : dockd::LogLevel::kError;
     if (record) io.event_log = &event_log;
+    if (watch_camera) io.camera_frames = &frames;
     if (with_udp) {
       dockcore::drivers::UdpHostLinkOptions o;
       o.port = 0;
@@ -130,6 +139,7 @@ struct Rig {
         lidar.pending = true;
       }
     }
+    if (camera_live && clock.t >= frames.last + 33333) frames.last = clock.t;
     daemon->on_tick(clock.t);
   }
   /// Ticks until `pred` or `max_s` of simulated time; true when pred held.
@@ -163,10 +173,12 @@ TEST(DockdDaemon, DocksChargesAndUndocksInSimulation) {
   CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
   r.host.command(1, 0);  // CAN host frame: dock at dock 0
   bool moved = false;
-  CHECK_TRUE(r.run_until([&] {
-    moved = moved || !r.wheels_zero();
-    return r.daemon->state() == TaskState::kFinishTasking;
-  }, 60.0));
+  CHECK_TRUE(r.run_until(
+      [&] {
+        moved = moved || !r.wheels_zero();
+        return r.daemon->state() == TaskState::kFinishTasking;
+      },
+      60.0));
   CHECK_TRUE(moved);
   CHECK_TRUE(r.chassis->state().charging);
   CHECK_TRUE(r.wheels_zero());
@@ -223,10 +235,10 @@ TEST(DockdDaemon, RetryEventSaysWhyTheAttemptEnded) {
   CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
   CHECK_EQUAL(1, r.daemon->last_status().retries);
   const std::string ev = r.events("state");
-  CHECK_TEXT(ev.find("\"from\":\"WAIT_FOR_CHARGE\",\"to\":\"RETRY\",\"dock_id\":0,\"result\":\"none\","
-                     "\"reason\":\"charge_not_confirmed\",\"code\":182,\"phase\":\"WAIT_FOR_CHARGE\"}") !=
-                 std::string::npos,
-             ev.c_str());
+  CHECK_TEXT(
+      ev.find("\"from\":\"WAIT_FOR_CHARGE\",\"to\":\"RETRY\",\"dock_id\":0,\"result\":\"none\","
+              "\"reason\":\"charge_not_confirmed\",\"code\":182,\"phase\":\"WAIT_FOR_CHARGE\"}") != std::string::npos,
+      ev.c_str());
   // Only the RETRY entry carries a reason.
   int reasons = 0;
   for (std::size_t p = ev.find("\"reason\""); p != std::string::npos; p = ev.find("\"reason\"", p + 1)) ++reasons;
@@ -322,8 +334,10 @@ TEST(DockdDaemon, LidarWatchdogDoesNotFlapAtStartUp) {
   int flaps = 0;
   for (int i = 0; i < 100; ++i) {  // 2 s
     r.tick();
-    if (!r.daemon->lidar_stale()) was_fresh = true;
-    else if (was_fresh) ++flaps;
+    if (!r.daemon->lidar_stale())
+      was_fresh = true;
+    else if (was_fresh)
+      ++flaps;
   }
   CHECK_TRUE(was_fresh);
   CHECK_EQUAL(0, flaps);
@@ -350,7 +364,7 @@ TEST(DockdDaemon, ScansDeliveredLateDoNotKeepTheLidarFresh) {
   CHECK_TRUE(r.daemon->lidar_stale());
   CHECK_TRUE(r.wheels_zero());
   CHECK(r.daemon->counters().scans >= scans_before + 4);  // they kept coming...
-  CHECK(r.daemon->counters().late_scans >= 4);             // ...and were counted as late
+  CHECK(r.daemon->counters().late_scans >= 4);            // ...and were counted as late
   // 0.8 s without a usable scan: the core's own scan-age backstop (lidar_stale_ms + 0.3 s) has faulted 185 while
   // dockd's watchdog held; live scans again resume the docking.
   CHECK_EQUAL(185, static_cast<int>(r.daemon->fault()));
@@ -420,10 +434,18 @@ TEST(DockdDaemon, UdpFloodStaysConsistentAndUnknownDockIsRejected) {
   for (int t = 0; t < 100; ++t) {
     for (int k = 0; k < 20; ++k) {
       switch ((t * 20 + k) % 4) {
-        case 0: send("{\"cmd\":\"dock\",\"seq\":" + std::to_string(seq++) + "}"); break;
-        case 1: send("{\"cmd\":\"stop\",\"seq\":" + std::to_string(seq++) + "}"); break;
-        case 2: send("{\"cmd\":\"dock\",\"seq\":"); break;
-        default: send("{\"cmd\":\"status\",\"seq\":" + std::to_string(seq++) + "}"); break;
+        case 0:
+          send("{\"cmd\":\"dock\",\"seq\":" + std::to_string(seq++) + "}");
+          break;
+        case 1:
+          send("{\"cmd\":\"stop\",\"seq\":" + std::to_string(seq++) + "}");
+          break;
+        case 2:
+          send("{\"cmd\":\"dock\",\"seq\":");
+          break;
+        default:
+          send("{\"cmd\":\"status\",\"seq\":" + std::to_string(seq++) + "}");
+          break;
       }
     }
     r.tick();
@@ -479,7 +501,8 @@ TEST(DockdDaemon, TeachStoresTargetUsedByLaterDockings) {
   // It survives a restart: a new daemon loads it from the state file.
   dockd::StateData loaded;
   std::string msg;
-  CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kOk), static_cast<int>(dockd::load_state(r.state_file, loaded, msg)));
+  CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kOk),
+              static_cast<int>(dockd::load_state(r.state_file, loaded, msg)));
   CHECK(loaded.find(3) != nullptr);
   DOUBLES_EQUAL(static_cast<double>(t->target.x_m), static_cast<double>(loaded.find(3)->target.x_m), 1e-6);
   ::close(s);
@@ -497,7 +520,8 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   next.log_level = dockd::LogLevel::kError;  // the reload applies [log] level to stderr: keep the test quiet
   next.chassis_stale_ms = 300;
   next.smooth.v_max_mps = static_cast<dockcore::Real>(0.15);
-  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kApplied), static_cast<int>(r.daemon->request_reload(next, r.clock.t, msg)));
+  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kApplied),
+              static_cast<int>(r.daemon->request_reload(next, r.clock.t, msg)));
   STRCMP_CONTAINS("good.toml: config reloaded", msg.c_str());
   CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
   CHECK_EQUAL(1u, r.daemon->counters().config_reloads);
@@ -509,7 +533,8 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
     std::fputs("[watchdog]\nchassis_stale_ms = 500\nlidar_stale_ms = \"fast\"\n", f);
     std::fclose(f);
   }
-  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kRejected), static_cast<int>(r.daemon->reload_from_file(bad, r.clock.t, msg)));
+  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kRejected),
+              static_cast<int>(r.daemon->reload_from_file(bad, r.clock.t, msg)));
   STRCMP_CONTAINS((bad + ":3:18: watchdog.lidar_stale_ms must be an integer").c_str(), msg.c_str());
   STRCMP_CONTAINS("running configuration stays", msg.c_str());
   CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
@@ -520,7 +545,8 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   other.source = "restart.toml";
   other.can_interface = "vcan7";
   other.chassis_stale_ms = 400;
-  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kRejected), static_cast<int>(r.daemon->request_reload(other, r.clock.t, msg)));
+  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kRejected),
+              static_cast<int>(r.daemon->request_reload(other, r.clock.t, msg)));
   STRCMP_CONTAINS("restart-only keys changed (can.interface)", msg.c_str());
   CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
   STRCMP_EQUAL("can0", r.daemon->config().can_interface.c_str());
@@ -533,7 +559,8 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   slow.source = "slow.toml";
   slow.smooth.v_max_mps = static_cast<dockcore::Real>(0.05);
   slow.chassis_stale_ms = 250;
-  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kPending), static_cast<int>(r.daemon->request_reload(slow, r.clock.t, msg)));
+  CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kPending),
+              static_cast<int>(r.daemon->request_reload(slow, r.clock.t, msg)));
   STRCMP_CONTAINS("pending until the task is idle (state ALIGN)", msg.c_str());
   CHECK_TRUE(r.daemon->reload_pending());
   for (int i = 0; i < 10; ++i) {
@@ -595,8 +622,13 @@ TEST(DockdDaemon, PushDuringALateScanGapIsReportedAfterTheResume) {
       }
       r.scan_lag_us = 0;
       const int want = turned != 0 ? 179 : 178;
-      CHECK_TEXT(r.run_until([&] { return static_cast<int>(r.daemon->fault()) == want ||
-                                          r.daemon->state() == TaskState::kFinishTasking; }, 30.0), what);
+      CHECK_TEXT(r.run_until(
+                     [&] {
+                       return static_cast<int>(r.daemon->fault()) == want ||
+                              r.daemon->state() == TaskState::kFinishTasking;
+                     },
+                     30.0),
+                 what);
       CHECK_EQUAL_TEXT(want, static_cast<int>(r.daemon->fault()), what);
       CHECK_TEXT(r.wheels_zero(), what);
     }
@@ -621,8 +653,13 @@ TEST(DockdDaemon, ChassisOutageResumeKeepsThePushReference) {
     r.run_until([] { return false; }, 0.5);
     r.link.silent = false;
     if (pushed != 0) {
-      CHECK_TEXT(r.run_until([&] { return static_cast<int>(r.daemon->fault()) == 178 ||
-                                          r.daemon->state() == TaskState::kFinishTasking; }, 30.0), what);
+      CHECK_TEXT(r.run_until(
+                     [&] {
+                       return static_cast<int>(r.daemon->fault()) == 178 ||
+                              r.daemon->state() == TaskState::kFinishTasking;
+                     },
+                     30.0),
+                 what);
       CHECK_EQUAL_TEXT(178, static_cast<int>(r.daemon->fault()), what);
       CHECK_TEXT(r.wheels_zero(), what);
     } else {
@@ -630,4 +667,29 @@ TEST(DockdDaemon, ChassisOutageResumeKeepsThePushReference) {
     }
     CHECK_EQUAL_TEXT(1u, r.daemon->counters().resumes, what);
   }
+}
+
+// A camera that stops delivering frames mid-docking is reported (status flag, counter, watchdog event) and changes
+// nothing else: the docking goes on with the lidar alone — no hold, no fault, no retry.
+TEST(DockdDaemon, ACameraStallIsReportedAndTheDockingGoesOnWithTheLidar) {
+  Rig r("camstall", false, 1.2, true, true);
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
+  CHECK_FALSE(r.daemon->camera_stalled());
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kAlign && !r.wheels_zero(); }, 20.0));
+  r.camera_live = false;
+  const std::uint64_t last = r.frames.last;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->camera_stalled(); }, 1.0));
+  CHECK(r.clock.t - last <= 220000);  // stall_ms (200) plus at most one tick
+  CHECK_FALSE(r.wheels_zero());       // still driving
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
+  CHECK_TRUE(r.chassis->state().charging);
+  CHECK_TRUE(r.daemon->camera_stalled());
+  CHECK_EQUAL(1u, r.daemon->counters().camera_stalls);
+  CHECK_EQUAL(0u, r.daemon->counters().resumes);
+  CHECK_EQUAL(0u, r.daemon->counters().lidar_stale_trips);
+  CHECK_EQUAL(0, static_cast<int>(r.daemon->last_status().retries));
+  const std::string ev = r.events("watchdog");
+  CHECK_TRUE(ev.find("\"which\":\"camera\",\"stale\":true") != std::string::npos);
+  CHECK_TRUE(ev.find("\"camera_stalls\":1") != std::string::npos);
 }

@@ -4,9 +4,11 @@
 //   camera-check detect --image photo.jpg --fx 600 ...               tags in one image, with pose
 //   camera-check bench --image photo.jpg --frames 200                detection time per 640×480 grey frame
 //   camera-check tag-pose --frames 300 --distance 1.0                 dock pose from a tag on rendered frames
+//   camera-check calib --distance 1.0 --fx 610 ... --image a.jpg      a calibration against a tag at a known distance
 // Output is JSON, one object per line. Exit status: 0 ok, 1 the check failed (capture: no frame, stamps not
-// increasing, --expect-reconnect without a loss and reopen; detect: no tag), 2 usage or option error, 3 the device
-// could not be used (refused, or no frame for --give-up-seconds).
+// increasing, --expect-reconnect without a loss and reopen; detect: no tag; calib: off by more than the tolerance),
+// 2 usage or option error, 3 the device could not be used (refused, or no frame for --give-up-seconds), 4 calib: no
+// frame held the tag.
 #include <fcntl.h>
 #include <linux/videodev2.h>
 #include <sys/ioctl.h>
@@ -23,9 +25,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "calib.hpp"
 #include "dockcore/drivers/apriltag_detector.hpp"
+#include "dockcore/drivers/jpeg_grey.hpp"
 #include "dockcore/drivers/v4l2_camera.hpp"
-#include "jpeg_grey.hpp"
 #include "tag_pose.hpp"
 
 using namespace dockcore::drivers;
@@ -95,23 +98,24 @@ bool set_control(const std::string& device, const std::string& spec, std::string
 
 void print_counters(const char* type, const V4l2Camera& cam, std::uint64_t backsteps, std::uint64_t max_age_us) {
   const auto& c = cam.counters();
-  std::printf("{\"type\":\"%s\",\"t_us\":%llu,\"connected\":%s,\"frames\":%llu,\"dropped\":%llu,\"late\":%llu,"
-              "\"corrupt\":%llu,\"disconnects\":%u,\"reconnects\":%u,\"driver_stamps\":%s,\"stamp_backsteps\":%llu,"
-              "\"max_age_us\":%llu,\"error\":\"%s\"}\n",
-              type, static_cast<unsigned long long>(mono_us()), cam.connected() ? "true" : "false",
-              static_cast<unsigned long long>(c.frames), static_cast<unsigned long long>(c.dropped),
-              static_cast<unsigned long long>(c.late), static_cast<unsigned long long>(c.corrupt), c.disconnects,
-              c.reconnects, cam.driver_stamps() ? "true" : "false", static_cast<unsigned long long>(backsteps),
-              static_cast<unsigned long long>(max_age_us), json_escape(cam.last_error()).c_str());
+  std::printf(
+      "{\"type\":\"%s\",\"t_us\":%llu,\"connected\":%s,\"frames\":%llu,\"dropped\":%llu,\"late\":%llu,"
+      "\"corrupt\":%llu,\"disconnects\":%u,\"reconnects\":%u,\"driver_stamps\":%s,\"stamp_backsteps\":%llu,"
+      "\"max_age_us\":%llu,\"error\":\"%s\"}\n",
+      type, static_cast<unsigned long long>(mono_us()), cam.connected() ? "true" : "false",
+      static_cast<unsigned long long>(c.frames), static_cast<unsigned long long>(c.dropped),
+      static_cast<unsigned long long>(c.late), static_cast<unsigned long long>(c.corrupt), c.disconnects, c.reconnects,
+      cam.driver_stamps() ? "true" : "false", static_cast<unsigned long long>(backsteps),
+      static_cast<unsigned long long>(max_age_us), json_escape(cam.last_error()).c_str());
   std::fflush(stdout);
 }
 
 void print_detection(const TagDetection& d) {
-  std::printf("{\"type\":\"tag\",\"id\":%d,\"u_px\":%.3f,\"v_px\":%.3f,\"decision_margin\":%.2f,\"hamming\":%d,"
-              "\"corners_px\":[[%.3f,%.3f],[%.3f,%.3f],[%.3f,%.3f],[%.3f,%.3f]]",
-              d.id, d.u_px, d.v_px, d.decision_margin, d.hamming, d.corners_px[0][0], d.corners_px[0][1],
-              d.corners_px[1][0], d.corners_px[1][1], d.corners_px[2][0], d.corners_px[2][1], d.corners_px[3][0],
-              d.corners_px[3][1]);
+  std::printf(
+      "{\"type\":\"tag\",\"id\":%d,\"u_px\":%.3f,\"v_px\":%.3f,\"decision_margin\":%.2f,\"hamming\":%d,"
+      "\"corners_px\":[[%.3f,%.3f],[%.3f,%.3f],[%.3f,%.3f],[%.3f,%.3f]]",
+      d.id, d.u_px, d.v_px, d.decision_margin, d.hamming, d.corners_px[0][0], d.corners_px[0][1], d.corners_px[1][0],
+      d.corners_px[1][1], d.corners_px[2][0], d.corners_px[2][1], d.corners_px[3][0], d.corners_px[3][1]);
   if (d.has_pose) {
     std::printf(",\"x_m\":%.4f,\"y_m\":%.4f,\"z_m\":%.4f,\"pose_error\":%.3g", d.translation_m[0], d.translation_m[1],
                 d.translation_m[2], d.pose_error);
@@ -122,8 +126,8 @@ void print_detection(const TagDetection& d) {
 /// The image as a width×height grey frame: decoded, then the centre cropped (or padded with mid-grey) to the size.
 bool load_frame(const std::string& path, std::uint32_t w, std::uint32_t h, std::vector<std::uint8_t>& out,
                 std::string& err) {
-  camera_check::GreyImage img;
-  if (!camera_check::decode_jpeg_grey(path, img, err)) return false;
+  GreyImage img;
+  if (!read_jpeg_grey(path, img, err)) return false;
   out.assign(static_cast<std::size_t>(w) * h, 128);
   const long ox = (static_cast<long>(img.width_px) - static_cast<long>(w)) / 2;
   const long oy = (static_cast<long>(img.height_px) - static_cast<long>(h)) / 2;
@@ -133,7 +137,8 @@ bool load_frame(const std::string& path, std::uint32_t w, std::uint32_t h, std::
     for (std::uint32_t c = 0; c < w; ++c) {
       const long sc = static_cast<long>(c) + ox;
       if (sc < 0 || sc >= static_cast<long>(img.width_px)) continue;
-      out[static_cast<std::size_t>(r) * w + c] = img.pixels[static_cast<std::size_t>(sr) * img.width_px + static_cast<std::size_t>(sc)];
+      out[static_cast<std::size_t>(r) * w + c] =
+          img.pixels[static_cast<std::size_t>(sr) * img.width_px + static_cast<std::size_t>(sc)];
     }
   }
   return true;
@@ -159,13 +164,17 @@ int main(int argc, char** argv) {
   bool expect_reconnect = false;
   double give_up_s = 10;
   std::uint64_t after_reconnect = 0;
-  auto* cap = app.add_subcommand("capture", "capture frames; one JSON line per frame (--every N), state changes and a summary");
+  auto* cap =
+      app.add_subcommand("capture", "capture frames; one JSON line per frame (--every N), state changes and a summary");
   cap->add_option("--device", cam_opt.device, "V4L2 device")->capture_default_str();
-  cap->add_option("--format", format, "grey | yuyv")->check(CLI::IsMember({"grey", "yuyv"}))->capture_default_str();
+  cap->add_option("--format", format, "grey | yuyv | mjpeg")
+      ->check(CLI::IsMember({"grey", "yuyv", "mjpeg"}))
+      ->capture_default_str();
   cap->add_option("--width", cam_opt.width_px, "px")->capture_default_str();
   cap->add_option("--height", cam_opt.height_px, "px")->capture_default_str();
   cap->add_option("--fps", cam_opt.fps, "frame rate to ask for (0 = device default)")->capture_default_str();
-  cap->add_option("--late-ms", cam_opt.late_ms, "a frame dequeued later than this after its stamp is late")->capture_default_str();
+  cap->add_option("--late-ms", cam_opt.late_ms, "a frame dequeued later than this after its stamp is late")
+      ->capture_default_str();
   cap->add_option("--reconnect-min-ms", cam_opt.reconnect_min_ms)->capture_default_str();
   cap->add_option("--reconnect-max-ms", cam_opt.reconnect_max_ms)->capture_default_str();
   cap->add_option("--frames", frames, "stop after this many frames (0 = no limit)");
@@ -222,6 +231,31 @@ int main(int argc, char** argv) {
   tagpose->add_option("--focal", tp_fx, "focal length of the rendered 640×480 camera, px")->capture_default_str();
   tagpose->add_option("--seed", tp.seed)->capture_default_str();
 
+  camera_check::CalibOptions calib_opt;
+  std::vector<std::string> calib_images;
+  V4l2CameraOptions calib_cam;
+  std::string calib_format = "grey";
+  auto* calib = app.add_subcommand(
+      "calib", "check a calibration: a tag at a measured distance in a few frames (device or JPEG images)");
+  calib->add_option("--distance", calib_opt.distance_m, "lens to tag along the optical axis, m (measured)")->required();
+  calib->add_option("--lateral", calib_opt.lateral_m, "tag centre right of the optical axis, m (measured)")
+      ->capture_default_str();
+  calib->add_option("--frames", calib_opt.frames, "device: frames with the tag to average")->capture_default_str();
+  calib->add_option("--tag-id", calib_opt.tag_id, "the tag to use (-1: the strongest)")->capture_default_str();
+  calib->add_option("--tolerance", calib_opt.tolerance, "ok within this fraction of the distance")
+      ->capture_default_str();
+  calib->add_option("--image", calib_images, "JPEG frame (repeatable) instead of a device");
+  calib->add_option("--device", calib_cam.device, "V4L2 device")->capture_default_str();
+  calib->add_option("--format", calib_format, "grey | yuyv | mjpeg")
+      ->check(CLI::IsMember({"grey", "yuyv", "mjpeg"}))
+      ->capture_default_str();
+  calib->add_option("--width", calib_cam.width_px, "px")->capture_default_str();
+  calib->add_option("--height", calib_cam.height_px, "px")->capture_default_str();
+  calib->add_option("--give-up-seconds", calib_opt.give_up_s, "device: stop after this long without the tag")
+      ->capture_default_str();
+  add_detector_options(calib, nullptr);
+  add_intrinsics(calib);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -243,6 +277,26 @@ int main(int argc, char** argv) {
     k.k3 = d[4];
     det_opt.intrinsics = k;
   };
+  if (calib->parsed()) {
+    // A default tag size would silently scale every distance: the size of the tag in front of the camera is required.
+    if (calib->get_option("--tag-size")->count() == 0) {
+      std::fprintf(stderr, "camera-check calib: --tag-size (the black square's side, camera.tag.size_m) is required\n");
+      return camera_check::kCalibUsage;
+    }
+    if (!calib_images.empty()) {
+      // The principal point defaults to the centre of the first image.
+      GreyImage first;
+      if (!read_jpeg_grey(calib_images.front(), first, err)) {
+        std::fprintf(stderr, "camera-check calib: %s\n", err.c_str());
+        return camera_check::kCalibUsage;
+      }
+      set_intrinsics(first.width_px, first.height_px);
+      return camera_check::run_calib_images(calib_images, calib_opt, det_opt);
+    }
+    calib_cam.format = *parse_camera_pixel_format(calib_format);
+    set_intrinsics(calib_cam.width_px, calib_cam.height_px);
+    return camera_check::run_calib_device(calib_cam, calib_opt, det_opt);
+  }
   if (cap->parsed()) {
     cam_opt.format = *parse_camera_pixel_format(format);
     std::unique_ptr<TagDetector> live;
@@ -298,9 +352,10 @@ int main(int argc, char** argv) {
       const std::uint64_t age = now >= f.stamp_us ? now - f.stamp_us : 0;
       max_age = std::max(max_age, age);
       if (every > 0 && cam->counters().frames % every == 0) {
-        std::printf("{\"type\":\"frame\",\"seq\":%u,\"stamp_us\":%llu,\"age_us\":%llu,\"mean\":%u}\n", f.sequence,
-                    static_cast<unsigned long long>(f.stamp_us), static_cast<unsigned long long>(age),
-                    static_cast<unsigned>(f.grey[static_cast<std::size_t>(f.height_px / 2) * f.stride_bytes + f.width_px / 2]));
+        std::printf(
+            "{\"type\":\"frame\",\"seq\":%u,\"stamp_us\":%llu,\"age_us\":%llu,\"mean\":%u}\n", f.sequence,
+            static_cast<unsigned long long>(f.stamp_us), static_cast<unsigned long long>(age),
+            static_cast<unsigned>(f.grey[static_cast<std::size_t>(f.height_px / 2) * f.stride_bytes + f.width_px / 2]));
         std::fflush(stdout);
       }
       if (live) {
@@ -329,7 +384,8 @@ int main(int argc, char** argv) {
     const std::uint32_t cells[4] = {4, 6, 8, 12};
     std::uint32_t x = 10;
     for (int i = 0; i < 4; ++i) {
-      if (!draw_tag_upright("tag36h11", i, cells[i], x, 20 + 20 * static_cast<std::uint32_t>(i), frame.data(), w, h, w)) {
+      if (!draw_tag_upright("tag36h11", i, cells[i], x, 20 + 20 * static_cast<std::uint32_t>(i), frame.data(), w, h,
+                            w)) {
         std::fprintf(stderr, "camera-check: a %ux%u frame is too small for the drawn tags\n", w, h);
         return 2;
       }
@@ -337,8 +393,8 @@ int main(int argc, char** argv) {
     }
     image = "drawn";
   } else if (det->parsed()) {
-    camera_check::GreyImage img;
-    if (!camera_check::decode_jpeg_grey(image, img, err)) {
+    GreyImage img;
+    if (!read_jpeg_grey(image, img, err)) {
       std::fprintf(stderr, "camera-check: %s\n", err.c_str());
       return 2;
     }
@@ -373,10 +429,14 @@ int main(int argc, char** argv) {
   std::sort(ms.begin(), ms.end());
   double sum = 0;
   for (double v : ms) sum += v;
-  const auto pct = [&](double p) { return ms[std::min(ms.size() - 1, static_cast<std::size_t>(p * static_cast<double>(ms.size())))]; };
-  std::printf("{\"type\":\"bench\",\"image\":\"%s\",\"width_px\":%u,\"height_px\":%u,\"family\":\"%s\",\"decimate\":%g,"
-              "\"threads\":%d,\"frames\":%zu,\"tags\":%zu,\"mean_ms\":%.3f,\"median_ms\":%.3f,\"p95_ms\":%.3f,\"max_ms\":%.3f}\n",
-              json_escape(image).c_str(), w, h, det_opt.family.c_str(), det_opt.quad_decimate, det_opt.threads,
-              ms.size(), tags, sum / static_cast<double>(ms.size()), pct(0.5), pct(0.95), ms.back());
+  const auto pct = [&](double p) {
+    return ms[std::min(ms.size() - 1, static_cast<std::size_t>(p * static_cast<double>(ms.size())))];
+  };
+  std::printf(
+      "{\"type\":\"bench\",\"image\":\"%s\",\"width_px\":%u,\"height_px\":%u,\"family\":\"%s\",\"decimate\":%g,"
+      "\"threads\":%d,\"frames\":%zu,\"tags\":%zu,\"mean_ms\":%.3f,\"median_ms\":%.3f,\"p95_ms\":%.3f,\"max_ms\":%.3f}"
+      "\n",
+      json_escape(image).c_str(), w, h, det_opt.family.c_str(), det_opt.quad_decimate, det_opt.threads, ms.size(), tags,
+      sum / static_cast<double>(ms.size()), pct(0.5), pct(0.95), ms.back());
   return 0;
 }

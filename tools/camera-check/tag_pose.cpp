@@ -73,26 +73,33 @@ double rms(const std::vector<double>& v) {
 
 }  // namespace
 
+bool make_tag_pattern(const std::string& family, int id, double tag_size_m, std::vector<std::uint8_t>& cells,
+                      docksim::TagPattern& pattern) {
+  // One pixel per cell: the smallest image the tag fits in is its side in cells.
+  cells.assign(64 * 64, 0);
+  std::uint32_t black_cells = 0;
+  std::uint32_t side = 0;
+  for (std::uint32_t n = 4; n <= 64 && black_cells == 0; ++n) {
+    if (dockcore::drivers::draw_tag_upright(family, id, 1, 0, 0, cells.data(), n, n, n, &black_cells)) side = n;
+  }
+  if (side == 0) return false;
+  cells.resize(static_cast<std::size_t>(side) * side);
+  pattern = docksim::TagPattern{cells.data(), side, tag_size_m / black_cells};
+  return true;
+}
+
 int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions det, double fx_px) {
   if (o.frames == 0 || o.distance_m <= 0 || fx_px <= 0 || det.tag_size_m <= 0) {
     std::fprintf(stderr, "camera-check tag-pose: --frames, --distance, --fx and --tag-size must be > 0\n");
     return 2;
   }
   const int family_id = 3;
-  // The pattern, one pixel per cell, and the black square's side in cells.
-  std::vector<std::uint8_t> cells(64 * 64, 0);
-  std::uint32_t black_cells = 0;
-  std::uint32_t side = 0;
-  for (std::uint32_t n = 4; n <= 64 && black_cells == 0; ++n) {
-    if (dockcore::drivers::draw_tag_upright(det.family, family_id, 1, 0, 0, cells.data(), n, n, n, &black_cells))
-      side = n;
-  }
-  if (side == 0) {
+  std::vector<std::uint8_t> cells;
+  docksim::TagPattern pattern;
+  if (!make_tag_pattern(det.family, family_id, det.tag_size_m, cells, pattern)) {
     std::fprintf(stderr, "camera-check tag-pose: cannot draw tag %d of %s\n", family_id, det.family.c_str());
     return 2;
   }
-  cells.resize(static_cast<std::size_t>(side) * side);
-  const docksim::TagPattern pattern{cells.data(), side, det.tag_size_m / black_cells};
   docksim::PinholeView view;
   view.fx_px = view.fy_px = fx_px;
   view.width_px = o.width_px;

@@ -1,8 +1,11 @@
 #pragma once
 // camera-check tag-pose: the dock pose derived from a tag on rendered frames (docs/camera.md, "Fusion").
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "dockcore/drivers/apriltag_detector.hpp"
+#include "docksim/tag_render.hpp"
 
 namespace camera_check {
 
@@ -17,6 +20,11 @@ struct TagPoseOptions {
   std::uint64_t seed = 1;
   std::uint32_t width_px = 640, height_px = 480;
 };
+
+/// Tag `id` of `family` as the renderer's pattern, one value per code cell (kept in `cells`, which must outlive the
+/// pattern), scaled so its black square is `tag_size_m`. False when the family or id cannot be drawn. Allocates.
+bool make_tag_pattern(const std::string& family, int id, double tag_size_m, std::vector<std::uint8_t>& cells,
+                      docksim::TagPattern& pattern);
 
 /// Renders, detects and prints one JSON summary line (percentiles of the errors of the dock pose in the robot frame,
 /// the model's σ). Returns the exit status: 0, 1 when no frame had the tag, 2 for bad options.

@@ -21,10 +21,10 @@
 namespace dockcore::drivers {
 
 struct CameraPipelineOptions {
-  std::int32_t target_id = -1;         ///< Only this tag id is the target; -1 = any (the strongest).
-  std::uint32_t max_age_ms = 500;      ///< Targets older than this when polled are refused (counted stale).
-  double full_confidence_margin = 100; ///< Decision margin reported as confidence 1 (confidence = margin / this, ≤ 1).
-  int frame_timeout_ms = 100;          ///< Longest wait for a frame before the thread checks for stop.
+  std::int32_t target_id = -1;          ///< Only this tag id is the target; -1 = any (the strongest).
+  std::uint32_t max_age_ms = 500;       ///< Targets older than this when polled are refused (counted stale).
+  double full_confidence_margin = 100;  ///< Decision margin reported as confidence 1 (confidence = margin / this, ≤ 1).
+  int frame_timeout_ms = 100;           ///< Longest wait for a frame before the thread checks for stop.
 };
 
 /// What one frame's detections give the control tick: seed 003's camera target and, when the detector had
@@ -56,13 +56,14 @@ struct CameraPipelineStats {
   std::uint64_t stale = 0;             ///< Targets older than max_age_ms when polled.
   double detect_last_ms = 0;           ///< Detector time on the last frame.
   double detect_worst_ms = 0;
-  bool have_tag = false;               ///< The last frame held the target:
-  TagDetection last_tag{};             ///< its detection (centre, id, margin, pose).
+  bool have_tag = false;    ///< The last frame held the target:
+  TagDetection last_tag{};  ///< its detection (centre, id, margin, pose).
   std::uint64_t last_tag_stamp_us = 0;
 };
 
-/// Also a hal::TagPoseSource: the target tag's pose of every frame that had one (with intrinsics), in frame order.
-class CameraPipeline final : public hal::CameraTargetSource, public hal::TagPoseSource {
+/// Also a hal::TagPoseSource: the target tag's pose of every frame that had one (with intrinsics), in frame order; and
+/// a hal::CameraFrameMonitor: when the thread last received a frame.
+class CameraPipeline final : public hal::CameraTargetSource, public hal::TagPoseSource, public hal::CameraFrameMonitor {
  public:
   /// Starts the thread. The source and the detector must outlive the pipeline; only the thread uses them.
   /// nullptr + message when the wake-up descriptor or the thread cannot be created.
@@ -79,6 +80,9 @@ class CameraPipeline final : public hal::CameraTargetSource, public hal::TagPose
   bool poll_tag(TagObservation& out) override;
   /// Tag poses dropped because poll_tag was not called for kCameraQueueCapacity results. Tick side only.
   std::uint64_t tags_dropped() const { return tags_dropped_; }
+  /// CLOCK_MONOTONIC µs at which the thread last got a frame from the source, before detecting in it; 0 before the
+  /// first. Lock-free, never blocks. O(1).
+  std::uint64_t last_frame_us() const override { return last_frame_us_.load(std::memory_order_relaxed); }
   /// An eventfd that is readable when the thread has queued a result (poll_target clears it).
   int fd() const override { return event_fd_; }
   /// The latest snapshot; never blocks (when the thread is updating it, the previous snapshot is returned).
@@ -105,6 +109,7 @@ class CameraPipeline final : public hal::CameraTargetSource, public hal::TagPose
   std::atomic<std::size_t> head_{0};
   std::atomic<std::size_t> tail_{0};
   std::atomic<std::uint64_t> stale_{0};
+  std::atomic<std::uint64_t> last_frame_us_{0};
   // Tick side only: the newest drained target not yet polled, and the drained tag poses not yet polled.
   bool pending_target_ = false;
   CameraTarget pending_target_value_{};
@@ -112,7 +117,7 @@ class CameraPipeline final : public hal::CameraTargetSource, public hal::TagPose
   std::size_t tags_head_ = 0, tags_count_ = 0;
   std::uint64_t tags_dropped_ = 0;
   mutable std::mutex stats_mutex_;
-  CameraPipelineStats stats_{};           ///< Written by the thread under stats_mutex_.
+  CameraPipelineStats stats_{};              ///< Written by the thread under stats_mutex_.
   mutable CameraPipelineStats last_read_{};  ///< The tick's copy when the lock was busy.
 };
 

@@ -1,10 +1,12 @@
 #pragma once
 /// @file V4L2 capture behind hal::CameraFrameSource (docs/camera.md): opens a video capture device by path,
-/// negotiates a grey or YUYV format of the configured size, streams through mmap'ed driver buffers and hands out
-/// 8-bit grey frames stamped with the driver's own capture time. A device that vanishes (unplugged, driver unbound,
-/// module removed) is closed, counted and reopened with exponential back-off. Every ioctl is checked; failures name
-/// the device and the ioctl ("camera /dev/video0: VIDIOC_S_FMT: Invalid argument"). Heap: one grey frame buffer,
-/// allocated when the camera is created; nothing after (the capture buffers are the driver's, mapped).
+/// negotiates a grey, YUYV or MJPEG format of the configured size, streams through mmap'ed driver buffers and hands
+/// out 8-bit grey frames stamped with the driver's own capture time. A device that vanishes (unplugged, driver
+/// unbound, module removed) is closed, counted and reopened with exponential back-off. Every ioctl is checked;
+/// failures name the device and the ioctl ("camera /dev/video0: VIDIOC_S_FMT: Invalid argument"). Heap: the grey
+/// frame (two for MJPEG, which decodes into a spare one) and the JPEG decoder, allocated when the camera is created;
+/// nothing after for grey and YUYV (the capture buffers are the driver's, mapped). libjpeg allocates inside every
+/// MJPEG decode: next_frame() runs on the detection thread, which allocates anyway (libapriltag).
 
 #include <cstddef>
 #include <cstdint>
@@ -12,30 +14,32 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "dockcore/hal/camera.hpp"
 
 namespace dockcore::drivers {
 
-/// Pixel formats the driver negotiates (MJPEG is not supported: decoding it would allocate per frame).
+/// Pixel formats the driver negotiates.
 enum class CameraPixelFormat : std::uint8_t {
-  kGrey = 0,  ///< V4L2_PIX_FMT_GREY: 8-bit luma, used as is.
-  kYuyv = 1,  ///< V4L2_PIX_FMT_YUYV: 4:2:2, Y0 U Y1 V; the Y samples are the grey frame.
+  kGrey = 0,   ///< V4L2_PIX_FMT_GREY: 8-bit luma, used as is.
+  kYuyv = 1,   ///< V4L2_PIX_FMT_YUYV: 4:2:2, Y0 U Y1 V; the Y samples are the grey frame.
+  kMjpeg = 2,  ///< V4L2_PIX_FMT_MJPEG: one JPEG per buffer, decoded to grey (needs libjpeg: DOCKCORE_HAVE_JPEG).
 };
 
-/// "grey" | "yuyv" → format; nullopt otherwise.
+/// "grey" | "yuyv" | "mjpeg" → format; nullopt otherwise.
 std::optional<CameraPixelFormat> parse_camera_pixel_format(std::string_view name);
 const char* to_string(CameraPixelFormat f);
 
 struct V4l2CameraOptions {
   std::string device = "/dev/video0";
   CameraPixelFormat format = CameraPixelFormat::kGrey;
-  std::uint32_t width_px = 640;   ///< The device must grant exactly this size.
+  std::uint32_t width_px = 640;  ///< The device must grant exactly this size.
   std::uint32_t height_px = 480;
-  std::uint32_t fps = 0;          ///< Frame rate asked for with VIDIOC_S_PARM; 0 = the device's default.
-  std::uint32_t buffers = 4;      ///< Capture buffers asked for (2..kMaxV4l2Buffers; the driver may grant more).
-  std::uint32_t late_ms = 100;    ///< A frame dequeued more than this after its capture stamp counts as late.
-  std::uint32_t reconnect_min_ms = 200;   ///< First reopen delay after the device vanished; doubles per failure.
+  std::uint32_t fps = 0;                 ///< Frame rate asked for with VIDIOC_S_PARM; 0 = the device's default.
+  std::uint32_t buffers = 4;             ///< Capture buffers asked for (2..kMaxV4l2Buffers; the driver may grant more).
+  std::uint32_t late_ms = 100;           ///< A frame dequeued more than this after its capture stamp counts as late.
+  std::uint32_t reconnect_min_ms = 200;  ///< First reopen delay after the device vanished; doubles per failure.
   std::uint32_t reconnect_max_ms = 2000;  ///< Cap of the reopen delay.
 };
 
@@ -94,6 +98,45 @@ class SequenceTracker {
 inline bool frame_complete(std::uint32_t bytes_used, std::uint32_t expected_bytes, bool error_flag) {
   return !error_flag && bytes_used >= expected_bytes;
 }
+
+/// A dequeued buffer → the grey frame, for every format: GREY and YUYV copied (row stride bytes_per_line), MJPEG
+/// decoded with libjpeg. Owns the frame (and for MJPEG a spare frame and the decoder). A buffer that is not a frame —
+/// flagged errored, fewer bytes than a GREY/YUYV image, an empty, undecodable or damaged JPEG, a JPEG of another
+/// size — is counted in corrupt() and leaves frame() untouched.
+class FrameConverter {
+ public:
+  /// Allocates the frame(s) and, for MJPEG, the decoder. The layout defaults to packed rows.
+  FrameConverter(CameraPixelFormat format, std::uint32_t width_px, std::uint32_t height_px);
+  ~FrameConverter();
+  FrameConverter(const FrameConverter&) = delete;
+  FrameConverter& operator=(const FrameConverter&) = delete;
+  /// The granted row stride of GREY and YUYV buffers, bytes (≥ a row of pixels; ignored for MJPEG). O(1).
+  void set_bytes_per_line(std::uint32_t bytes_per_line);
+  /// Bytes a complete GREY / YUYV buffer fills (the last row needs only its pixels); 0 for MJPEG. O(1).
+  std::uint32_t min_bytes() const;
+  /// Converts `bytes_used` bytes of a dequeued buffer. True: frame() holds the new image. False: corrupt (counted;
+  /// the reason in error()), frame() as before. O(w·h) (MJPEG: plus the decode).
+  bool convert(const std::uint8_t* data, std::uint32_t bytes_used, bool error_flag);
+  /// The latest good frame: width × height, packed rows (all zero before the first).
+  const std::uint8_t* frame() const { return frame_; }
+  std::uint64_t corrupt() const { return corrupt_; }
+  /// Why the last convert() failed; "" after a success. Never null.
+  const char* error() const { return error_; }
+
+ private:
+  bool reject(const char* why);
+
+  CameraPixelFormat format_;
+  std::uint32_t width_px_, height_px_;
+  std::uint32_t bytes_per_line_;
+  std::vector<std::uint8_t> a_, b_;  ///< The frame and, for MJPEG, the spare the next one is decoded into.
+  std::uint8_t* frame_ = nullptr;
+  std::uint8_t* spare_ = nullptr;
+  struct Jpeg;
+  std::unique_ptr<Jpeg> jpeg_;
+  std::uint64_t corrupt_ = 0;
+  char error_[200] = "";
+};
 
 }  // namespace v4l2_detail
 

@@ -4,7 +4,8 @@
 ///    vision process (the UDP datagram of docs/dockd.md) or from dockd's own detector (docs/camera.md);
 ///  - TagPoseSource: the dock tag's pose per frame (DockcoreBase::on_tag's input), from dockd's own detector;
 ///  - CameraFrameSource: raw grey frames from a capture device (a V4L2 camera), stamped by the driver, for a
-///    detector that runs on the robot's board.
+///    detector that runs on the robot's board;
+///  - CameraFrameMonitor: when such a source last delivered a frame (the stall watchdog).
 
 #include <cstddef>
 #include <cstdint>
@@ -35,6 +36,17 @@ class TagPoseSource {
   ~TagPoseSource() = default;
 };
 
+/// When the camera last delivered a frame, for a watchdog on the control tick (dockd's camera stall, docs/camera.md).
+class CameraFrameMonitor {
+ public:
+  /// CLOCK_MONOTONIC µs at which the newest frame arrived from the device (whether or not it held a tag); 0 before
+  /// the first. Never blocks. O(1).
+  virtual std::uint64_t last_frame_us() const = 0;
+
+ protected:
+  ~CameraFrameMonitor() = default;
+};
+
 /// One captured frame as 8-bit grey, row-major. The pixels belong to the source and stay valid until the next
 /// next_frame() call on it.
 struct CameraFrame {
@@ -42,16 +54,17 @@ struct CameraFrame {
   std::uint32_t width_px = 0;
   std::uint32_t height_px = 0;
   std::uint32_t stride_bytes = 0;
-  std::uint64_t stamp_us = 0;   ///< Capture time on CLOCK_MONOTONIC, µs (the driver's stamp, not the read time).
-  std::uint32_t sequence = 0;   ///< The device's frame counter (gaps are dropped frames).
+  std::uint64_t stamp_us = 0;  ///< Capture time on CLOCK_MONOTONIC, µs (the driver's stamp, not the read time).
+  std::uint32_t sequence = 0;  ///< The device's frame counter (gaps are dropped frames).
 };
 
 /// Counters of a frame source since it was created (never reset, so a reader can take differences).
 struct CameraFrameCounters {
-  std::uint64_t frames = 0;       ///< Frames handed out by next_frame().
-  std::uint64_t dropped = 0;      ///< Frames the device numbered but never delivered (sequence gaps).
-  std::uint64_t late = 0;         ///< Frames older than the source's late threshold when dequeued (a backlog).
-  std::uint64_t corrupt = 0;      ///< Frames skipped: fewer bytes than the format needs, or flagged as errored.
+  std::uint64_t frames = 0;   ///< Frames handed out by next_frame().
+  std::uint64_t dropped = 0;  ///< Frames the device numbered but never delivered (sequence gaps).
+  std::uint64_t late = 0;     ///< Frames older than the source's late threshold when dequeued (a backlog).
+  std::uint64_t corrupt =
+      0;  ///< Frames skipped: flagged as errored, fewer bytes than the format needs, or undecodable.
   std::uint32_t disconnects = 0;  ///< Times the device went away (open failures not counted).
   std::uint32_t reconnects = 0;   ///< Times it was opened again after a disconnect.
 };
