@@ -367,6 +367,28 @@ TEST(RenderedTag, DetectedWhereTheProjectionPutsItWithItsPose) {
   }
 }
 
+TEST(RenderedTag, RendererPlacesEdgesBetweenItsCoarseSamples) {
+  // A tag turned a little about the vertical: its bottom edge slants by a fraction of a pixel across the tag. The
+  // rendered grey along that edge must follow the slant (an edge crossing a pixel between its coarse samples is
+  // integrated on the fine grid), or sub-pixel corner checks measure the renderer.
+  const RenderedTag r = render(3, 0.0186, 0, 1.0, 0.0692, 0.15);
+  double u0 = 0, v0 = 0, u1 = 0, v1 = 0;
+  CHECK(docksim::project_tag_point(r.view, -0.05, 0.075, u0, v0));
+  CHECK(docksim::project_tag_point(r.view, 0.05, 0.075, u1, v1));
+  CHECK(std::fabs(v0 - v1) > 0.2);  // the edge slants
+  // The black fraction of the pixel row the edge crosses, at both ends, tracks the edge's position.
+  auto edge_row_v = [&](double u, double v) {
+    const auto col = static_cast<std::size_t>(std::lround(u));
+    const auto row = static_cast<std::size_t>(std::lround(v));
+    // Pixels above the edge are black (0), below white (255): the edge sits where the column turns white.
+    const double above = r.image[(row - 1) * kW + col] / 255.0, at = r.image[row * kW + col] / 255.0,
+                 below = r.image[(row + 1) * kW + col] / 255.0;
+    return static_cast<double>(row) - 1.5 + (1 - above) + (1 - at) + (1 - below);
+  };
+  DOUBLES_EQUAL(v0, edge_row_v(u0, v0), 0.05);
+  DOUBLES_EQUAL(v1, edge_row_v(u1, v1), 0.05);
+}
+
 TEST(RenderedTag, RendererRefusesBadInput) {
   std::vector<std::uint8_t> img(kW * kH, 7);
   docksim::PinholeView v;
