@@ -21,6 +21,20 @@ std::uint64_t mono_us() {
 }
 }  // namespace
 
+TagObservation tag_observation(const TagDetection& d, std::uint64_t stamp_us) {
+  TagObservation o;
+  o.id = d.id;
+  o.decision_margin = static_cast<Real>(d.decision_margin);
+  o.stamp_us = stamp_us;
+  for (int k = 0; k < 9; ++k) o.rotation(k / 3, k % 3) = static_cast<Real>(d.rotation[k]);
+  for (int k = 0; k < 3; ++k) o.translation_m(k) = static_cast<Real>(d.translation_m[k]);
+  o.has_corners = true;
+  for (int k = 0; k < 4; ++k) {
+    o.corners[k] = Vec2(static_cast<Real>(d.corners_unit_focal[k][0]), static_cast<Real>(d.corners_unit_focal[k][1]));
+  }
+  return o;
+}
+
 CameraPipeline::CameraPipeline(hal::CameraFrameSource& s, TagDetector& d, const CameraPipelineOptions& o, int efd)
     : source_(s), detector_(d), opt_(o), event_fd_(efd) {}
 
@@ -89,11 +103,7 @@ void CameraPipeline::run() {
       r.target.stamp_us = f.stamp_us;
       if (tag->has_pose) {
         r.has_pose = true;
-        r.tag.id = tag->id;
-        r.tag.decision_margin = static_cast<Real>(tag->decision_margin);
-        r.tag.stamp_us = f.stamp_us;
-        for (int k = 0; k < 9; ++k) r.tag.rotation(k / 3, k % 3) = static_cast<Real>(tag->rotation[k]);
-        for (int k = 0; k < 3; ++k) r.tag.translation_m(k) = static_cast<Real>(tag->translation_m[k]);
+        r.tag = tag_observation(*tag, f.stamp_us);
       }
       if (push(r)) {
         const std::uint64_t one = 1;

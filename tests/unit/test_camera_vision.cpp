@@ -367,6 +367,39 @@ TEST(RenderedTag, DetectedWhereTheProjectionPutsItWithItsPose) {
   }
 }
 
+TEST(RenderedTag, RefinedCornersAreWithinAFewHundredthsOfAPixel) {
+  // The tag's yaw rests on tenths of a pixel of perspective between its left and right edges: the refined corners
+  // must be far better than that, at any pose.
+  struct Case {
+    double x, y, z, yaw_deg, side_m;
+  };
+  const Case cases[] = {{0, 0, 1.0, 4, 0.15}, {0.05, 0.01, 1.0, -9, 0.08}, {-0.12, 0.03, 0.8, 25, 0.10}};
+  for (const Case& c : cases) {
+    const RenderedTag r = render(3, c.x, c.y, c.z, c.yaw_deg * 3.14159265358979 / 180, c.side_m);
+    TagDetectorOptions o;
+    o.tag_size_m = r.black_side_m;
+    o.intrinsics = CameraIntrinsics{r.view.fx_px, r.view.fy_px, r.view.cx_px, r.view.cy_px};
+    std::string err;
+    auto det = TagDetector::create(o, err);
+    TagDetection d[4];
+    CHECK_EQUAL(1u, det->detect(r.image.data(), kW, kH, kW, d, 4));
+    char msg[160];
+    const double h = r.black_side_m / 2;
+    for (int k = 0; k < 4; ++k) {
+      double u = 0, v = 0;
+      CHECK(docksim::project_tag_point(r.view, dockcore::kTagCornerX[k] * h, dockcore::kTagCornerY[k] * h, u, v));
+      const double e = std::hypot(d[0].corners_px[k][0] - u, d[0].corners_px[k][1] - v);
+      std::snprintf(msg, sizeof msg, "yaw %.0f deg, corner %d off by %.3f px", c.yaw_deg, k, e);
+      CHECK_TEXT(e < 0.04, msg);
+      // The unit-focal corners are the same points for the core's corner fit.
+      DOUBLES_EQUAL_TEXT((d[0].corners_px[k][0] - r.view.cx_px) / r.view.fx_px, d[0].corners_unit_focal[k][0], 1e-9,
+                         msg);
+      DOUBLES_EQUAL_TEXT((d[0].corners_px[k][1] - r.view.cy_px) / r.view.fy_px, d[0].corners_unit_focal[k][1], 1e-9,
+                         msg);
+    }
+  }
+}
+
 TEST(RenderedTag, RendererPlacesEdgesBetweenItsCoarseSamples) {
   // A tag turned a little about the vertical: its bottom edge slants by a fraction of a pixel across the tag. The
   // rendered grey along that edge must follow the slant (an edge crossing a pixel between its coarse samples is

@@ -27,6 +27,10 @@ struct CameraPipelineOptions {
   int frame_timeout_ms = 100;          ///< Longest wait for a frame before the thread checks for stop.
 };
 
+/// The tag's pose, corners and decode quality of `d` (which must have its pose) as the core's dock-pose input, stamped
+/// with its frame's capture time. O(1).
+TagObservation tag_observation(const TagDetection& d, std::uint64_t stamp_us);
+
 /// Results the thread can queue before the tick collects them.
 constexpr std::size_t kCameraQueueCapacity = 8;
 
