@@ -188,8 +188,8 @@ bool fit_line(const double (*pts)[2], int n, double line[3]) {
 /// across the edge is sampled and the step's position found from its area (below). The profile reaches half a code
 /// cell to either side, so it sees the black border and the white ring only. libapriltag's own edge refinement
 /// leaves corner errors of ≈ 0.1 px, which the tag's yaw (a few tenths of a pixel of perspective between its left
-/// and right edges) cannot afford. Corners are left alone when an edge yields too few points or a refined corner
-/// lands more than 2 px from the detected one.
+/// and right edges) cannot afford. Corners are left alone for tags with code cells under 5 px, when an edge yields
+/// too few points or when a refined corner lands more than 1 px from the detected one.
 void refine_corners(const image_u8_t& im, int cells_at_border, double p[4][2]) {
   double lines[4][3];
   for (int e = 0; e < 4; ++e) {
@@ -199,7 +199,9 @@ void refine_corners(const image_u8_t& im, int cells_at_border, double p[4][2]) {
     if (!(len > 8)) return;
     const double dx = (b[0] - a[0]) / len, dy = (b[1] - a[1]) / len;
     const double nx = -dy, ny = dx;
-    const double reach = std::clamp(0.5 * len / cells_at_border, 1.0, 4.0);
+    // Half a code cell, at most 4 px; a step needs ±2.5 px to show both its levels through the blur of a lens.
+    const double reach = std::min(0.5 * len / cells_at_border, 4.0);
+    if (reach < 2.5) return;
     constexpr double kStep = 0.25;
     const int half = static_cast<int>(reach / kStep);
     double pts[256][2];
@@ -238,7 +240,7 @@ void refine_corners(const image_u8_t& im, int cells_at_border, double p[4][2]) {
     q[c][0] = (l0[2] * l1[1] - l0[1] * l1[2]) / det;
     q[c][1] = (l0[0] * l1[2] - l0[2] * l1[0]) / det;
     // A refined corner far from the detected one means the lines were not the square's edges.
-    if (std::hypot(q[c][0] - p[c][0], q[c][1] - p[c][1]) > 2) return;
+    if (std::hypot(q[c][0] - p[c][0], q[c][1] - p[c][1]) > 1) return;
   }
   std::memcpy(p, q, sizeof q);
 }
