@@ -50,8 +50,8 @@ struct TagFusionParams {
   Real tag_size_m = static_cast<Real>(0.1);  ///< Side of the tag's black square (dockd: [camera.tag] size_m). > 0.
   DockTag dock_tag{};                        ///< The active dock's tag (dockd: its [[docks]] entry).
   /// Effective corner noise of the detector, px: the model's one free parameter (see the file comment). Measured
-  /// on rendered frames with noise and blur: `camera-check tag-pose`.
-  Real sigma_px = static_cast<Real>(0.3);
+  /// on rendered frames with noise and blur, corners refined and fitted: `camera-check tag-pose`.
+  Real sigma_px = static_cast<Real>(0.04);
   Real sigma_scale = 1;                       ///< Multiplies every σ of the model (inflate for a poorer camera).
   Real min_decision_margin = 0;               ///< Detections with a smaller decision margin are refused (kWeak).
   Real max_range_m = static_cast<Real>(3.0);  ///< Tags farther than this along the optical axis are refused (kFar).
