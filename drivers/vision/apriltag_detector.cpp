@@ -209,11 +209,11 @@ void refine_corners(const image_u8_t& im, int cells_at_border, double p[4][2]) {
     const int samples = std::min(256, static_cast<int>(len * 0.7));
     for (int i = 0; i < samples; ++i) {
       const double t = len * (0.15 + 0.7 * (i + 0.5) / samples);
-      const double cx = a[0] + dx * t, cy = a[1] + dy * t;
+      const double ex = a[0] + dx * t, ey = a[1] + dy * t;  // on the current edge
       double prof[40];
       bool ok = half * 2 + 1 <= 40;
       for (int k = -half; k <= half && ok; ++k)
-        ok = sample(im, cx + nx * k * kStep, cy + ny * k * kStep, prof[k + half]);
+        ok = sample(im, ex + nx * k * kStep, ey + ny * k * kStep, prof[k + half]);
       if (!ok) continue;
       const double lo = (prof[0] + prof[1] + prof[2]) / 3;
       const double hi = (prof[2 * half] + prof[2 * half - 1] + prof[2 * half - 2]) / 3;
@@ -225,8 +225,8 @@ void refine_corners(const image_u8_t& im, int cells_at_border, double p[4][2]) {
       for (int k = 0; k < 2 * half; ++k) low_side += 0.5 * ((hi - prof[k]) + (hi - prof[k + 1])) / (hi - lo) * kStep;
       const double best = low_side - half * kStep;
       if (!(std::fabs(best) < reach)) continue;
-      pts[n][0] = cx + nx * best;
-      pts[n][1] = cy + ny * best;
+      pts[n][0] = ex + nx * best;
+      pts[n][1] = ey + ny * best;
       ++n;
     }
     if (!fit_line(pts, n, lines[e])) return;

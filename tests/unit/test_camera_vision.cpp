@@ -241,6 +241,11 @@ TEST(CameraPipeline, TagPosesComeInFrameOrderWithTheirStampsBesideTheTarget) {
   CHECK(b.stamp_us > a.stamp_us);
   CHECK(a.translation_m.z() > 0);
   CHECK(a.decision_margin > 0);
+  // The corners for the core's corner fit: around the tag's centre, in unit-focal coordinates.
+  CHECK(a.has_corners);
+  const dockcore::Vec2 mean = (a.corners[0] + a.corners[1] + a.corners[2] + a.corners[3]) / 4;
+  DOUBLES_EQUAL(a.translation_m.x() / a.translation_m.z(), mean.x(), 1e-3);
+  DOUBLES_EQUAL(a.translation_m.y() / a.translation_m.z(), mean.y(), 1e-3);
   CameraTarget t;
   CHECK(p->poll_target(t));
   CHECK(t.stamp_us >= b.stamp_us);
