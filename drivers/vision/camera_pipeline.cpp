@@ -21,6 +21,20 @@ std::uint64_t mono_us() {
 }
 }  // namespace
 
+TagObservation tag_observation(const TagDetection& d, std::uint64_t stamp_us) {
+  TagObservation o;
+  o.id = d.id;
+  o.decision_margin = static_cast<Real>(d.decision_margin);
+  o.stamp_us = stamp_us;
+  for (int k = 0; k < 9; ++k) o.rotation(k / 3, k % 3) = static_cast<Real>(d.rotation[k]);
+  for (int k = 0; k < 3; ++k) o.translation_m(k) = static_cast<Real>(d.translation_m[k]);
+  o.has_corners = true;
+  for (int k = 0; k < 4; ++k) {
+    o.corners[k] = Vec2(static_cast<Real>(d.corners_unit_focal[k][0]), static_cast<Real>(d.corners_unit_focal[k][1]));
+  }
+  return o;
+}
+
 CameraPipeline::CameraPipeline(hal::CameraFrameSource& s, TagDetector& d, const CameraPipelineOptions& o, int efd)
     : source_(s), detector_(d), opt_(o), event_fd_(efd) {}
 
@@ -66,11 +80,7 @@ const TagDetection* select_target_tag(const TagDetection* detections, std::size_
   out->target.stamp_us = stamp_us;
   if (tag->has_pose) {
     out->has_pose = true;
-    out->tag.id = tag->id;
-    out->tag.decision_margin = static_cast<Real>(tag->decision_margin);
-    out->tag.stamp_us = stamp_us;
-    for (int k = 0; k < 9; ++k) out->tag.rotation(k / 3, k % 3) = static_cast<Real>(tag->rotation[k]);
-    for (int k = 0; k < 3; ++k) out->tag.translation_m(k) = static_cast<Real>(tag->translation_m[k]);
+    out->tag = tag_observation(*tag, stamp_us);
   }
   return tag;
 }

@@ -53,4 +53,18 @@ inline TagObservation observe_tag(const Pose2& robot, const Pose2& dock, const T
   return o;
 }
 
+/// `o` with its corners: the tag's corners (dockcore::kTagCornerX/Y, side p.tag_size_m) projected through o's
+/// rotation and translation into unit-focal image coordinates, exactly.
+inline TagObservation with_corners(TagObservation o, const TagFusionParams& p) {
+  const double h = static_cast<double>(p.tag_size_m) / 2;
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 c = o.rotation * Vec3(static_cast<dockcore::Real>(dockcore::kTagCornerX[k] * h),
+                                     static_cast<dockcore::Real>(dockcore::kTagCornerY[k] * h), 0) +
+                   o.translation_m;
+    o.corners[k] = Vec2(c.x() / c.z(), c.y() / c.z());
+  }
+  o.has_corners = true;
+  return o;
+}
+
 }  // namespace dockcore_test

@@ -241,6 +241,11 @@ TEST(CameraPipeline, TagPosesComeInFrameOrderWithTheirStampsBesideTheTarget) {
   CHECK(b.stamp_us > a.stamp_us);
   CHECK(a.translation_m.z() > 0);
   CHECK(a.decision_margin > 0);
+  // The corners for the core's corner fit: around the tag's centre, in unit-focal coordinates.
+  CHECK(a.has_corners);
+  const dockcore::Vec2 mean = (a.corners[0] + a.corners[1] + a.corners[2] + a.corners[3]) / 4;
+  DOUBLES_EQUAL(a.translation_m.x() / a.translation_m.z(), mean.x(), 1e-3);
+  DOUBLES_EQUAL(a.translation_m.y() / a.translation_m.z(), mean.y(), 1e-3);
   CameraTarget t;
   CHECK(p->poll_target(t));
   CHECK(t.stamp_us >= b.stamp_us);
@@ -365,6 +370,61 @@ TEST(RenderedTag, DetectedWhereTheProjectionPutsItWithItsPose) {
     DOUBLES_EQUAL_TEXT(c.y, d[0].translation_m[1], 0.01 * c.z, msg);
     DOUBLES_EQUAL_TEXT(c.z, d[0].translation_m[2], 0.01 * c.z, msg);
   }
+}
+
+TEST(RenderedTag, RefinedCornersAreWithinAFewHundredthsOfAPixel) {
+  // The tag's yaw rests on tenths of a pixel of perspective between its left and right edges: the refined corners
+  // must be far better than that, at any pose.
+  struct Case {
+    double x, y, z, yaw_deg, side_m;
+  };
+  const Case cases[] = {{0, 0, 1.0, 4, 0.15}, {0.05, 0.01, 1.0, -9, 0.08}, {-0.12, 0.03, 0.8, 25, 0.10}};
+  for (const Case& c : cases) {
+    const RenderedTag r = render(3, c.x, c.y, c.z, c.yaw_deg * 3.14159265358979 / 180, c.side_m);
+    TagDetectorOptions o;
+    o.tag_size_m = r.black_side_m;
+    o.intrinsics = CameraIntrinsics{r.view.fx_px, r.view.fy_px, r.view.cx_px, r.view.cy_px};
+    std::string err;
+    auto det = TagDetector::create(o, err);
+    TagDetection d[4];
+    CHECK_EQUAL(1u, det->detect(r.image.data(), kW, kH, kW, d, 4));
+    char msg[160];
+    const double h = r.black_side_m / 2;
+    for (int k = 0; k < 4; ++k) {
+      double u = 0, v = 0;
+      CHECK(docksim::project_tag_point(r.view, dockcore::kTagCornerX[k] * h, dockcore::kTagCornerY[k] * h, u, v));
+      const double e = std::hypot(d[0].corners_px[k][0] - u, d[0].corners_px[k][1] - v);
+      std::snprintf(msg, sizeof msg, "yaw %.0f deg, corner %d off by %.3f px", c.yaw_deg, k, e);
+      CHECK_TEXT(e < 0.04, msg);
+      // The unit-focal corners are the same points for the core's corner fit.
+      DOUBLES_EQUAL_TEXT((d[0].corners_px[k][0] - r.view.cx_px) / r.view.fx_px, d[0].corners_unit_focal[k][0], 1e-9,
+                         msg);
+      DOUBLES_EQUAL_TEXT((d[0].corners_px[k][1] - r.view.cy_px) / r.view.fy_px, d[0].corners_unit_focal[k][1], 1e-9,
+                         msg);
+    }
+  }
+}
+
+TEST(RenderedTag, RendererPlacesEdgesBetweenItsCoarseSamples) {
+  // A tag turned a little about the vertical: its bottom edge slants by a fraction of a pixel across the tag. The
+  // rendered grey along that edge must follow the slant (an edge crossing a pixel between its coarse samples is
+  // integrated on the fine grid), or sub-pixel corner checks measure the renderer.
+  const RenderedTag r = render(3, 0.0186, 0, 1.0, 0.0692, 0.15);
+  double u0 = 0, v0 = 0, u1 = 0, v1 = 0;
+  CHECK(docksim::project_tag_point(r.view, -0.05, 0.075, u0, v0));
+  CHECK(docksim::project_tag_point(r.view, 0.05, 0.075, u1, v1));
+  CHECK(std::fabs(v0 - v1) > 0.2);  // the edge slants
+  // The black fraction of the pixel row the edge crosses, at both ends, tracks the edge's position.
+  auto edge_row_v = [&](double u, double v) {
+    const auto col = static_cast<std::size_t>(std::lround(u));
+    const auto row = static_cast<std::size_t>(std::lround(v));
+    // Pixels above the edge are black (0), below white (255): the edge sits where the column turns white.
+    const double above = r.image[(row - 1) * kW + col] / 255.0, at = r.image[row * kW + col] / 255.0,
+                 below = r.image[(row + 1) * kW + col] / 255.0;
+    return static_cast<double>(row) - 1.5 + (1 - above) + (1 - at) + (1 - below);
+  };
+  DOUBLES_EQUAL(v0, edge_row_v(u0, v0), 0.05);
+  DOUBLES_EQUAL(v1, edge_row_v(u1, v1), 0.05);
 }
 
 TEST(RenderedTag, RendererRefusesBadInput) {

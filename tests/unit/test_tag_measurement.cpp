@@ -14,6 +14,7 @@
 
 using namespace dockcore;
 using dockcore_test::observe_tag;
+using dockcore_test::with_corners;
 
 namespace {
 
@@ -96,6 +97,57 @@ TEST(TagMeasurement, RoundTripThroughAnyMountAndTagPlacement) {
     REAL_EQUAL(truth.y_m, m.dock_in_robot.y_m, 1e-5);
     REAL_EQUAL(0, wrap_angle(truth.yaw_rad - m.dock_in_robot.yaw_rad), 1e-5);
   }
+}
+
+TEST(TagMeasurement, CornerFitRecoversTheDockFromAnyStartNearIt) {
+  docksim::Rng rng(23);
+  for (int i = 0; i < 100; ++i) {
+    TagFusionParams p = params();
+    p.mount.y_m = static_cast<Real>(rng.uniform(-0.2, 0.2));
+    p.mount.z_m = static_cast<Real>(rng.uniform(0.1, 0.4));
+    p.mount.yaw_rad = static_cast<Real>(rng.uniform(-0.3, 0.3));
+    p.mount.pitch_rad = static_cast<Real>(rng.uniform(-0.2, 0.2));
+    p.mount.roll_rad = static_cast<Real>(rng.uniform(-0.1, 0.1));
+    p.dock_tag.y_m = static_cast<Real>(rng.uniform(-0.1, 0.1));
+    p.dock_tag.yaw_rad = static_cast<Real>(rng.uniform(-0.3, 0.3));
+    const Pose2 robot{static_cast<Real>(rng.uniform(0.8, 1.8)), static_cast<Real>(rng.uniform(-0.3, 0.3)),
+                      static_cast<Real>(kPi + rng.uniform(-0.3, 0.3))};
+    const TagObservation o = with_corners(observe_tag(robot, Pose2{}, p, nullptr, 0, 1), p);
+    const Pose2 truth = robot.inverse();
+    const Pose2 start{truth.x_m + static_cast<Real>(rng.uniform(-0.03, 0.03)),
+                      truth.y_m + static_cast<Real>(rng.uniform(-0.03, 0.03)),
+                      wrap_angle(truth.yaw_rad + static_cast<Real>(rng.uniform(-0.1, 0.1)))};
+    TagCornerFit f;
+    CHECK(fit_dock_to_tag_corners(o.corners, p, start, &f));
+    REAL_EQUAL(truth.x_m, f.dock_in_robot.x_m, 1e-5);
+    REAL_EQUAL(truth.y_m, f.dock_in_robot.y_m, 1e-5);
+    REAL_EQUAL(0, wrap_angle(truth.yaw_rad - f.dock_in_robot.yaw_rad), 1e-4);
+    CHECK(f.rms_px < 1e-3);
+    CHECK(f.iterations <= kTagFitMaxIterations);
+  }
+}
+
+TEST(TagMeasurement, CornersPickTheRightOneOfThePlanarPoseTwins) {
+  // The robot on the dock's axis, the dock turned 12° against the line of sight; the detector's pose is the twin
+  // (turned −12°), as libapriltag returns it for near face-on tags. The corners are those of the true pose.
+  const TagFusionParams p = params();
+  const Pose2 robot{1.2, 0, kPi};
+  const Real turn = deg_to_rad(static_cast<Real>(12));
+  const Pose2 dock{0, 0, turn};
+  const Pose2 twin{0, 0, -turn};
+  TagObservation o = observe_tag(robot, twin, p, nullptr, 0, 1);
+  const TagObservation right = with_corners(observe_tag(robot, dock, p, nullptr, 0, 1), p);
+  TagMeasurement m;
+  CHECK(tag_to_dock_measurement(o, p, &m) == TagStatus::kFused);
+  const Pose2 truth = robot.inverse().compose(dock);
+  CHECK(std::fabs(wrap_angle(truth.yaw_rad - m.dock_in_robot.yaw_rad)) > deg_to_rad(static_cast<Real>(20)));
+  for (int k = 0; k < 4; ++k) o.corners[k] = right.corners[k];
+  o.has_corners = true;
+  CHECK(tag_to_dock_measurement(o, p, &m) == TagStatus::kFused);
+  REAL_EQUAL(0, wrap_angle(truth.yaw_rad - m.dock_in_robot.yaw_rad), 1e-4);
+  REAL_EQUAL(truth.x_m, m.dock_in_robot.x_m, 1e-5);
+  REAL_EQUAL(truth.y_m, m.dock_in_robot.y_m, 1e-5);
+  CHECK(m.corner_rms_px >= 0 && m.corner_rms_px < 1e-3);
 }
 
 TEST(TagMeasurement, CovarianceMatchesTheScatterOfSimulatedMeasurements) {

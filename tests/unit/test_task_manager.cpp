@@ -877,7 +877,7 @@ struct FacadeSim {
   TagFusionParams tag_truth{};  // where the tag really is (observe_tag), whatever the core is told
   bool tags_on = false;
   bool lidar_sees_dock = true;  // false: every scan has no returns (no lidar detection; the scans still arrive)
-  double tag_sigma_px = 0.3;
+  double tag_sigma_px = static_cast<double>(TagFusionParams{}.sigma_px);  // tags drawn at the model's σ
   docksim::Rng tag_rng{7};  // its own stream: the lidar's noise is the same with and without tags
   struct Past {
     std::uint64_t stamp_us;

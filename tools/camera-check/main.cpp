@@ -194,6 +194,8 @@ int main(int argc, char** argv) {
     s->add_option("--sigma", det_opt.quad_sigma, "quad_sigma, px")->capture_default_str();
     s->add_option("--threads", det_opt.threads, "detector threads")->capture_default_str();
     s->add_option("--refine-edges", det_opt.refine_edges, "true | false")->capture_default_str();
+    s->add_option("--refine-corners", det_opt.refine_corners, "sub-pixel corners from the edges: true | false")
+        ->capture_default_str();
     s->add_option("--tag-size", det_opt.tag_size_m, "black square side, m")->capture_default_str();
   };
   auto add_intrinsics = [&](CLI::App* s) {
@@ -230,6 +232,10 @@ int main(int argc, char** argv) {
   tagpose->add_option("--sigma-px", tp.sigma_px, "the covariance model's corner noise, px")->capture_default_str();
   tagpose->add_option("--focal", tp_fx, "focal length of the rendered 640×480 camera, px")->capture_default_str();
   tagpose->add_option("--seed", tp.seed)->capture_default_str();
+  tagpose
+      ->add_option("--corner-fit", tp.corner_fit,
+                   "fit the dock pose to the corners (true) or take libapriltag's pose alone (false)")
+      ->capture_default_str();
 
   camera_check::CalibOptions calib_opt;
   std::vector<std::string> calib_images;

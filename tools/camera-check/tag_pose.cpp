@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "dockcore/drivers/camera_pipeline.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/tag_measurement.hpp"
 #include "docksim/rng.hpp"
@@ -130,7 +131,7 @@ int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions 
   const Mat3 r_rc = dockcore::camera_rotation(p.mount);
   docksim::Rng rng(o.seed);
   std::vector<std::uint8_t> img(static_cast<std::size_t>(o.width_px) * o.height_px);
-  std::vector<double> lat_mm, depth_mm, yaw_deg, z_lat, z_yaw, in_dock_mm;
+  std::vector<double> lat_mm, depth_mm, yaw_deg, z_lat, z_yaw, in_dock_mm, corner_err_px, fit_rms_px;
   std::uint32_t found = 0;
   for (std::uint32_t i = 0; i < o.frames; ++i) {
     // The dock in the robot frame: ahead at distance + mount, offset sideways, turned.
@@ -156,11 +157,16 @@ int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions 
       if (d[k].id == family_id && d[k].has_pose) tag = &d[k];
     }
     if (tag == nullptr) continue;
-    dockcore::TagObservation obs;
-    obs.id = tag->id;
-    obs.decision_margin = static_cast<Real>(tag->decision_margin);
-    for (int k = 0; k < 9; ++k) obs.rotation(k / 3, k % 3) = static_cast<Real>(tag->rotation[k]);
-    for (int k = 0; k < 3; ++k) obs.translation_m(k) = static_cast<Real>(tag->translation_m[k]);
+    dockcore::TagObservation obs = dockcore::drivers::tag_observation(*tag, 0);
+    obs.has_corners = o.corner_fit;
+    // The detector's corner error against the rendered truth (the noise the pose is estimated from).
+    for (int k = 0; k < 4; ++k) {
+      const double h = det.tag_size_m / 2;
+      double u = 0, v = 0;
+      docksim::project_tag_point(view, dockcore::kTagCornerX[k] * h, dockcore::kTagCornerY[k] * h, u, v);
+      corner_err_px.push_back(tag->corners_px[k][0] - u);
+      corner_err_px.push_back(tag->corners_px[k][1] - v);
+    }
     dockcore::TagMeasurement m;
     if (dockcore::tag_to_dock_measurement(obs, p, &m) != dockcore::TagStatus::kFused) continue;
     ++found;
@@ -174,21 +180,32 @@ int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions 
     yaw_deg.push_back(eyaw * 180 / dockcore::kPi);
     z_lat.push_back(ey / std::sqrt(static_cast<double>(m.covariance(1, 1))));
     z_yaw.push_back(eyaw / std::sqrt(static_cast<double>(m.covariance(2, 2))));
+    if (m.corner_rms_px >= 0) fit_rms_px.push_back(static_cast<double>(m.corner_rms_px));
   }
   auto abs_all = [](std::vector<double> v) {
     for (double& x : v) x = std::fabs(x);
     return v;
   };
+  // The information bound of the yaw of a tag seen face-on: each corner moves by f·(s/2)²/Z² px per rad across the
+  // line of sight (the perspective difference of the left and right edges), so with corner noise σ_c the yaw's σ is
+  // at least σ_c·Z² / (2·f·(s/2)²) = 2·σ_c·Z² / (f·s²) (docs/camera.md, "Choosing the tag size").
+  const double corner_rms_px = rms(corner_err_px);
+  const double bound_deg =
+      2 * corner_rms_px * o.distance_m * o.distance_m / (fx_px * det.tag_size_m * det.tag_size_m) * 180 / dockcore::kPi;
+  char fit_rms[32] = "null";  // no corner fit: nothing to report
+  if (!fit_rms_px.empty()) std::snprintf(fit_rms, sizeof fit_rms, "%.3f", percentile(fit_rms_px, 0.5));
   std::printf(
       "{\"type\":\"tag_pose\",\"frames\":%u,\"found\":%u,\"distance_m\":%g,\"tag_size_m\":%g,\"fx_px\":%g,"
       "\"noise_grey\":%g,\"blur_px\":%g,\"decimate\":%g,\"lateral_p50_mm\":%.2f,\"lateral_p95_mm\":%.2f,"
       "\"depth_p95_mm\":%.2f,\"robot_in_dock_lateral_p95_mm\":%.1f,\"yaw_p50_deg\":%.3f,\"yaw_p95_deg\":%.3f,\"sigma_"
       "px\":%g,"
-      "\"lateral_rms_over_model_sigma\":%.2f,\"yaw_rms_over_model_sigma\":%.2f}\n",
+      "\"lateral_rms_over_model_sigma\":%.2f,\"yaw_rms_over_model_sigma\":%.2f,\"corner_fit\":%s,"
+      "\"corner_error_rms_px\":%.3f,\"yaw_face_on_bound_deg\":%.3f,\"fit_rms_p50_px\":%s,\"yaw_max_deg\":%.2f}\n",
       o.frames, found, o.distance_m, det.tag_size_m, fx_px, o.noise_grey, o.blur_px, det.quad_decimate,
       percentile(abs_all(lat_mm), 0.5), percentile(abs_all(lat_mm), 0.95), percentile(abs_all(depth_mm), 0.95),
       percentile(abs_all(in_dock_mm), 0.95), percentile(abs_all(yaw_deg), 0.5), percentile(abs_all(yaw_deg), 0.95),
-      o.sigma_px, rms(z_lat), rms(z_yaw));
+      o.sigma_px, rms(z_lat), rms(z_yaw), o.corner_fit ? "true" : "false", corner_rms_px, bound_deg, fit_rms,
+      percentile(abs_all(yaw_deg), 1.0));
   return found > 0 ? 0 : 1;
 }
 

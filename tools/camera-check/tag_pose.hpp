@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "dockcore/drivers/apriltag_detector.hpp"
+#include "dockcore/tag_measurement.hpp"
 #include "docksim/tag_render.hpp"
 
 namespace camera_check {
@@ -16,7 +17,9 @@ struct TagPoseOptions {
   double yaw_deg = 15;         ///< Dock turned against the robot: uniform in ±this.
   double noise_grey = 4;       ///< Gaussian pixel noise, grey levels (σ).
   double blur_px = 0.8;        ///< Gaussian blur σ, px (0: none).
-  double sigma_px = 0.3;       ///< The covariance model's corner noise, for the model's σ printed beside.
+  /// The covariance model's corner noise, for the model's σ printed beside (default: the core's default).
+  double sigma_px = static_cast<double>(dockcore::TagFusionParams{}.sigma_px);
+  bool corner_fit = true;  ///< Hand the corners to the core (the dock pose fitted to them), or the pose alone.
   std::uint64_t seed = 1;
   std::uint32_t width_px = 640, height_px = 480;
 };

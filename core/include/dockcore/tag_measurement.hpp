@@ -50,8 +50,8 @@ struct TagFusionParams {
   Real tag_size_m = static_cast<Real>(0.1);  ///< Side of the tag's black square (dockd: [camera.tag] size_m). > 0.
   DockTag dock_tag{};                        ///< The active dock's tag (dockd: its [[docks]] entry).
   /// Effective corner noise of the detector, px: the model's one free parameter (see the file comment). Measured
-  /// on rendered frames with noise and blur: `camera-check tag-pose`.
-  Real sigma_px = static_cast<Real>(0.3);
+  /// on rendered frames with noise and blur, corners refined and fitted: `camera-check tag-pose`.
+  Real sigma_px = static_cast<Real>(0.04);
   Real sigma_scale = 1;                       ///< Multiplies every σ of the model (inflate for a poorer camera).
   Real min_decision_margin = 0;               ///< Detections with a smaller decision margin are refused (kWeak).
   Real max_range_m = static_cast<Real>(3.0);  ///< Tags farther than this along the optical axis are refused (kFar).
@@ -60,6 +60,11 @@ struct TagFusionParams {
   Real max_lag_s = static_cast<Real>(0.05);
 };
 
+/// Corner k of a tag in the tag frame, in half sides: (kTagCornerX[k], kTagCornerY[k])·size/2 (libapriltag's order,
+/// the one its pose estimate pairs with the detected corners).
+constexpr Real kTagCornerX[4] = {-1, 1, 1, -1};
+constexpr Real kTagCornerY[4] = {1, 1, -1, -1};
+
 /// One tag detection as a camera's detector gives it.
 struct TagObservation {
   std::int32_t id = -1;
@@ -67,6 +72,12 @@ struct TagObservation {
   std::uint64_t stamp_us = 0;         ///< Capture time of the frame, on the host's monotonic clock.
   Mat3 rotation = Mat3::Identity();   ///< Tag frame → camera optical frame.
   Vec3 translation_m = Vec3::Zero();  ///< Tag centre in the camera optical frame, m.
+  /// With the corners the dock pose is fitted to them (tag_to_dock_measurement); without, rotation and translation
+  /// are used as given.
+  bool has_corners = false;
+  /// The detected corners in the ideal pinhole image, in unit-focal coordinates ((u − cx)/fx, (v − cy)/fy, lens
+  /// distortion removed), in the kTagCornerX/Y order.
+  Vec2 corners[4] = {Vec2::Zero(), Vec2::Zero(), Vec2::Zero(), Vec2::Zero()};
 };
 
 /// Why a tag detection was or was not turned into a measurement, or fused.
@@ -90,13 +101,34 @@ struct TagMeasurement {
   Pose2 dock_in_robot{};
   Mat3 covariance = Mat3::Zero();  ///< Of (x, y, yaw) in the robot frame.
   Real depth_m = 0;                ///< The tag's depth along the optical axis.
+  Real corner_rms_px = -1;         ///< RMS reprojection error of the corner fit; −1: no fit (no corners).
 };
+
+/// A dock pose fitted to a tag's corners.
+struct TagCornerFit {
+  Pose2 dock_in_robot{};
+  Real rms_px = 0;  ///< RMS over the 8 corner coordinates of (projected − detected), px (fx_px per unit focal).
+  std::int32_t iterations = 0;
+};
+
+/// Gauss–Newton iterations at most per start of fit_dock_to_tag_corners.
+constexpr std::int32_t kTagFitMaxIterations = 20;
+
+/// Fits the dock pose (x, y, yaw in the robot frame) to the tag's four `corners` (TagObservation::corners) by
+/// Gauss–Newton on their reprojection error, starting at `start`. The rest of the chain is taken as known: the
+/// dock stands upright on the floor the robot drives on, the camera's mount (height, pitch, roll) and the tag's place
+/// on the dock and size are as configured, so 3 unknowns are fitted to 8 coordinates. False (out untouched) when a
+/// corner is behind the camera at the start or the result is not finite. O(kTagFitMaxIterations).
+bool fit_dock_to_tag_corners(const Vec2 corners[4], const TagFusionParams& params, const Pose2& start,
+                             TagCornerFit* out);
 
 /// The camera optical frame → robot frame rotation for `mount`. O(1).
 Mat3 camera_rotation(const CameraMount3& mount);
 
 /// Turns `obs` into a dock-pose measurement (the id is not checked here). Returns kFused for a usable measurement
-/// (written to `out`), else kInvalid, kBehind, kFar or kWeak and leaves `out` alone. O(1).
+/// (written to `out`), else kInvalid, kBehind, kFar or kWeak and leaves `out` alone. With corners, the pose is
+/// fit_dock_to_tag_corners started from the given pose and from its mirror image about the line of sight (the other
+/// minimum of a planar target's pose), whichever fits the corners better. O(1).
 TagStatus tag_to_dock_measurement(const TagObservation& obs, const TagFusionParams& params, TagMeasurement* out);
 
 }  // namespace dockcore

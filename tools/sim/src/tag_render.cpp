@@ -28,48 +28,80 @@ bool project_tag_point(const PinholeView& v, double x_m, double y_m, double& u_p
 bool render_tag(const TagPattern& tag, const PinholeView& v, std::uint8_t* grey, std::uint32_t stride_bytes,
                 const PixelRect* region) {
   if (tag.cells_grey == nullptr || tag.cells == 0 || !(tag.cell_m > 0) || !(v.fx_px > 0) || !(v.fy_px > 0) ||
-      v.supersample < 1 || v.supersample > 8 || grey == nullptr || stride_bytes < v.width_px) {
+      v.supersample < 1 || v.supersample > 8 || v.edge_supersample > 32 || grey == nullptr ||
+      stride_bytes < v.width_px) {
     return false;
   }
-  PixelRect r{0, 0, v.width_px, v.height_px};
+  PixelRect rect{0, 0, v.width_px, v.height_px};
   if (region != nullptr) {
-    r = PixelRect{std::min(region->col0, v.width_px), std::min(region->row0, v.height_px),
-                  std::min(region->col1, v.width_px), std::min(region->row1, v.height_px)};
+    rect = PixelRect{std::min(region->col0, v.width_px), std::min(region->row0, v.height_px),
+                     std::min(region->col1, v.width_px), std::min(region->row1, v.height_px)};
   }
+  if (rect.col0 >= rect.col1 || rect.row0 >= rect.row1) return true;
   const double* R = v.rotation;
   const double* t = v.translation_m;
   const double n[3] = {R[2], R[5], R[8]};  // the tag's z axis in the camera frame
   const double nt = n[0] * t[0] + n[1] * t[1] + n[2] * t[2];
   const double half = 0.5 * tag.cell_m * tag.cells;
-  const std::uint32_t ss = v.supersample;
-  for (std::uint32_t row = r.row0; row < r.row1; ++row) {
-    for (std::uint32_t col = r.col0; col < r.col1; ++col) {
-      double sum = 0;
-      for (std::uint32_t sy = 0; sy < ss; ++sy) {
-        for (std::uint32_t sx = 0; sx < ss; ++sx) {
-          // Sub-sample positions spread over the pixel [col − ½, col + ½] × [row − ½, row + ½].
-          const double u = col - 0.5 + (sx + 0.5) / ss;
-          const double w = row - 0.5 + (sy + 0.5) / ss;
-          const double d[3] = {(u - v.cx_px) / v.fx_px, (w - v.cy_px) / v.fy_px, 1.0};
-          const double nd = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
-          double value = v.background;
-          // The plane n·(P − t) = 0 along the ray P = λ·d, met in front of the camera and from the tag's front.
-          if (nd > 1e-12 && nt > 0) {
-            const double lambda = nt / nd;
-            const double p[3] = {lambda * d[0] - t[0], lambda * d[1] - t[1], lambda * d[2] - t[2]};
-            const double x = R[0] * p[0] + R[3] * p[1] + R[6] * p[2];  // Rᵀ(P − t)
-            const double y = R[1] * p[0] + R[4] * p[1] + R[7] * p[2];
-            if (x >= -half && x < half && y >= -half && y < half) {
-              const auto c = static_cast<std::uint32_t>((x + half) / tag.cell_m);
-              const auto rr = static_cast<std::uint32_t>((y + half) / tag.cell_m);
-              if (c < tag.cells && rr < tag.cells) value = tag.cells_grey[rr * tag.cells + c];
-            }
-          }
-          sum += value;
-        }
+  // The grey of the scene along the ray through image point (u, w).
+  auto scene = [&](double u, double w) {
+    const double d[3] = {(u - v.cx_px) / v.fx_px, (w - v.cy_px) / v.fy_px, 1.0};
+    const double nd = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+    // The plane n·(P − t) = 0 along the ray P = λ·d, met in front of the camera and from the tag's front.
+    if (!(nd > 1e-12 && nt > 0)) return static_cast<double>(v.background);
+    const double lambda = nt / nd;
+    const double p[3] = {lambda * d[0] - t[0], lambda * d[1] - t[1], lambda * d[2] - t[2]};
+    const double x = R[0] * p[0] + R[3] * p[1] + R[6] * p[2];  // Rᵀ(P − t)
+    const double y = R[1] * p[0] + R[4] * p[1] + R[7] * p[2];
+    if (!(x >= -half && x < half && y >= -half && y < half)) return static_cast<double>(v.background);
+    const auto c = static_cast<std::uint32_t>((x + half) / tag.cell_m);
+    const auto r = static_cast<std::uint32_t>((y + half) / tag.cell_m);
+    return c < tag.cells && r < tag.cells ? static_cast<double>(tag.cells_grey[r * tag.cells + c])
+                                          : static_cast<double>(v.background);
+  };
+  // The mean of n × n sub-samples spread over the pixel [col − ½, col + ½] × [row − ½, row + ½]; `uniform` tells
+  // whether they all agreed.
+  auto pixel = [&](std::uint32_t col, std::uint32_t row, std::uint32_t n_side, bool* uniform) {
+    double sum = 0, first = -1;
+    bool same = true;
+    for (std::uint32_t sy = 0; sy < n_side; ++sy) {
+      for (std::uint32_t sx = 0; sx < n_side; ++sx) {
+        const double g = scene(col - 0.5 + (sx + 0.5) / n_side, row - 0.5 + (sy + 0.5) / n_side);
+        if (first < 0) first = g;
+        same = same && g == first;
+        sum += g;
       }
-      grey[static_cast<std::size_t>(row) * stride_bytes + col] =
-          static_cast<std::uint8_t>(std::lround(sum / (ss * ss)));
+    }
+    if (uniform != nullptr) *uniform = same;
+    return sum / (n_side * n_side);
+  };
+  // Coarse pass; then every pixel whose samples disagree or whose coarse value differs from a neighbour's is
+  // integrated on the fine grid: an edge can cross a pixel between its coarse samples, and only a neighbour shows it.
+  // Indices are within the rendered rectangle; its edge stands in for the image's.
+  const std::uint32_t w_px = rect.col1 - rect.col0, h_px = rect.row1 - rect.row0;
+  std::vector<std::uint8_t> coarse(static_cast<std::size_t>(w_px) * h_px);
+  std::vector<std::uint8_t> mixed(coarse.size());
+  for (std::uint32_t row = 0; row < h_px; ++row) {
+    for (std::uint32_t col = 0; col < w_px; ++col) {
+      bool uniform = true;
+      const std::size_t i = static_cast<std::size_t>(row) * w_px + col;
+      coarse[i] =
+          static_cast<std::uint8_t>(std::lround(pixel(rect.col0 + col, rect.row0 + row, v.supersample, &uniform)));
+      mixed[i] = uniform ? 0 : 1;
+    }
+  }
+  for (std::uint32_t row = 0; row < h_px; ++row) {
+    for (std::uint32_t col = 0; col < w_px; ++col) {
+      const std::size_t i = static_cast<std::size_t>(row) * w_px + col;
+      bool edge = mixed[i] != 0;
+      edge = edge || (col > 0 && coarse[i - 1] != coarse[i]) || (col + 1 < w_px && coarse[i + 1] != coarse[i]);
+      edge = edge || (row > 0 && coarse[i - w_px] != coarse[i]) || (row + 1 < h_px && coarse[i + w_px] != coarse[i]);
+      std::uint8_t g = coarse[i];
+      if (edge && v.edge_supersample > v.supersample) {
+        g = static_cast<std::uint8_t>(
+            std::lround(pixel(rect.col0 + col, rect.row0 + row, v.edge_supersample, nullptr)));
+      }
+      grey[static_cast<std::size_t>(rect.row0 + row) * stride_bytes + rect.col0 + col] = g;
     }
   }
   return true;

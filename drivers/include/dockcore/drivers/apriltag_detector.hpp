@@ -46,6 +46,9 @@ struct TagDetectorOptions {
   double quad_sigma = 0.0;           ///< Gaussian blur before quad detection, px (0 = none).
   int threads = 1;                   ///< libapriltag worker threads.
   bool refine_edges = true;          ///< Snap quad edges to the full-resolution gradients.
+  /// Then move the corners onto lines fitted to the black square's edges at sub-pixel precision (the step position
+  /// of the grey profile across each edge): the tag's yaw rests on tenths of a pixel between its edges.
+  bool refine_corners = true;
   double min_decision_margin = 0.0;  ///< Detections with a smaller decision margin are dropped.
   int max_hamming = 2;               ///< Bit errors corrected (0..2; libapriltag's default for tag36h11 is 2).
 };
@@ -64,11 +67,14 @@ struct TagDetection {
   int hamming = 0;                ///< Bits corrected.
   double decision_margin = 0;     ///< libapriltag's decode quality (higher = more certain; small for a blurred tag).
   double u_px = 0, v_px = 0;      ///< Centre of the tag (ideal pinhole image when distortion is given).
-  double corners_px[4][2] = {};   ///< Corners as libapriltag returns them (raw image), counter-clockwise.
+  double corners_px[4][2] = {};   ///< Corners in the raw image (refined when refine_corners), counter-clockwise.
   bool has_pose = false;
   double rotation[9] = {};        ///< Tag frame → camera frame rotation, row-major (camera: x right, y down, z out).
   double translation_m[3] = {};   ///< Tag centre in the camera frame, m.
   double pose_error = 0;          ///< estimate_tag_pose's object-space error (smaller is better).
+  /// With the pose: the corners in the ideal pinhole image in unit-focal coordinates ((u − cx)/fx, (v − cy)/fy,
+  /// distortion removed), in `corners_px`'s order, which is the tag-frame order of dockcore::kTagCornerX/Y.
+  double corners_unit_focal[4][2] = {};
 };
 
 /// Most detections reported per frame (more are counted in `overflow` of detect()).

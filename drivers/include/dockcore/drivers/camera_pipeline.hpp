@@ -43,6 +43,10 @@ struct TagFrameResult {
 const TagDetection* select_target_tag(const TagDetection* detections, std::size_t count, std::int32_t target_id,
                                       double full_confidence_margin, std::uint64_t stamp_us, TagFrameResult* out);
 
+/// The tag's pose, corners and decode quality of `d` (which must have its pose) as the core's dock-pose input, stamped
+/// with its frame's capture time. O(1).
+TagObservation tag_observation(const TagDetection& d, std::uint64_t stamp_us);
+
 /// Results the thread can queue before the tick collects them.
 constexpr std::size_t kCameraQueueCapacity = 8;
 

@@ -26,6 +26,9 @@ struct PinholeView {
   double translation_m[3] = {0, 0, 1};               ///< Tag centre in the camera frame.
   std::uint8_t background = 128;                     ///< Grey where the ray misses the tag.
   std::uint32_t supersample = 3;                     ///< Samples per pixel side (anti-aliasing; 1..8).
+  /// Samples per pixel side where those `supersample` ones disagree (a pixel on an edge; ≤ 32): an edge is then
+  /// placed to 1/(2·this) px rather than 1/(2·supersample), which sub-pixel corner and yaw checks need.
+  std::uint32_t edge_supersample = 16;
 };
 
 /// A rectangle of pixels: columns [col0, col1), rows [row0, row1).
@@ -35,8 +38,8 @@ struct PixelRect {
 
 /// Renders the tag into `grey` (width × height, `stride_bytes` per row), replacing every pixel (or only those in
 /// `region`, clipped to the image, when given). Pixels whose rays miss the tag or meet it from behind get the
-/// background. False (image untouched) for an empty pattern, a zero focal length or supersample outside 1..8.
-/// O(pixels rendered · supersample²).
+/// background. False (image untouched) for an empty pattern, a zero focal length, supersample outside 1..8 or
+/// edge_supersample above 32. O(pixels rendered · supersample² + edge pixels · edge_supersample²).
 bool render_tag(const TagPattern& tag, const PinholeView& view, std::uint8_t* grey, std::uint32_t stride_bytes,
                 const PixelRect* region = nullptr);
 
