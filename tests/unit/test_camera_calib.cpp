@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "calib.hpp"
+#include "docksim/rendered_camera.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/tag_render.hpp"
 #include "jpeg_encode.hpp"
@@ -32,9 +33,10 @@ struct Frames {
 
 /// `n` frames of the tag (id 3) at (lateral, 0, distance) in the camera frame, facing it, with Gaussian noise.
 void render(Frames& out, double distance_m, double lateral_m, int n) {
-  std::vector<std::uint8_t> cells;
-  docksim::TagPattern pattern;
-  CHECK_TRUE(camera_check::make_tag_pattern("tag36h11", 3, kTagSize, cells, pattern));
+  docksim::TagPatternImage tag;
+  std::string err;
+  CHECK_TRUE(docksim::make_tag_pattern("tag36h11", 3, kTagSize, tag, err));
+  const docksim::TagPattern& pattern = tag.pattern;
   docksim::PinholeView view;
   view.fx_px = view.fy_px = kTrueF;
   view.cx_px = kTrueCx;

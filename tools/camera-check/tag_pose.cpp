@@ -10,6 +10,7 @@
 #include "dockcore/drivers/camera_pipeline.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/tag_measurement.hpp"
+#include "docksim/rendered_camera.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/tag_render.hpp"
 
@@ -22,43 +23,6 @@ using dockcore::Vec2;
 using dockcore::Vec3;
 
 namespace {
-
-Mat3 rot_z(double a) {
-  Mat3 r = Mat3::Identity();
-  r(0, 0) = static_cast<Real>(std::cos(a));
-  r(0, 1) = static_cast<Real>(-std::sin(a));
-  r(1, 0) = static_cast<Real>(std::sin(a));
-  r(1, 1) = static_cast<Real>(std::cos(a));
-  return r;
-}
-
-/// Separable Gaussian blur of σ px (kernel ±3σ), in place.
-void blur(std::vector<std::uint8_t>& img, std::uint32_t w, std::uint32_t h, double sigma) {
-  if (sigma <= 0) return;
-  const int r = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
-  std::vector<double> k(static_cast<std::size_t>(2 * r + 1));
-  double sum = 0;
-  for (int i = -r; i <= r; ++i) sum += k[static_cast<std::size_t>(i + r)] = std::exp(-0.5 * i * i / (sigma * sigma));
-  for (double& v : k) v /= sum;
-  std::vector<double> tmp(img.size());
-  const int iw = static_cast<int>(w), ih = static_cast<int>(h);
-  for (int y = 0; y < ih; ++y) {
-    for (int x = 0; x < iw; ++x) {
-      double a = 0;
-      for (int i = -r; i <= r; ++i)
-        a += k[static_cast<std::size_t>(i + r)] * img[static_cast<std::size_t>(y * iw + std::clamp(x + i, 0, iw - 1))];
-      tmp[static_cast<std::size_t>(y * iw + x)] = a;
-    }
-  }
-  for (int y = 0; y < ih; ++y) {
-    for (int x = 0; x < iw; ++x) {
-      double a = 0;
-      for (int i = -r; i <= r; ++i)
-        a += k[static_cast<std::size_t>(i + r)] * tmp[static_cast<std::size_t>(std::clamp(y + i, 0, ih - 1) * iw + x)];
-      img[static_cast<std::size_t>(y * iw + x)] = static_cast<std::uint8_t>(std::clamp(std::lround(a), 0L, 255L));
-    }
-  }
-}
 
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return std::nan("");
@@ -74,33 +38,19 @@ double rms(const std::vector<double>& v) {
 
 }  // namespace
 
-bool make_tag_pattern(const std::string& family, int id, double tag_size_m, std::vector<std::uint8_t>& cells,
-                      docksim::TagPattern& pattern) {
-  // One pixel per cell: the smallest image the tag fits in is its side in cells.
-  cells.assign(64 * 64, 0);
-  std::uint32_t black_cells = 0;
-  std::uint32_t side = 0;
-  for (std::uint32_t n = 4; n <= 64 && black_cells == 0; ++n) {
-    if (dockcore::drivers::draw_tag_upright(family, id, 1, 0, 0, cells.data(), n, n, n, &black_cells)) side = n;
-  }
-  if (side == 0) return false;
-  cells.resize(static_cast<std::size_t>(side) * side);
-  pattern = docksim::TagPattern{cells.data(), side, tag_size_m / black_cells};
-  return true;
-}
-
 int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions det, double fx_px) {
   if (o.frames == 0 || o.distance_m <= 0 || fx_px <= 0 || det.tag_size_m <= 0) {
     std::fprintf(stderr, "camera-check tag-pose: --frames, --distance, --fx and --tag-size must be > 0\n");
     return 2;
   }
   const int family_id = 3;
-  std::vector<std::uint8_t> cells;
-  docksim::TagPattern pattern;
-  if (!make_tag_pattern(det.family, family_id, det.tag_size_m, cells, pattern)) {
-    std::fprintf(stderr, "camera-check tag-pose: cannot draw tag %d of %s\n", family_id, det.family.c_str());
+  docksim::TagPatternImage tag_image;
+  std::string err;
+  if (!docksim::make_tag_pattern(det.family, family_id, det.tag_size_m, tag_image, err)) {
+    std::fprintf(stderr, "camera-check tag-pose: %s\n", err.c_str());
     return 2;
   }
+  const docksim::TagPattern& pattern = tag_image.pattern;
   docksim::PinholeView view;
   view.fx_px = view.fy_px = fx_px;
   view.width_px = o.width_px;
@@ -108,7 +58,6 @@ int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions 
   view.cx_px = (o.width_px - 1) / 2.0;
   view.cy_px = (o.height_px - 1) / 2.0;
   det.intrinsics = dockcore::drivers::CameraIntrinsics{fx_px, fx_px, view.cx_px, view.cy_px};
-  std::string err;
   auto detector = dockcore::drivers::TagDetector::create(det, err);
   if (!detector) {
     std::fprintf(stderr, "camera-check tag-pose: %s\n", err.c_str());
@@ -124,11 +73,6 @@ int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions 
   p.dock_tag.id = family_id;
   p.dock_tag.z_m = static_cast<Real>(0.2);
   p.sigma_px = static_cast<Real>(o.sigma_px);
-  Mat3 upright = Mat3::Zero();
-  upright(1, 0) = 1;
-  upright(2, 1) = -1;
-  upright(0, 2) = -1;
-  const Mat3 r_rc = dockcore::camera_rotation(p.mount);
   docksim::Rng rng(o.seed);
   std::vector<std::uint8_t> img(static_cast<std::size_t>(o.width_px) * o.height_px);
   std::vector<double> lat_mm, depth_mm, yaw_deg, z_lat, z_yaw, in_dock_mm, corner_err_px, fit_rms_px;
@@ -138,16 +82,10 @@ int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions 
     const double yaw = dockcore::kPi + rng.uniform(-1, 1) * o.yaw_deg * dockcore::kPi / 180;
     const Pose2 dock{static_cast<Real>(o.distance_m + 0.2), static_cast<Real>(rng.uniform(-1, 1) * o.lateral_m),
                      static_cast<Real>(yaw)};
-    const Mat3 r_rt = rot_z(dock.yaw_rad) * upright;
-    const Vec2 t2 = dock.transform(Vec2(0, 0));
-    const Vec3 t_rt(t2.x(), t2.y(), static_cast<Real>(0.2));
-    const Mat3 r_ct = r_rc.transpose() * r_rt;
-    const Vec3 t_ct = r_rc.transpose() * (t_rt - Vec3(p.mount.x_m, p.mount.y_m, p.mount.z_m));
-    for (int k = 0; k < 9; ++k) view.rotation[k] = static_cast<double>(r_ct(k / 3, k % 3));
-    for (int k = 0; k < 3; ++k) view.translation_m[k] = static_cast<double>(t_ct(k));
+    docksim::place_tag_in_view(view, p.mount, dock, p.dock_tag);
     view.background = static_cast<std::uint8_t>(100 + rng.uniform(0, 60));
     docksim::render_tag(pattern, view, img.data(), o.width_px);
-    blur(img, o.width_px, o.height_px, o.blur_px);
+    docksim::blur_grey(img.data(), o.width_px, o.height_px, o.width_px, o.blur_px);
     for (std::uint8_t& px : img)
       px = static_cast<std::uint8_t>(std::clamp(std::lround(px + rng.normal() * o.noise_grey), 0L, 255L));
     dockcore::drivers::TagDetection d[4];

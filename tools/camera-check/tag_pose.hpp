@@ -24,11 +24,6 @@ struct TagPoseOptions {
   std::uint32_t width_px = 640, height_px = 480;
 };
 
-/// Tag `id` of `family` as the renderer's pattern, one value per code cell (kept in `cells`, which must outlive the
-/// pattern), scaled so its black square is `tag_size_m`. False when the family or id cannot be drawn. Allocates.
-bool make_tag_pattern(const std::string& family, int id, double tag_size_m, std::vector<std::uint8_t>& cells,
-                      docksim::TagPattern& pattern);
-
 /// Renders, detects and prints one JSON summary line (percentiles of the errors of the dock pose in the robot frame,
 /// the model's σ). Returns the exit status: 0, 1 when no frame had the tag, 2 for bad options.
 int run_tag_pose(const TagPoseOptions& o, dockcore::drivers::TagDetectorOptions det, double fx_px);
