@@ -48,6 +48,14 @@ const TagDetection* pick(const TagDetection* d, std::size_t n, int tag_id) {
   return nullptr;
 }
 
+/// The detector for `det`, or nullptr after printing why.
+std::unique_ptr<TagDetector> make_detector(const TagDetectorOptions& det) {
+  std::string err;
+  std::unique_ptr<TagDetector> detector = TagDetector::create(det, err);
+  if (!detector) std::fprintf(stderr, "camera-check calib: %s\n", err.c_str());
+  return detector;
+}
+
 void print_frame(const char* source, const TagDetection& t) {
   std::printf(
       "{\"type\":\"calib_frame\",\"source\":\"%s\",\"id\":%d,\"u_px\":%.2f,\"x_m\":%.4f,\"z_m\":%.4f,"
@@ -121,11 +129,8 @@ int run_calib_images(const std::vector<std::string>& images, const CalibOptions&
                      CalibReport* report) {
   if (!usable(o, det)) return kCalibUsage;
   std::string err;
-  std::unique_ptr<TagDetector> detector = TagDetector::create(det, err);
-  if (!detector) {
-    std::fprintf(stderr, "camera-check calib: %s\n", err.c_str());
-    return kCalibUsage;
-  }
+  std::unique_ptr<TagDetector> detector = make_detector(det);
+  if (!detector) return kCalibUsage;
   std::vector<CalibSample> samples;
   for (const std::string& path : images) {
     dockcore::drivers::GreyImage img;
@@ -151,11 +156,8 @@ int run_calib_device(const dockcore::drivers::V4l2CameraOptions& cam_opt, const 
                      const TagDetectorOptions& det) {
   if (!usable(o, det)) return kCalibUsage;
   std::string err;
-  std::unique_ptr<TagDetector> detector = TagDetector::create(det, err);
-  if (!detector) {
-    std::fprintf(stderr, "camera-check calib: %s\n", err.c_str());
-    return kCalibUsage;
-  }
+  std::unique_ptr<TagDetector> detector = make_detector(det);
+  if (!detector) return kCalibUsage;
   auto cam = dockcore::drivers::open_v4l2_camera(cam_opt, err);
   if (!cam) {
     std::fprintf(stderr, "camera-check calib: %s\n", err.c_str());
