@@ -169,6 +169,19 @@ dockcore::DriveGeometry core_drive_geometry(const DriveGeometry& g) {
   return c;
 }
 
+dockcore::TagFusionParams tag_fusion_params(const Scenario& sc) {
+  dockcore::TagFusionParams p = sc.tag_fusion;
+  const dockcore::CameraModel& m = sc.camera.model;
+  p.mount = dockcore::CameraMount3{m.mount.x_m, m.mount.y_m, static_cast<Real>(sc.camera.z_m), m.mount.yaw_rad, 0, 0};
+  p.fx_px = m.fx_px;
+  p.tag_size_m = static_cast<Real>(sc.dock_tag.size_m);
+  p.dock_tag.id = sc.dock_tag.id;
+  p.dock_tag.x_m = sc.camera.target_in_dock.x();
+  p.dock_tag.y_m = sc.camera.target_in_dock.y();
+  p.dock_tag.z_m = static_cast<Real>(std::isnan(sc.dock_tag.z_m) ? sc.camera.z_m : sc.dock_tag.z_m);
+  return p;
+}
+
 CameraSimParams camera_sim_params(const Scenario& sc) {
   CameraSimParams camp;
   camp.model = sc.camera.model;
@@ -278,18 +291,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       throw ScenarioError("robot.camera.render needs a tag detector: this dock-sim was built without libapriltag");
     }
     frame_camera = opt.make_frame_camera(sc);
-    if (sc.camera.fuse_tags) {
-      cfg.tag = sc.tag_fusion;
-      const dockcore::CameraModel& m = sc.camera.model;
-      cfg.tag.mount =
-          dockcore::CameraMount3{m.mount.x_m, m.mount.y_m, static_cast<Real>(sc.camera.z_m), m.mount.yaw_rad, 0, 0};
-      cfg.tag.fx_px = m.fx_px;
-      cfg.tag.tag_size_m = static_cast<Real>(sc.dock_tag.size_m);
-      cfg.tag.dock_tag.id = sc.dock_tag.id;
-      cfg.tag.dock_tag.x_m = sc.camera.target_in_dock.x();
-      cfg.tag.dock_tag.y_m = sc.camera.target_in_dock.y();
-      cfg.tag.dock_tag.z_m = static_cast<Real>(std::isnan(sc.dock_tag.z_m) ? sc.camera.z_m : sc.dock_tag.z_m);
-    }
+    if (sc.camera.fuse_tags) cfg.tag = tag_fusion_params(sc);
   }
   if (!core->configure(sc.profile, cfg)) throw ScenarioError("dock profile has no segments");
 

@@ -43,6 +43,10 @@ std::uint64_t trial_seed(std::uint64_t base, std::uint64_t index);
 dockcore::DriveGeometry core_drive_geometry(const DriveGeometry& g);
 /// The camera simulator's parameters for a scenario's camera (rate, latency, noise, dropouts, depth range). O(1).
 CameraSimParams camera_sim_params(const Scenario& sc);
+/// The tag fusion's parameters for a scenario's camera and dock tag: [camera.fusion], the camera's mount (level, at
+/// `robot.camera.z_m`), focal length, tag size and the tag's place on the dock (the camera target, at `dock.tag.z_m`
+/// or the camera's height). What the run fuses with and where the rendered camera draws the tag. O(1).
+dockcore::TagFusionParams tag_fusion_params(const Scenario& sc);
 /// The seed of one random stream of a run: splitmix64 of `seed ^ salt`, as run_docking derives its chassis, lidar and
 /// camera streams (salts 0x43484153 "CHAS", 0x4C494441 "LIDA", 0x43414d "CAM"). O(1).
 std::uint64_t seed_stream(std::uint64_t seed, std::uint64_t salt);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "dockcore/drivers/camera_pipeline.hpp"
+#include "docksim/sim_run.hpp"
 
 namespace docksim {
 
@@ -47,13 +48,10 @@ std::unique_ptr<RenderedTagCamera> RenderedTagCamera::create(const Scenario& sc,
   v.width_px = static_cast<std::uint32_t>(cam.model.image_width_px);
   v.height_px = cam.height_px;
   v.background = 128;
-  c->mount_ = dockcore::CameraMount3{
-      cam.model.mount.x_m, cam.model.mount.y_m, static_cast<Real>(cam.z_m), cam.model.mount.yaw_rad, 0, 0};
+  const dockcore::TagFusionParams tag = tag_fusion_params(sc);
+  c->mount_ = tag.mount;
   c->dock_world_ = sc.dock_pose;
-  c->dock_tag_.id = sc.dock_tag.id;
-  c->dock_tag_.x_m = cam.target_in_dock.x();
-  c->dock_tag_.y_m = cam.target_in_dock.y();
-  c->dock_tag_.z_m = static_cast<Real>(std::isnan(sc.dock_tag.z_m) ? cam.z_m : sc.dock_tag.z_m);
+  c->dock_tag_ = tag.dock_tag;
   c->blur_px_ = cam.blur_px;
   c->exposure_q8_ = static_cast<int>(std::lround(cam.exposure * 256));
   c->tag_id_ = sc.dock_tag.id;
