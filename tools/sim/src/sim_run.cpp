@@ -469,7 +469,8 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
 
     // 3. Camera.
     if (sc.camera.enabled) {
-      if (rendered && !active_obs.empty()) {
+      // Obstacle events join the occluders only for a frame that is taken (20 Hz, not every 5 ms step).
+      if (rendered && !active_obs.empty() && camera.frame_due(now_us)) {
         World frame_occluders = occluders;
         for (const auto& o : active_obs) frame_occluders.add_circle(o.c, o.r);
         camera.update(now_us, cs.true_pose, target_world, !occluded, reported.odom_pose, &frame_occluders);

@@ -71,6 +71,8 @@ class CameraSim {
   /// period. O(1) amortised (plus a render and a detection per rendered frame).
   void update(std::uint64_t t_us, const dockcore::Pose2& robot_world, const dockcore::Vec2& target_world, bool visible,
               const dockcore::Pose2& odom_pose = dockcore::Pose2{}, const World* occluders = nullptr);
+  /// True when update(t_us, ...) will capture a frame (so a caller builds a frame's inputs only then). O(1).
+  bool frame_due(std::uint64_t t_us) const { return t_us >= next_capture_us_; }
   /// The most recently delivered frame (invalid until the first one; an empty frame is delivered as invalid with
   /// its stamp).
   const dockcore::CameraTarget& latest() const { return latest_; }
