@@ -460,10 +460,20 @@ void Daemon::reply_error(const HostRequest& r, HostErrorCode code, const char* m
   reply_json(r, buf, n);
   ++counters_.commands_rejected;
   if (io_.udp_host != nullptr) io_.udp_host->count_rejected();
+  if (!refusal_log_.admit(r.stamp_us)) return;
   char f[256];
   std::snprintf(f, sizeof f, "\"source\":\"udp\",\"cmd\":\"%s\",\"seq\":%u,\"error\":\"%s\"", to_string(r.kind), r.seq,
                 to_string(code));
   log_event(r.stamp_us, "command_rejected", f, LogLevel::kWarn);
+}
+
+void Daemon::report_held_events(std::uint64_t now_us) {
+  const std::uint32_t n = refusal_log_.take_held(now_us);
+  if (n == 0) return;
+  char f[128];
+  std::snprintf(f, sizeof f, "\"of\":\"refusals\",\"count\":%u,\"limit_per_s\":%u", n,
+                EventRateLimit::kPerWindow);
+  log_event(now_us, "events_held_back", f, LogLevel::kWarn);
 }
 
 void Daemon::handle_udp_request(const HostRequest& r, std::uint64_t now_us) {
@@ -760,6 +770,7 @@ void Daemon::on_tick(std::uint64_t now_us) {
   poll_lidar(now_us);
   poll_camera(now_us);
   poll_hosts(now_us);
+  report_held_events(now_us);
   watchdogs(now_us);
   teach_progress(now_us);
   if (pending_cfg_ != nullptr && reload_can_apply()) {
@@ -858,7 +869,9 @@ void Daemon::on_tick(std::uint64_t now_us) {
     std::snprintf(f, sizeof f, "\"source\":\"%s\",\"command\":%u,\"dock_id\":%u,\"result\":\"%s\"",
                   cmd.resume ? "resume" : (cmd.from_udp ? "udp" : "can"), static_cast<unsigned>(cmd.type), cmd.dock_id,
                   dockcore::to_string(out.command_result));
-    log_event(now_us, "command_result", f, accepted ? LogLevel::kInfo : LogLevel::kWarn);
+    if (accepted || refusal_log_.admit(now_us)) {
+      log_event(now_us, "command_result", f, accepted ? LogLevel::kInfo : LogLevel::kWarn);
+    }
   }
 
   // A watchdog fault interrupting a running dock/undock remembers it for the resume.

@@ -68,6 +68,50 @@ struct TickStats {
   std::uint64_t worst_work_us = 0;    ///< Longest time spent inside on_tick (clock before and after).
 };
 
+/// At most kPerWindow events of one kind per kWindowUs reach the record and stderr; the rest are held back and
+/// counted. A host flooding refused requests would otherwise make every request a write(2) or two (on flash, wear
+/// too) and starve the control loop; the request counters still count every one. Cost: O(1), no allocation.
+class EventRateLimit {
+ public:
+  static constexpr std::uint32_t kPerWindow = 20;
+  static constexpr std::uint64_t kWindowUs = 1000000;
+  /// True when an event at now_us (monotonic, µs) may be logged; false: it is held back and counted.
+  bool admit(std::uint64_t now_us) {
+    roll(now_us);
+    if (logged_ < kPerWindow) {
+      ++logged_;
+      return true;
+    }
+    ++held_;
+    ++held_total_;
+    return false;
+  }
+  /// Events held back in windows that have ended by now_us, each reported once (0 while the window runs).
+  std::uint32_t take_held(std::uint64_t now_us) {
+    roll(now_us);
+    const std::uint32_t n = ready_;
+    ready_ = 0;
+    return n;
+  }
+  std::uint32_t held_total() const { return held_total_; }  ///< Held back since start.
+
+ private:
+  void roll(std::uint64_t now_us) {
+    if (started_ && now_us - window_start_us_ < kWindowUs) return;
+    started_ = true;
+    window_start_us_ = now_us;
+    logged_ = 0;
+    ready_ += held_;
+    held_ = 0;
+  }
+  bool started_ = false;
+  std::uint64_t window_start_us_ = 0;
+  std::uint32_t logged_ = 0;
+  std::uint32_t held_ = 0;   ///< In the running window.
+  std::uint32_t ready_ = 0;  ///< From ended windows, not yet reported.
+  std::uint32_t held_total_ = 0;
+};
+
 /// Counters the daemon itself keeps (the drivers keep theirs).
 struct DaemonCounters {
   std::uint32_t commands = 0;  ///< Task commands handed to the task manager.
@@ -190,6 +234,8 @@ class Daemon {
   void poll_camera(std::uint64_t now_us);
   void poll_hosts(std::uint64_t now_us);
   void handle_udp_request(const dockcore::drivers::HostRequest& r, std::uint64_t now_us);
+  /// Logs how many refusal events refusal_log_ held back, once their window has ended.
+  void report_held_events(std::uint64_t now_us);
   bool enqueue(const PendingCommand& c);
   void reply_error(const dockcore::drivers::HostRequest& r, dockcore::drivers::HostErrorCode code, const char* msg);
   void reply_json(const dockcore::drivers::HostRequest& r, const char* json, std::size_t len);
@@ -284,6 +330,7 @@ class Daemon {
   TickStats stats_{};
   std::uint64_t prev_tick_us_ = 0;
   DaemonCounters counters_{};
+  EventRateLimit refusal_log_{};  ///< command_rejected and refused command_result events (one per refused request).
   bool shutdown_logged_ = false;
   std::unique_ptr<DockdConfig> pending_cfg_;  ///< A validated reload waiting for an idle task.
 };

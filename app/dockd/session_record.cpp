@@ -107,18 +107,35 @@ void RecordingCanBus::record(const dockcore::CanFrame& f) {
   if (!log_.is_open()) return;
   char line[96];
   const std::size_t n = format_candump_line(line, sizeof line, realtime_us(), iface_, f);
-  if (n > 0) log_.write_line(line, n);
+  if (n == 0) return;
+  if (pending_len_ + n > sizeof pending_) flush();
+  std::memcpy(pending_ + pending_len_, line, n);
+  pending_len_ += n;
+}
+
+void RecordingCanBus::flush() {
+  if (pending_len_ == 0) return;
+  log_.write_line(pending_, pending_len_);
+  pending_len_ = 0;
 }
 
 bool RecordingCanBus::send(const dockcore::CanFrame& frame) {
+  flush();  // the received frames before it, in order
   const bool ok = inner_.send(frame);
-  if (ok) record(frame);
+  if (ok) {
+    record(frame);
+    flush();
+  }
   return ok;
 }
 
 bool RecordingCanBus::receive(dockcore::CanFrame& frame, std::uint64_t& stamp_us) {
   const bool ok = inner_.receive(frame, stamp_us);
-  if (ok) record(frame);
+  if (ok) {
+    record(frame);
+  } else {
+    flush();
+  }
   return ok;
 }
 

@@ -48,11 +48,19 @@ std::size_t format_candump_line(char* buf, std::size_t size, std::uint64_t unix_
 /// CLOCK_REALTIME in µs (the candump log's time base).
 std::uint64_t realtime_us();
 
-/// hal::CanBus decorator: forwards to `inner` and logs every frame sent (when queued) and received.
+/// hal::CanBus decorator: forwards to `inner` and logs every frame sent (when queued) and received. Received frames
+/// are gathered and written together once the bus is drained (receive() finds no frame), before a send, or when the
+/// buffer is full: one write(2) per drain instead of one per frame, so a burst of incoming frames costs the loop one
+/// system call. Sent frames are written at once, so the record survives a SIGKILL up to the last frame sent.
 class RecordingCanBus final : public dockcore::hal::CanBus {
  public:
   /// `inner` and `log` must outlive this object; `log` may be closed (then nothing is written).
   RecordingCanBus(dockcore::hal::CanBus& inner, RotatingLog& log, const std::string& iface);
+  ~RecordingCanBus() { flush(); }
+  RecordingCanBus(const RecordingCanBus&) = delete;
+  RecordingCanBus& operator=(const RecordingCanBus&) = delete;
+  /// Writes the gathered lines (nothing when there are none).
+  void flush();
   bool send(const dockcore::CanFrame& frame) override;
   bool receive(dockcore::CanFrame& frame, std::uint64_t& stamp_us) override;
   int fd() const override { return inner_.fd(); }
@@ -63,6 +71,8 @@ class RecordingCanBus final : public dockcore::hal::CanBus {
   dockcore::hal::CanBus& inner_;
   RotatingLog& log_;
   char iface_[24];
+  char pending_[8192];  ///< Received frames' lines not yet written (about 90 frames).
+  std::size_t pending_len_ = 0;
 };
 
 }  // namespace dockd

@@ -303,7 +303,9 @@ def retry_onsets(r):
     """[(wall, what, excuse)] for every attempt that ended in RETRY (DockStatus state 6); `what` = dockd's reason and
     phase (its state event) and the true pads then; excuse says why the retry was the test machine's ("" when
     nothing excuses it): the attempt ended in ALIGN with align_failed, the true contacts were open (dockd did not miss
-    a contact), and dockd's own 20 ms wheel frames stalled longer than RETRY_STALL_MS during that attempt."""
+    a contact), and dockd's own 20 ms wheel frames stalled longer than RETRY_STALL_MS during that attempt. The attempt
+    runs from its approach (REACH_TASKING_POINT, or ALIGN when it starts there): a stall on the approach leaves the
+    robot off the line that ALIGN then cannot correct within its bounds."""
     wheels = [e["wall"] for e in r.wheels()]
     reasons = [e for e in r.dockd_events if e.get("event") == "state" and e.get("to") == "RETRY"]
     out = []
@@ -314,7 +316,7 @@ def retry_onsets(r):
         s = int(e["signals"]["state"])
         if s == prev:
             continue
-        if s == STATE["ALIGN"]:
+        if s in (STATE["REACH_TASKING_POINT"], STATE["ALIGN"]) and attempt_t0 is None:
             attempt_t0 = e["wall"]
         if s == STATE["RETRY"]:
             t = e["wall"]
@@ -326,8 +328,9 @@ def retry_onsets(r):
             if tr is not None:
                 pads = (f"pads {float(tr['pad_lateral_m']) * 1000:+.0f} mm, "
                         f"{float(tr['pad_yaw_rad']) * 57.29578:+.1f} deg, contact {tr['contact']}")
-            what = f"{reason} in {ev.get('phase', '?')}, {pads}"
             stall = stall_ms(wheels, attempt_t0, t) if attempt_t0 is not None else 0.0
+            what = f"{reason} in {ev.get('phase', '?')}, {pads}, longest stall {stall:.0f} ms"
+            attempt_t0 = None
             why = ""
             if (prev == STATE["ALIGN"] and reason == "align_failed" and tr is not None and not tr["contact"]
                     and stall > RETRY_STALL_MS):

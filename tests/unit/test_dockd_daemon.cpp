@@ -468,6 +468,45 @@ TEST(DockdDaemon, UdpFloodStaysConsistentAndUnknownDockIsRejected) {
   ::close(s);
 }
 
+// A flood of refused requests reaches the record as at most EventRateLimit::kPerWindow refusal events a second and
+// one events_held_back line per window with the rest: each refusal is logged or counted there, none twice.
+TEST(DockdDaemon, RefusalFloodIsLoggedAtTheCapAndTheRestCounted) {
+  Rig r("refusals", true, 1.2, true);
+  r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+  const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  to.sin_port = htons(r.udp->bound_port());
+  const std::uint32_t before = r.daemon->counters().commands_rejected;
+  char buf[2048];
+  int seq = 1;
+  for (int t = 0; t < 150; ++t) {  // 3 s at 1000 unknown-dock requests a second
+    for (int k = 0; k < 20; ++k) {
+      const std::string m = "{\"cmd\":\"dock\",\"dock_id\":9,\"seq\":" + std::to_string(seq++) + "}";
+      ::sendto(s, m.data(), m.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+    }
+    r.tick();
+    while (::recv(s, buf, sizeof buf, MSG_DONTWAIT) > 0) {
+    }
+  }
+  r.run_until([] { return false; }, 1.1);  // the last window ends and its held-back count is logged
+  ::close(s);
+  const std::uint32_t refused = r.daemon->counters().commands_rejected - before;
+  CHECK_EQUAL(3000u, refused);
+  const std::string logged = r.events("command_rejected");
+  const std::string held = r.events("events_held_back");
+  const long n_logged = std::count(logged.begin(), logged.end(), '\n');
+  long n_held = 0;
+  for (std::size_t at = held.find("\"count\":"); at != std::string::npos; at = held.find("\"count\":", at + 1)) {
+    n_held += std::strtol(held.c_str() + at + 8, nullptr, 10);
+  }
+  CHECK(n_logged <= 4 * static_cast<long>(dockd::EventRateLimit::kPerWindow));
+  CHECK(n_logged >= 3 * static_cast<long>(dockd::EventRateLimit::kPerWindow));
+  CHECK_EQUAL(static_cast<long>(refused), n_logged + n_held);
+  STRCMP_CONTAINS("\"of\":\"refusals\"", held.c_str());
+}
+
 TEST(DockdDaemon, TeachStoresTargetUsedByLaterDockings) {
   Rig r("teach", true);
   // Dock first, so the robot sits on the charger (as if placed there by hand).

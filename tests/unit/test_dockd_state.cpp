@@ -2,11 +2,16 @@
 // last good copy.
 #include <unistd.h>
 
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <cstdio>
+#include <deque>
 #include <fstream>
 #include <sstream>
 #include <string>
 
+#include "session_record.hpp"
 #include "state_file.hpp"
 
 #include "real_tolerance.hpp"
@@ -112,4 +117,63 @@ TEST(DockdState, OversizedFileIsCorruptAndTheBackupIsUsed) {
   CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kRecoveredBackup), static_cast<int>(dockd::load_state(path, out, msg)));
   STRCMP_CONTAINS("larger than 1048576 bytes", msg.c_str());
   CHECK_TRUE(out.find(2) != nullptr);
+}
+
+namespace {
+/// A CanBus whose receive queue the test fills; it counts the bytes in the record file after each call.
+struct QueueBus final : dockcore::hal::CanBus {
+  std::deque<dockcore::CanFrame> rx;
+  dockcore::hal::CanBusCounters c{};
+  bool send(const dockcore::CanFrame&) override { return true; }
+  bool receive(dockcore::CanFrame& f, std::uint64_t& stamp_us) override {
+    if (rx.empty()) return false;
+    f = rx.front();
+    rx.pop_front();
+    stamp_us = 1;
+    return true;
+  }
+  int fd() const override { return -1; }
+  const dockcore::hal::CanBusCounters& counters() const override { return c; }
+};
+}  // namespace
+
+// Received frames reach the record once the bus is drained (or before a send), sent frames at once, all in order.
+TEST(DockdState, RecordedCanFramesAreWrittenPerDrainAndInOrder) {
+  const std::string dir = path + "_can";
+  ::mkdir(dir.c_str(), 0700);
+  {
+    dockd::RotatingLog log;
+    std::string err;
+    CHECK_TRUE_TEXT(log.open(dir, "can.log", 1 << 20, 2, err), err.c_str());
+    QueueBus inner;
+    dockd::RecordingCanBus bus(inner, log, "vcan0");
+    for (int i = 0; i < 300; ++i) {  // more than the gathering buffer holds
+      dockcore::CanFrame f{};
+      f.id = 0x100u + static_cast<std::uint32_t>(i);
+      f.dlc = 1;
+      f.data[0] = static_cast<std::uint8_t>(i);
+      inner.rx.push_back(f);
+    }
+    dockcore::CanFrame f{};
+    std::uint64_t t = 0;
+    for (int i = 0; i < 250; ++i) CHECK_TRUE(bus.receive(f, t));
+    const std::string mid = read_all(dir + "/can.log");  // the full buffer was written, the rest waits
+    CHECK(std::count(mid.begin(), mid.end(), '\n') > 100);
+    CHECK(std::count(mid.begin(), mid.end(), '\n') < 250);
+    dockcore::CanFrame out{};
+    out.id = 0x7FF;
+    out.dlc = 0;
+    CHECK_TRUE(bus.send(out));  // writes the received frames before it, then itself
+    const std::string after_send = read_all(dir + "/can.log");
+    CHECK_EQUAL(251, std::count(after_send.begin(), after_send.end(), '\n'));
+    STRCMP_CONTAINS(" vcan0 1F9#F9\n", after_send.c_str());  // frame 249
+    CHECK(after_send.size() > 12 && after_send.compare(after_send.size() - 12, 12, " vcan0 7FF#\n") == 0);
+    while (bus.receive(f, t)) {
+    }
+    const std::string drained = read_all(dir + "/can.log");  // the drain's end wrote the other 50
+    CHECK_EQUAL(301, std::count(drained.begin(), drained.end(), '\n'));
+    CHECK(drained.size() > 14 && drained.compare(drained.size() - 14, 14, " vcan0 22B#2B\n") == 0);
+  }
+  std::remove((dir + "/can.log").c_str());
+  ::rmdir(dir.c_str());
 }
