@@ -1,11 +1,11 @@
 // Compiled (never linked or run) by tools/size-report for each target and scalar type: every array below has the
 // size of one object, so `nm -S` on the object file reads sizeof() for any target without running target code.
-#include "dockcore/controllers.hpp"
-#include "dockcore/dock_pose_estimator.hpp"
-#include "dockcore/dock_pose_filter.hpp"
+#include "dockcore/control/controllers.hpp"
 #include "dockcore/dockcore.hpp"
 #include "dockcore/laser_scan.hpp"
-#include "dockcore/task_manager.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_pose_filter.hpp"
+#include "dockcore/task/task_manager.hpp"
 
 #define DOCKCORE_SIZE(name, type) extern "C" { char size_of_##name[sizeof(type)]; }
 DOCKCORE_SIZE(Dockcore, dockcore::Dockcore)

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "dockcore/controllers.hpp"
+#include "dockcore/control/controllers.hpp"
 #include "dockcore/drivers/apriltag_detector.hpp"
 #include "dockcore/drivers/v4l2_camera.hpp"
 

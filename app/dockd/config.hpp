@@ -10,18 +10,18 @@
 #include <string>
 #include <vector>
 
-#include "dockcore/controllers.hpp"
-#include "dockcore/dock_pose_estimator.hpp"
-#include "dockcore/dock_profile.hpp"
-#include "dockcore/geometry.hpp"
-#include "dockcore/kinematics.hpp"
-#include "dockcore/safety.hpp"
-#include "dockcore/task_manager.hpp"
-#include "dockcore/tag_measurement.hpp"
+#include "dockcore/control/controllers.hpp"
+#include "dockcore/control/kinematics.hpp"
+#include "dockcore/control/safety.hpp"
 #include "dockcore/drivers/can_link.hpp"
 #include "dockcore/drivers/lidar_driver.hpp"
 #include "dockcore/drivers/udp_camera.hpp"
 #include "dockcore/drivers/udp_host_link.hpp"
+#include "dockcore/geometry.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
+#include "dockcore/task/task_manager.hpp"
 #include "camera_config.hpp"
 
 namespace dockd {

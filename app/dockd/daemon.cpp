@@ -6,7 +6,7 @@
 #include <cstring>
 #include <ctime>
 
-#include "dockcore/kinematics.hpp"
+#include "dockcore/control/kinematics.hpp"
 
 namespace dockd {
 

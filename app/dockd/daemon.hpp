@@ -21,7 +21,7 @@
 #include <string>
 
 #include "config.hpp"
-#include "dockcore/controllers.hpp"
+#include "dockcore/control/controllers.hpp"
 #include "dockcore/dockcore.hpp"
 #include "dockcore/drivers/udp_host_link.hpp"
 #include "dockcore/hal/camera.hpp"

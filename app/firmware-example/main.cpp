@@ -12,12 +12,12 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "dockcore/controllers.hpp"
+#include "dockcore/control/controllers.hpp"
 #include "dockcore/dockcore.hpp"
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/laser_scan.hpp"
-#include "dockcore/profile_geometry.hpp"
-#include "dockcore/task_manager.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/profile_geometry.hpp"
+#include "dockcore/task/task_manager.hpp"
 
 using namespace dockcore;
 

@@ -4,9 +4,9 @@
 #include <cstring>
 #include <limits>
 
-#include "dockcore/can_agilex_v2.hpp"
-#include "dockcore/can_dockcore_v1.hpp"
 #include "dockcore/drivers/can_link.hpp"
+#include "dockcore/protocols/can/can_agilex_v2.hpp"
+#include "dockcore/protocols/can/can_dockcore_v1.hpp"
 
 namespace dockcore::drivers {
 

@@ -19,9 +19,9 @@
 #include <algorithm>
 #include <vector>
 
-#include "dockcore/lidar_lakibeam.hpp"
-#include "dockcore/lidar_ld06.hpp"
-#include "dockcore/lidar_rplidar.hpp"
+#include "dockcore/protocols/lidar/lidar_lakibeam.hpp"
+#include "dockcore/protocols/lidar/lidar_ld06.hpp"
+#include "dockcore/protocols/lidar/lidar_rplidar.hpp"
 
 // The kernel's termios2 (asm/termbits.h cannot be included together with <termios.h>): arbitrary baud rates via
 // BOTHER for rates termios has no B constant for (RPLIDAR A2/A3's 256000).

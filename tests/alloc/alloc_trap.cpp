@@ -5,15 +5,15 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "dockcore/breakpoint_detector.hpp"
-#include "dockcore/controllers.hpp"
+#include "dockcore/control/controllers.hpp"
 #include "dockcore/dockcore.hpp"
-#include "dockcore/dock_pose_estimator.hpp"
-#include "dockcore/dock_pose_filter.hpp"
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/laser_scan.hpp"
-#include "dockcore/line_segments.hpp"
-#include "dockcore/vmarker_detector.hpp"
+#include "dockcore/perception/breakpoint_detector.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_pose_filter.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/line_segments.hpp"
+#include "dockcore/perception/vmarker_detector.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/scenes.hpp"
 #include "../support/malloc_count.hpp"

@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "dockcore/can_agilex_v2.hpp"
-#include "dockcore/can_dockcore_v1.hpp"
+#include "dockcore/protocols/can/can_agilex_v2.hpp"
+#include "dockcore/protocols/can/can_dockcore_v1.hpp"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "dockcore/can_dockcore_v1.hpp"
+#include "dockcore/protocols/can/can_dockcore_v1.hpp"
 
 namespace {
 

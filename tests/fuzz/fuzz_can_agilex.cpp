@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "dockcore/can_agilex_v2.hpp"
+#include "dockcore/protocols/can/can_agilex_v2.hpp"
 
 using namespace dockcore;
 using namespace dockcore::agilex_v2;

@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "dockcore/can_dockcore_v1.hpp"
+#include "dockcore/protocols/can/can_dockcore_v1.hpp"
 
 using namespace dockcore;
 using namespace dockcore::can_v1;

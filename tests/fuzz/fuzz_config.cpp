@@ -12,8 +12,8 @@
 #include <string>
 
 #include "config.hpp"
-#include "dockcore/dock_pose_estimator.hpp"
 #include "dockcore/drivers/udp_host_link.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
 
 namespace {
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <optional>
 
-#include "dockcore/lidar_lakibeam.hpp"
+#include "dockcore/protocols/lidar/lidar_lakibeam.hpp"
 
 using namespace dockcore;
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <optional>
 
-#include "dockcore/lidar_ld06.hpp"
+#include "dockcore/protocols/lidar/lidar_ld06.hpp"
 
 using namespace dockcore;
 

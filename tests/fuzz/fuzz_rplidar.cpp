@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <optional>
 
-#include "dockcore/lidar_rplidar.hpp"
+#include "dockcore/protocols/lidar/lidar_rplidar.hpp"
 
 using namespace dockcore;
 

@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "dockcore/can_dockcore_v1.hpp"
+#include "dockcore/protocols/can/can_dockcore_v1.hpp"
 
 int main(int argc, char** argv) {
   if (argc < 4) {

@@ -1,11 +1,11 @@
 #pragma once
 // Simulated camera tag detections for the tag fusion tests: the exact tag pose a camera on a robot sees, plus noise
-// drawn at the covariance model's σ (dockcore/tag_measurement.hpp).
+// drawn at the covariance model's σ (dockcore/perception/tag_measurement.hpp).
 #include <cmath>
 #include <cstdint>
 
 #include "dockcore/geometry.hpp"
-#include "dockcore/tag_measurement.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
 #include "docksim/rng.hpp"
 
 namespace dockcore_test {

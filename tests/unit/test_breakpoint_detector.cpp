@@ -4,10 +4,10 @@
 #include <cstring>
 #include <limits>
 
-#include "dockcore/breakpoint_detector.hpp"
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
+#include "dockcore/perception/breakpoint_detector.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenes.hpp"

@@ -2,7 +2,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "dockcore/can_agilex_v2.hpp"
+#include "dockcore/protocols/can/can_agilex_v2.hpp"
 
 #include <CppUTest/TestHarness.h>
 

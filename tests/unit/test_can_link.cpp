@@ -10,9 +10,9 @@
 #include <unistd.h>
 
 #include "../support/fake_can_bus.hpp"
-#include "dockcore/can_agilex_v2.hpp"
-#include "dockcore/can_dockcore_v1.hpp"
 #include "dockcore/drivers/can_link.hpp"
+#include "dockcore/protocols/can/can_agilex_v2.hpp"
+#include "dockcore/protocols/can/can_dockcore_v1.hpp"
 
 #include <CppUTest/TestHarness.h>
 

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "dockcore/can_dockcore_v1.hpp"
+#include "dockcore/protocols/can/can_dockcore_v1.hpp"
 
 #include <CppUTest/TestHarness.h>
 

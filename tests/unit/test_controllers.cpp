@@ -9,8 +9,8 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "dockcore/controllers.hpp"
-#include "dockcore/kinematics.hpp"
+#include "dockcore/control/controllers.hpp"
+#include "dockcore/control/kinematics.hpp"
 #include "docksim/chassis.hpp"
 
 #include <CppUTest/TestHarness.h>

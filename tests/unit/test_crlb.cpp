@@ -1,4 +1,4 @@
-#include "dockcore/dock_profile.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 #include "docksim/crlb.hpp"
 
 #include <cstdio>

@@ -2,7 +2,7 @@
 #include <cstring>
 #include <vector>
 
-#include "dockcore/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/scenes.hpp"
 

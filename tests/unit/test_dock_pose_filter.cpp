@@ -1,4 +1,4 @@
-#include "dockcore/dock_pose_filter.hpp"
+#include "dockcore/perception/dock_pose_filter.hpp"
 #include "docksim/rng.hpp"
 
 #include "real_tolerance.hpp"

@@ -1,9 +1,9 @@
 #include <cstdio>
 #include <cstring>
 
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 
 #include "real_tolerance.hpp"
 

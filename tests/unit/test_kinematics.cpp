@@ -3,7 +3,7 @@
 #include <cmath>
 #include <type_traits>
 
-#include "dockcore/kinematics.hpp"
+#include "dockcore/control/kinematics.hpp"
 #include "docksim/chassis.hpp"
 
 #include "real_tolerance.hpp"

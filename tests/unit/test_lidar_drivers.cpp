@@ -19,9 +19,9 @@
 #include <vector>
 
 #include "dockcore/drivers/lidar_driver.hpp"
-#include "dockcore/lidar_lakibeam.hpp"
-#include "dockcore/lidar_ld06.hpp"
-#include "dockcore/lidar_rplidar.hpp"
+#include "dockcore/protocols/lidar/lidar_lakibeam.hpp"
+#include "dockcore/protocols/lidar/lidar_ld06.hpp"
+#include "dockcore/protocols/lidar/lidar_rplidar.hpp"
 
 #include <CppUTest/TestHarness.h>
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "dockcore/lidar_ld06.hpp"
+#include "dockcore/protocols/lidar/lidar_ld06.hpp"
 
 #include "lidar_capture.hpp"
 #include "real_tolerance.hpp"

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "dockcore/lidar_rplidar.hpp"
+#include "dockcore/protocols/lidar/lidar_rplidar.hpp"
 
 #include "lidar_capture.hpp"
 #include "real_tolerance.hpp"

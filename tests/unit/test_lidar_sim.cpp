@@ -5,9 +5,9 @@
 #include <cstring>
 #include <vector>
 
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenes.hpp"

@@ -4,7 +4,7 @@
 
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
-#include "dockcore/line_segments.hpp"
+#include "dockcore/perception/line_segments.hpp"
 #include "docksim/rng.hpp"
 
 #include "real_tolerance.hpp"

@@ -1,4 +1,4 @@
-#include "dockcore/profile_check.hpp"
+#include "dockcore/perception/profile_check.hpp"
 
 #include <cmath>
 #include <cstdio>

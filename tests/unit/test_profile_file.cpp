@@ -5,7 +5,7 @@
 #include <fstream>
 #include <string>
 
-#include "dockcore/dock_profile.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 #include "docksim/profile_file.hpp"
 
 #include "real_tolerance.hpp"

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "dockcore/dock_pose_estimator.hpp"
-#include "dockcore/dock_profile.hpp"
-#include "dockcore/profile_geometry.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/profile_geometry.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/real_perception.hpp"
 #include "docksim/realdata.hpp"

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "dockcore/drivers/apriltag_detector.hpp"
-#include "dockcore/tag_measurement.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
 #include "docksim/rendered_camera.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenario.hpp"

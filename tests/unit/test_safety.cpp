@@ -2,8 +2,8 @@
 #include <cmath>
 #include <memory>
 
-#include "dockcore/dock_profile.hpp"
-#include "dockcore/safety.hpp"
+#include "dockcore/control/safety.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 
 #include <CppUTest/TestHarness.h>
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "dockcore/faults.hpp"
+#include "dockcore/task/faults.hpp"
 #include "docksim/camera_sim.hpp"
 #include "docksim/scenario.hpp"
 #include "docksim/sim_run.hpp"

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "dockcore/geometry.hpp"
-#include "dockcore/tag_measurement.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
 #include "docksim/rng.hpp"
 
 #include "real_tolerance.hpp"

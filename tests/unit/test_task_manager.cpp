@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/dockcore.hpp"
-#include "dockcore/tag_measurement.hpp"
-#include "dockcore/task_manager.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
+#include "dockcore/task/task_manager.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 

@@ -4,11 +4,11 @@
 #include <cstring>
 #include <vector>
 
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
-#include "dockcore/line_segments.hpp"
-#include "dockcore/vmarker_detector.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/line_segments.hpp"
+#include "dockcore/perception/vmarker_detector.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenes.hpp"

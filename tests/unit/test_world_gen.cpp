@@ -10,7 +10,7 @@
 #include <memory>
 #include <string>
 
-#include "dockcore/profile_geometry.hpp"
+#include "dockcore/perception/profile_geometry.hpp"
 #include "docksim/lidar_sim.hpp"
 
 #include <CppUTest/TestHarness.h>

@@ -9,7 +9,7 @@
 
 #include "dockcore/drivers/camera_pipeline.hpp"
 #include "dockcore/geometry.hpp"
-#include "dockcore/tag_measurement.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
 #include "docksim/rendered_camera.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/tag_render.hpp"

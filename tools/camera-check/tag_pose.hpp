@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "dockcore/drivers/apriltag_detector.hpp"
-#include "dockcore/tag_measurement.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
 #include "docksim/tag_render.hpp"
 
 namespace camera_check {

@@ -25,9 +25,9 @@
 #include <vector>
 
 #include "chassis_sim_lidar.hpp"
-#include "dockcore/can_agilex_v2.hpp"
-#include "dockcore/can_dockcore_v1.hpp"
 #include "dockcore/drivers/can_link.hpp"
+#include "dockcore/protocols/can/can_agilex_v2.hpp"
+#include "dockcore/protocols/can/can_dockcore_v1.hpp"
 #include "docksim/chassis.hpp"
 #include "docksim/cli_checks.hpp"
 #include "docksim/lidar_sim.hpp"

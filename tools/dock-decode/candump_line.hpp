@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "dockcore/can_frame.hpp"
+#include "dockcore/protocols/can/can_frame.hpp"
 
 namespace dockdecode {
 

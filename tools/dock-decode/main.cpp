@@ -15,10 +15,10 @@
 #include <nlohmann/json.hpp>
 
 #include "candump_line.hpp"
-#include "dockcore/can_agilex_v2.hpp"
-#include "dockcore/can_dockcore_v1.hpp"
-#include "dockcore/faults.hpp"
-#include "dockcore/task_manager.hpp"
+#include "dockcore/protocols/can/can_agilex_v2.hpp"
+#include "dockcore/protocols/can/can_dockcore_v1.hpp"
+#include "dockcore/task/faults.hpp"
+#include "dockcore/task/task_manager.hpp"
 #include "docksim/svg.hpp"
 
 namespace {

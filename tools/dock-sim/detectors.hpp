@@ -7,12 +7,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dockcore/breakpoint_detector.hpp"
-#include "dockcore/dock_pose_estimator.hpp"
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/laser_scan.hpp"
-#include "dockcore/line_segments.hpp"
-#include "dockcore/vmarker_detector.hpp"
+#include "dockcore/perception/breakpoint_detector.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/line_segments.hpp"
+#include "dockcore/perception/vmarker_detector.hpp"
 
 namespace docksim_cli {
 

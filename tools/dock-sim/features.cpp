@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "dockcore/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
 #include "docksim/cli_checks.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/real_perception.hpp"

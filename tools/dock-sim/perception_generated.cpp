@@ -14,9 +14,9 @@
 #include <thread>
 #include <vector>
 
-#include "dockcore/dock_pose_estimator.hpp"
-#include "dockcore/dock_pose_filter.hpp"
-#include "dockcore/profile_check.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_pose_filter.hpp"
+#include "dockcore/perception/profile_check.hpp"
 #include "docksim/crlb.hpp"
 #include "docksim/sim_run.hpp"
 #include "docksim/world_gen.hpp"

@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
-#include "dockcore/faults.hpp"
+#include "dockcore/task/faults.hpp"
 #include "docksim/cli_checks.hpp"
 #include "docksim/scenario.hpp"
 #include "docksim/sim_run.hpp"

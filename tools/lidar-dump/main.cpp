@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "dockcore/drivers/lidar_driver.hpp"
-#include "dockcore/lidar_rplidar.hpp"
+#include "dockcore/protocols/lidar/lidar_rplidar.hpp"
 #include "docksim/cli_checks.hpp"
 #include "docksim/scan_io.hpp"
 

@@ -33,16 +33,16 @@
 
 #include <cstdint>
 
-#include "dockcore/controller.hpp"
-#include "dockcore/dock_pose_estimator.hpp"
-#include "dockcore/dock_pose_filter.hpp"
-#include "dockcore/dock_profile.hpp"
+#include "dockcore/control/controller.hpp"
+#include "dockcore/control/kinematics.hpp"
+#include "dockcore/control/safety.hpp"
 #include "dockcore/geometry.hpp"
-#include "dockcore/kinematics.hpp"
 #include "dockcore/laser_scan.hpp"
-#include "dockcore/safety.hpp"
-#include "dockcore/tag_measurement.hpp"
-#include "dockcore/task_manager.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_pose_filter.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
+#include "dockcore/task/task_manager.hpp"
 
 namespace dockcore {
 

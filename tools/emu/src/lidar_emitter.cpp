@@ -14,9 +14,9 @@
 #include <termios.h>
 #include <unistd.h>
 
-#include "dockcore/lidar_lakibeam.hpp"
-#include "dockcore/lidar_ld06.hpp"
-#include "dockcore/lidar_rplidar.hpp"
+#include "dockcore/protocols/lidar/lidar_lakibeam.hpp"
+#include "dockcore/protocols/lidar/lidar_ld06.hpp"
+#include "dockcore/protocols/lidar/lidar_rplidar.hpp"
 
 namespace dockcore::emu {
 

@@ -4,7 +4,7 @@
 #include <Eigen/LU>
 #include <cmath>
 
-#include "dockcore/profile_geometry.hpp"
+#include "dockcore/perception/profile_geometry.hpp"
 
 namespace docksim {
 

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <memory>
 
-#include "dockcore/dock_pose_filter.hpp"
-#include "dockcore/line_segments.hpp"
-#include "dockcore/profile_geometry.hpp"
+#include "dockcore/perception/dock_pose_filter.hpp"
+#include "dockcore/perception/line_segments.hpp"
+#include "dockcore/perception/profile_geometry.hpp"
 #include "docksim/scenes.hpp"
 
 namespace docksim {

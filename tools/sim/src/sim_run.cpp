@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <memory>
 
-#include "dockcore/controllers.hpp"
+#include "dockcore/control/controllers.hpp"
+#include "dockcore/control/kinematics.hpp"
 #include "dockcore/dockcore.hpp"
-#include "dockcore/faults.hpp"
-#include "dockcore/kinematics.hpp"
+#include "dockcore/task/faults.hpp"
 #include "docksim/camera_sim.hpp"
 #include "docksim/chassis.hpp"
 #include "docksim/lidar_sim.hpp"

@@ -14,7 +14,7 @@
 #include <string>
 #include <thread>
 
-#include "dockcore/controller.hpp"
+#include "dockcore/control/controller.hpp"
 #include "dockcore/drivers/apriltag_detector.hpp"
 #include "dockcore/hal/camera.hpp"
 

@@ -9,10 +9,10 @@
 #include <string>
 #include <string_view>
 
+#include "dockcore/control/kinematics.hpp"
 #include "dockcore/hal/can_bus.hpp"
 #include "dockcore/hal/chassis.hpp"
 #include "dockcore/hal/host_link.hpp"
-#include "dockcore/kinematics.hpp"
 
 namespace dockcore::drivers {
 

@@ -10,10 +10,10 @@
 #include <string_view>
 
 #include "dockcore/hal/lidar.hpp"
-#include "dockcore/lidar_lakibeam.hpp"
-#include "dockcore/lidar_ld06.hpp"
-#include "dockcore/lidar_rplidar.hpp"
-#include "dockcore/lidar_scan_assembler.hpp"
+#include "dockcore/protocols/lidar/lidar_lakibeam.hpp"
+#include "dockcore/protocols/lidar/lidar_ld06.hpp"
+#include "dockcore/protocols/lidar/lidar_rplidar.hpp"
+#include "dockcore/protocols/lidar/lidar_scan_assembler.hpp"
 
 namespace dockcore::drivers {
 

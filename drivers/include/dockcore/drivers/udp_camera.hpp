@@ -10,7 +10,7 @@
 #include <memory>
 #include <string>
 
-#include "dockcore/controller.hpp"
+#include "dockcore/control/controller.hpp"
 #include "dockcore/hal/camera.hpp"
 
 namespace dockcore::drivers {

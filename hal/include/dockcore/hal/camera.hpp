@@ -10,8 +10,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "dockcore/controller.hpp"
-#include "dockcore/tag_measurement.hpp"
+#include "dockcore/control/controller.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
 
 namespace dockcore::hal {
 

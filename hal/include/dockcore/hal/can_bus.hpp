@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "dockcore/can_frame.hpp"
+#include "dockcore/protocols/can/can_frame.hpp"
 
 namespace dockcore::hal {
 

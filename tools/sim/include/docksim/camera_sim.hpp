@@ -11,9 +11,9 @@
 #include <deque>
 #include <utility>
 
-#include "dockcore/controller.hpp"
+#include "dockcore/control/controller.hpp"
 #include "dockcore/geometry.hpp"
-#include "dockcore/tag_measurement.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 

@@ -7,7 +7,7 @@
 // random draw comes from the docksim::Rng seeded at construction, in a fixed order.
 //
 // Frames: world, robot body (origin at the kinematic centre — the axle midpoint for a differential drive, the wheel
-// rectangle's centre for mecanum; x forward, y left), dock (dockcore/dock_profile.hpp: origin at the centre of the
+// rectangle's centre for mecanum; x forward, y left), dock (dockcore/perception/dock_profile.hpp: origin at the centre of the
 // dock's charging contacts, x out of the dock face towards an approaching robot).
 #include <array>
 #include <cstddef>

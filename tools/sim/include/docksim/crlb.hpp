@@ -4,8 +4,8 @@
 // beside each measured error so the estimator's efficiency is visible.
 #include <cstddef>
 
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/geometry.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 
 namespace docksim {
 

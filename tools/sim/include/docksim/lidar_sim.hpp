@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 #include "docksim/rng.hpp"
 
 namespace docksim {

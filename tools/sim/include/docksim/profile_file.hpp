@@ -25,7 +25,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "dockcore/dock_profile.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 
 namespace docksim {
 

@@ -6,10 +6,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "dockcore/dock_pose_estimator.hpp"
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 #include "docksim/realdata.hpp"
 #include "docksim/rng.hpp"
 

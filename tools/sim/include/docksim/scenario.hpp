@@ -12,14 +12,14 @@
 #include <string>
 #include <vector>
 
-#include "dockcore/controllers.hpp"
-#include "dockcore/dock_pose_estimator.hpp"
-#include "dockcore/dock_profile.hpp"
+#include "dockcore/control/controllers.hpp"
+#include "dockcore/control/kinematics.hpp"
+#include "dockcore/control/safety.hpp"
 #include "dockcore/geometry.hpp"
-#include "dockcore/kinematics.hpp"
-#include "dockcore/safety.hpp"
-#include "dockcore/tag_measurement.hpp"
-#include "dockcore/task_manager.hpp"
+#include "dockcore/perception/dock_pose_estimator.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
+#include "dockcore/task/task_manager.hpp"
 #include "docksim/chassis.hpp"
 #include "docksim/lidar_sim.hpp"
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/geometry.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 

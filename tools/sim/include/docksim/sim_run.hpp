@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "dockcore/control/kinematics.hpp"
 #include "dockcore/geometry.hpp"
-#include "dockcore/kinematics.hpp"
-#include "dockcore/task_manager.hpp"
+#include "dockcore/task/task_manager.hpp"
 #include "docksim/camera_sim.hpp"
 #include "docksim/chassis.hpp"
 #include "docksim/scenario.hpp"

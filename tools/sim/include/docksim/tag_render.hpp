@@ -7,7 +7,7 @@
 #include <cstdint>
 
 #include "dockcore/geometry.hpp"
-#include "dockcore/tag_measurement.hpp"
+#include "dockcore/perception/tag_measurement.hpp"
 
 namespace docksim {
 

@@ -21,9 +21,9 @@
 
 #include <toml++/toml.h>
 
-#include "dockcore/dock_profile.hpp"
 #include "dockcore/params/toml_reader.hpp"
-#include "dockcore/profile_check.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/profile_check.hpp"
 
 namespace dockcore::params::profile_toml {
 

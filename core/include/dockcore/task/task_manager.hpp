@@ -1,0 +1,285 @@
+#pragma once
+/// @file The docking task manager: host commands, detection search, alignment with any
+/// DockingController, obstacle and pose-deviation safety, charging confirmation with retries, undocking, faults.
+///
+/// One tick (50 Hz in dockd) takes everything the robot knows now (TaskInput) and returns the body twist to command
+/// plus the status for the host (TaskOutput). State codes (TaskState) and fault codes (FaultCode) are stable wire
+/// numbers. The twist leaves through one function, emit(): it is zero unless the state is a moving state
+/// (REACH_TASKING_POINT, ALIGN, RETRY, UNDOCKING), no stop condition holds (obstacle, target lost, invalid values),
+/// and it is finite — so every exit path, fault and idle state commands zero by construction. State diagram and
+/// parameters: docs/task-manager.md. Cost per tick: O(1) plus one obstacle check O(B · S) when the robot is to move.
+/// No heap; holds a reference to the controller, which must outlive the task manager.
+
+#include <cstdint>
+
+#include "dockcore/control/controller.hpp"
+#include "dockcore/control/safety.hpp"
+#include "dockcore/geometry.hpp"
+#include "dockcore/laser_scan.hpp"
+#include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/task/faults.hpp"
+
+namespace dockcore {
+
+/// Task states. Values are wire codes; 0-4 are seed 004's AutoContainerState, 5+ are dockcore's.
+enum class TaskState : std::uint8_t {
+  kNotTasking = 0,        ///< Idle. Zero velocity, charge request off.
+  kGetTaskingCmd = 1,     ///< Command accepted; one tick to reset the controller and timers.
+  kReachTaskingPoint = 2, ///< Looking for the dock: wait, then swing in place within ±swing_amplitude.
+  kAlign = 3,             ///< The controller drives to the contacts.
+  kFinishTasking = 4,     ///< Docked and charging confirmed. Zero velocity; contacts watched.
+  kWaitForCharge = 5,     ///< At the contacts, charge requested; waiting for contact + current.
+  kRetry = 6,             ///< Backing off to the staging distance before another attempt (or the final fault).
+  kUndocking = 7,         ///< Charge off, then backing off to the staging distance.
+  kFault = 8,             ///< Stopped with a fault code. Cleared by cancel, dock or undock (on the contacts, or to
+                          ///< finish an undocking the fault interrupted).
+  kTestMode = 9,          ///< Recognition only: the dock estimate is reported, the robot never moves.
+};
+
+/// Stable name ("NOT_TASKING", ...). Never null. O(1).
+const char* to_string(TaskState s);
+
+/// Host command kinds (wire codes). Anything else is rejected as unknown.
+enum class HostCommandType : std::uint8_t {
+  kNone = 0,      ///< No command this tick.
+  kDock = 1,      ///< Dock at dock_id.
+  kCancel = 2,    ///< Stop whatever runs; clears a fault.
+  kUndock = 3,    ///< Leave the dock.
+  kTestMode = 4,  ///< Recognition only, on dock_id (reported in the status like a docking's).
+};
+
+/// A host command, delivered once (edge) on the tick it arrives.
+struct HostCommand {
+  HostCommandType type = HostCommandType::kNone;
+  std::uint16_t dock_id = 0;
+};
+
+/// What became of the command given on this tick.
+enum class CommandResult : std::uint8_t {
+  kNone = 0,              ///< No command this tick.
+  kAccepted = 1,
+  kAlreadyDocked = 2,     ///< Dock while docked/charging: no motion; charging is (re)confirmed.
+  kRejectedUnknown = 3,   ///< Unknown command code.
+  kRejectedDockId = 4,    ///< Dock/test dock id not accepted (>= 32 or not in accepted_dock_ids).
+  kRejectedNotDocked = 5, ///< Undock while not on the contacts (and not resuming an interrupted undocking).
+  kRejectedBusy = 6,      ///< Dock/test while a task runs, or undock while docking: cancel first.
+};
+
+/// Stable name. Never null. O(1).
+const char* to_string(CommandResult r);
+
+/// How the last task ended (persistent until the next one).
+enum class TaskResult : std::uint8_t {
+  kNone = 0,
+  kDocked = 1,    ///< Charging confirmed.
+  kUndocked = 2,  ///< Backed off to the staging distance.
+  kCancelled = 3,
+  kFaulted = 4,
+};
+
+/// Task manager parameters. Times in seconds, distances in metres, angles in radians.
+struct TaskParams {
+  // Detection search (REACH_TASKING_POINT).
+  Real detect_wait_s = static_cast<Real>(1.0);        ///< Stand still this long for a detection before swinging.
+  Real swing_amplitude_rad = deg_to_rad(static_cast<Real>(20));  ///< Swing to ±this about the start heading.
+  Real swing_speed_radps = static_cast<Real>(0.3);    ///< Swing rate (above the drive deadband).
+  Real swing_tolerance_rad = deg_to_rad(static_cast<Real>(1));   ///< A swing leg ends this close to its target.
+  std::uint8_t max_swings = 2;  ///< Full swings (+A, −A, back to the start) without a detection before fault 177.
+  // Target loss (ALIGN).
+  Real target_lost_after_s = static_cast<Real>(0.5);  ///< Estimate older than this: stop and wait.
+  Real target_lost_timeout_s = static_cast<Real>(5.0);///< Lost this long: fault 181.
+  // Pose deviation (ALIGN) and obstacle handling.
+  DeviationParams deviation{};
+  MotionGateParams gate{};
+  Real obstacle_timeout_s = static_cast<Real>(10.0);  ///< Blocked this long: fault 180.
+  // Charging (WAIT_FOR_CHARGE, FINISH_TASKING).
+  Real charge_current_threshold_a = static_cast<Real>(0.5);  ///< Charging = contact and current at least this.
+  Real charge_confirm_hold_s = static_cast<Real>(0.3);  ///< Contact and current held this long confirm charging.
+  Real charge_confirm_timeout_s = static_cast<Real>(5.0);  ///< No confirmation within this: retry.
+  Real contact_lost_debounce_s = static_cast<Real>(0.3);   ///< Contacts open this long while charging: fault 183.
+  std::uint8_t max_retries = 3;  ///< Attempts after the first; then fault 182/188 with the robot backed off.
+  // Backing off (RETRY, UNDOCKING).
+  Real staging_distance_m = static_cast<Real>(0.6);   ///< Back off until the robot centre is this far from the dock.
+  Real fallback_backoff_m = static_cast<Real>(0.3);   ///< Without a dock estimate: back off this far on odometry.
+  Real backoff_speed_mps = static_cast<Real>(0.1);    ///< Backing speed (above the drive deadband).
+  Real backoff_timeout_s = static_cast<Real>(20.0);   ///< Back-off not done in this time: fault (186 undocking).
+  Real charge_off_timeout_s = static_cast<Real>(2.0); ///< Undock: current must stop within this, else fault 186.
+  // Limits and timing.
+  Real task_timeout_s = static_cast<Real>(180.0);     ///< Docking (GET_TASKING_CMD..WAIT_FOR_CHARGE) longer: fault 189.
+  Real max_vx_mps = static_cast<Real>(0.5);           ///< Final clamp on |vx| (the controller's limits come first).
+  Real max_vy_mps = static_cast<Real>(0.5);           ///< Final clamp on |vy|.
+  Real max_wz_radps = static_cast<Real>(1.5);         ///< Final clamp on |wz|.
+  Real nominal_dt_s = static_cast<Real>(0.02);        ///< dt for the first tick and for non-increasing time.
+  std::uint32_t accepted_dock_ids = 0xFFFFFFFFu;      ///< Bit i set: dock id i accepted (ids 0..31).
+};
+
+/// The dock estimate (filtered), as the DockPoseFilter gives it for the current odometry pose.
+struct DockInput {
+  bool valid = false;             ///< The filter has a dock (it may be old: see stamp_us).
+  Pose2 pose{};                   ///< Dock in the robot frame now.
+  Mat3 covariance = Mat3::Zero(); ///< Robot-frame covariance of (x, y, yaw).
+  std::uint64_t stamp_us = 0;     ///< Time of the last detection fused into it.
+  /// The estimate rests on at least two agreeing detections since the filter's last (re)initialisation. When false
+  /// a disagreeing detection says only that one of two detections is wrong, not that the robot was pushed: the
+  /// push test skips it (the filter's gate sorts it out).
+  bool confirmed = true;
+};
+
+/// One raw detection of a scan processed since the previous tick (for the push test).
+struct DetectionInput {
+  bool fresh = false;          ///< A detection arrived since the previous tick.
+  Pose2 dock_in_robot{};       ///< Dock in the robot frame at the scan time.
+  Pose2 odom_at_scan{};        ///< Robot odometry pose at the scan time.
+  std::uint64_t stamp_us = 0;
+  /// The filter's expectation just before this detection was fused, as Dockcore records it per detection: the
+  /// push test compares the detection with it, so a detection the filter then adopts (it restarts after
+  /// DockFilterParams::reinit_after jumps, e.g. several scans of a pushed robot fused between two ticks) is still
+  /// judged against what odometry said at its time. When false (callers without a filter) the test uses
+  /// TaskInput::dock as it is on the tick.
+  bool expectation_set = false;
+  bool expectation_confirmed = false;  ///< The expectation rested on two agreeing detections (DockInput::confirmed).
+  Pose2 expected_in_odom{};            ///< Dock in the odometry frame the filter expected (when confirmed).
+};
+
+/// Detections one tick can carry: a host draining a scan backlog after a stall hands several scans to
+/// Dockcore::on_scan before the next tick (dockd: up to 4 per loop). Beyond this the oldest are kept (a push shows in
+/// the first detections after it) and the rest counted.
+constexpr std::size_t kMaxDetectionsPerTick = 8;
+
+/// Everything the task manager sees on one tick.
+struct TaskInput {
+  std::uint64_t now_us = 0;  ///< Monotonic time of this tick.
+  HostCommand command{};     ///< Command arriving on this tick (edge), or kNone.
+  DockInput dock{};
+  /// Detections since the previous tick, oldest first; the push test (ALIGN) runs on every one of them in order.
+  DetectionInput detections[kMaxDetectionsPerTick] = {};
+  std::uint8_t detection_count = 0;
+  Pose2 odom_pose{};
+  Twist2 odom_twist{};
+  const ScanView* scan = nullptr;  ///< Latest scan for the obstacle check (null: motion blocked). This call only.
+  Pose2 lidar_mount{};
+  CameraTarget camera{};
+  bool contact = false;            ///< Charging contacts closed.
+  Real charge_current_a = 0;       ///< Charging current (positive into the battery).
+  bool chassis_ok = true;          ///< Chassis feedback fresh (host's judgement).
+  bool lidar_ok = true;            ///< Lidar scans fresh (host's judgement).
+};
+
+/// The status frame content for the host (CAN/UDP).
+struct TaskStatus {
+  TaskState state = TaskState::kNotTasking;
+  std::uint8_t phase = 0;          ///< Controller phase in ALIGN, else 0.
+  FaultCode fault = FaultCode::kNone;
+  std::uint8_t retries = 0;        ///< Retries used in the current/last task.
+  /// In RETRY: why the attempt ended (kAlignFailed: the controller gave up, e.g. pressed without contact;
+  /// kChargeNotConfirmed: no charging current), the fault raised when no retry is left. kNone in every other state.
+  FaultCode retry_reason = FaultCode::kNone;
+  bool dock_valid = false;         ///< dock_pose is a current estimate (not older than target_lost_after_s).
+  Pose2 dock_pose{};               ///< Dock in the robot frame.
+  bool charge_enable = false;      ///< Charging requested.
+  CommandResult last_command = CommandResult::kNone;  ///< Result of the most recent command.
+  TaskResult last_result = TaskResult::kNone;
+  std::uint16_t dock_id = 0;       ///< Dock of the current/last task.
+};
+
+/// One tick's result.
+struct TaskOutput {
+  Twist2 cmd{};                     ///< Body twist to command (before kinematics). Zero unless moving is allowed.
+  TaskStatus status{};
+  CommandResult command_result = CommandResult::kNone;  ///< For the command given on this tick.
+  bool blocked = false;             ///< The wanted motion was stopped by an obstacle this tick.
+  bool target_lost = false;         ///< ALIGN is holding because the estimate is stale or the controller lost it.
+  ObstacleFlags obstacles{};        ///< Obstacle check of this tick (valid = false when none was needed).
+  ControlStatus control = ControlStatus::kRunning;  ///< Controller status this tick (ALIGN only).
+};
+
+class TaskManager {
+ public:
+  /// `controller` must outlive this object; it is reset() at the start of every attempt.
+  explicit TaskManager(DockingController& controller) : ctrl_(&controller) {}
+
+  /// Sets the parameters, footprint and dock outline (for the obstacle check's dock exclusion). Resets to
+  /// NOT_TASKING. O(vertices).
+  void configure(const TaskParams& params, const FootprintParams& footprint, const DockProfile& profile);
+
+  /// One tick. Cost: O(1) plus the controller's step plus one obstacle check when a motion is wanted.
+  TaskOutput tick(const TaskInput& in);
+
+  TaskState state() const { return state_; }
+  /// A detection failed the push test and the next agreeing one would raise 178/179 (ALIGN). O(1).
+  bool push_suspected() const { return deviation_count_ > 0; }
+  FaultCode fault() const { return fault_; }
+  const TaskParams& params() const { return params_; }
+  const ObstacleChecker& obstacle_checker() const { return obstacles_; }
+
+ private:
+  void handle_command(const TaskInput& in, TaskOutput& out);
+  void enter(TaskState s, const TaskInput& in);
+  void raise(FaultCode f, const TaskInput& in);
+  void start_backoff(const TaskInput& in);
+  /// Backs off; returns true when done. Sets want_.
+  bool run_backoff(const TaskInput& in);
+  void run_reach(const TaskInput& in);
+  void run_align(const TaskInput& in, TaskOutput& out);
+  /// Push test (178/179) on one detection; returns true when it raised the fault.
+  bool test_detection(const DetectionInput& det, const TaskInput& in);
+  void run_wait_for_charge(const TaskInput& in);
+  void run_finish(const TaskInput& in);
+  void run_retry(const TaskInput& in);
+  void run_undocking(const TaskInput& in);
+  /// Attempt failed (charge not confirmed or controller failure): back off, then retry or fault with `final_fault`.
+  void fail_attempt(FaultCode final_fault, const TaskInput& in);
+  bool dock_fresh(const TaskInput& in) const;
+  static Real since_s(std::uint64_t t_us, const TaskInput& in);
+  /// The one place the output twist is produced.
+  void emit(const TaskInput& in, TaskOutput& out);
+
+  DockingController* ctrl_;
+  TaskParams params_{};
+  ObstacleChecker obstacles_{};
+
+  TaskState state_ = TaskState::kNotTasking;
+  FaultCode fault_ = FaultCode::kNone;
+  TaskState faulted_in_ = TaskState::kNotTasking;  // the state the current fault was raised in
+  TaskResult last_result_ = TaskResult::kNone;
+  CommandResult last_command_ = CommandResult::kNone;
+  std::uint16_t dock_id_ = 0;
+  std::uint8_t retries_ = 0;
+  std::uint8_t phase_ = 0;
+
+  Twist2 want_{};              // the state's wanted twist for this tick; emit() decides what leaves
+  bool hold_ = false;          // a stop condition of the running state (target lost)
+  bool have_prev_tick_ = false;
+  std::uint64_t prev_tick_us_ = 0;
+  std::uint64_t state_since_us_ = 0;
+  std::uint64_t task_since_us_ = 0;
+
+  // Detection search.
+  Real swing_origin_rad_ = 0;
+  std::uint8_t swing_leg_ = 0;   // 0 wait, 1 to +A, 2 to −A, 3 back to origin
+  std::uint8_t swings_ = 0;
+  // Alignment.
+  bool lost_ = false;
+  std::uint64_t lost_since_us_ = 0;
+  Real start_distance_m_ = 0;
+  std::uint8_t deviation_count_ = 0;  ///< Consecutive detections failing the push test, each agreeing with the last.
+  Pose2 deviation_pose_{};            ///< The last failing detection in the odometry frame.
+  // Obstacles.
+  bool blocked_ = false;
+  std::uint64_t blocked_since_us_ = 0;
+  // Charging.
+  bool charge_ok_ = false;
+  std::uint64_t charge_ok_since_us_ = 0;
+  bool contact_open_ = false;
+  std::uint64_t contact_open_since_us_ = 0;
+  // Back-off.
+  Pose2 backoff_start_{};
+  Real backoff_needed_m_ = 0;
+  FaultCode pending_fault_ = FaultCode::kNone;  // set when the current back-off ends in a fault (retries used up)
+  FaultCode retry_reason_ = FaultCode::kNone;   // why the current attempt failed
+  bool undock_backing_ = false;
+  std::uint64_t backoff_since_us_ = 0;
+  Real dt_s_ = 0;
+};
+
+}  // namespace dockcore

@@ -1,0 +1,478 @@
+#include "dockcore/task/task_manager.hpp"
+
+#include <cmath>
+
+namespace dockcore {
+
+const char* to_string(TaskState s) {
+  switch (s) {
+    case TaskState::kNotTasking: return "NOT_TASKING";
+    case TaskState::kGetTaskingCmd: return "GET_TASKING_CMD";
+    case TaskState::kReachTaskingPoint: return "REACH_TASKING_POINT";
+    case TaskState::kAlign: return "ALIGN";
+    case TaskState::kFinishTasking: return "FINISH_TASKING";
+    case TaskState::kWaitForCharge: return "WAIT_FOR_CHARGE";
+    case TaskState::kRetry: return "RETRY";
+    case TaskState::kUndocking: return "UNDOCKING";
+    case TaskState::kFault: return "FAULT";
+    case TaskState::kTestMode: return "TEST_MODE";
+  }
+  return "UNKNOWN";
+}
+
+const char* to_string(CommandResult r) {
+  switch (r) {
+    case CommandResult::kNone: return "none";
+    case CommandResult::kAccepted: return "accepted";
+    case CommandResult::kAlreadyDocked: return "already_docked";
+    case CommandResult::kRejectedUnknown: return "rejected_unknown";
+    case CommandResult::kRejectedDockId: return "rejected_dock_id";
+    case CommandResult::kRejectedNotDocked: return "rejected_not_docked";
+    case CommandResult::kRejectedBusy: return "rejected_busy";
+  }
+  return "unknown";
+}
+
+namespace {
+
+bool is_moving_state(TaskState s) {
+  return s == TaskState::kReachTaskingPoint || s == TaskState::kAlign || s == TaskState::kRetry ||
+         s == TaskState::kUndocking;
+}
+
+/// States in which the docking task (started by a dock command) is running: the task timeout applies.
+bool is_docking_state(TaskState s) {
+  return s == TaskState::kGetTaskingCmd || s == TaskState::kReachTaskingPoint || s == TaskState::kAlign ||
+         s == TaskState::kWaitForCharge || s == TaskState::kRetry;
+}
+
+bool is_active_state(TaskState s) {
+  return s != TaskState::kNotTasking && s != TaskState::kFault && s != TaskState::kTestMode;
+}
+
+Real clamp_abs(Real v, Real limit) {
+  if (v > limit) return limit;
+  if (v < -limit) return -limit;
+  return v;
+}
+
+bool is_zero(const Twist2& t) { return t.vx_mps == 0 && t.vy_mps == 0 && t.wz_radps == 0; }
+
+}  // namespace
+
+void TaskManager::configure(const TaskParams& params, const FootprintParams& footprint, const DockProfile& profile) {
+  params_ = params;
+  obstacles_.configure(footprint, &profile);
+  state_ = TaskState::kNotTasking;
+  fault_ = FaultCode::kNone;
+  faulted_in_ = TaskState::kNotTasking;
+  last_result_ = TaskResult::kNone;
+  last_command_ = CommandResult::kNone;
+  retries_ = 0;
+  phase_ = 0;
+  have_prev_tick_ = false;
+}
+
+Real TaskManager::since_s(std::uint64_t t_us, const TaskInput& in) {
+  if (in.now_us <= t_us) return 0;
+  return static_cast<Real>(in.now_us - t_us) * static_cast<Real>(1e-6);
+}
+
+bool TaskManager::dock_fresh(const TaskInput& in) const {
+  return in.dock.valid && since_s(in.dock.stamp_us, in) <= params_.target_lost_after_s;
+}
+
+void TaskManager::enter(TaskState s, const TaskInput& in) {
+  state_ = s;
+  state_since_us_ = in.now_us;
+  blocked_ = false;
+  lost_ = false;
+  charge_ok_ = false;
+  contact_open_ = false;
+  swing_leg_ = 0;
+  undock_backing_ = false;
+  phase_ = 0;
+  want_ = Twist2{};
+  if (s == TaskState::kReachTaskingPoint) {
+    swings_ = 0;
+    swing_origin_rad_ = in.odom_pose.yaw_rad;
+  }
+}
+
+void TaskManager::raise(FaultCode f, const TaskInput& in) {
+  fault_ = f;
+  faulted_in_ = state_;
+  last_result_ = TaskResult::kFaulted;
+  enter(TaskState::kFault, in);
+}
+
+void TaskManager::handle_command(const TaskInput& in, TaskOutput& out) {
+  CommandResult r = CommandResult::kNone;
+  switch (in.command.type) {
+    case HostCommandType::kNone:
+      return;
+    case HostCommandType::kDock: {
+      const std::uint16_t id = in.command.dock_id;
+      if (id >= 32 || ((params_.accepted_dock_ids >> id) & 1u) == 0) {
+        r = CommandResult::kRejectedDockId;
+      } else if (state_ == TaskState::kWaitForCharge || state_ == TaskState::kFinishTasking) {
+        r = CommandResult::kAlreadyDocked;
+      } else if (state_ == TaskState::kNotTasking || state_ == TaskState::kFault) {
+        fault_ = FaultCode::kNone;
+        retries_ = 0;
+        dock_id_ = id;
+        task_since_us_ = in.now_us;
+        ctrl_->reset();
+        if (in.contact) {
+          // Already on the contacts: confirm charging without moving (a failed confirmation retries normally).
+          r = CommandResult::kAlreadyDocked;
+          enter(TaskState::kWaitForCharge, in);
+        } else {
+          r = CommandResult::kAccepted;
+          enter(TaskState::kGetTaskingCmd, in);
+        }
+      } else {
+        r = CommandResult::kRejectedBusy;
+      }
+      break;
+    }
+    case HostCommandType::kCancel:
+      r = CommandResult::kAccepted;
+      if (state_ != TaskState::kNotTasking) {
+        if (state_ != TaskState::kFault) last_result_ = TaskResult::kCancelled;
+        fault_ = FaultCode::kNone;
+        enter(TaskState::kNotTasking, in);
+      }
+      break;
+    case HostCommandType::kUndock:
+      if (state_ == TaskState::kUndocking) {
+        r = CommandResult::kAccepted;
+      } else if (state_ == TaskState::kWaitForCharge || state_ == TaskState::kFinishTasking ||
+                 ((state_ == TaskState::kNotTasking || state_ == TaskState::kFault) && in.contact) ||
+                 (state_ == TaskState::kFault && faulted_in_ == TaskState::kUndocking)) {
+        // A fault during the back-off (a watchdog hold, an obstacle timeout) leaves the robot between the contacts
+        // and the staging point: undock again finishes the back-off (the distance still needed is measured anew),
+        // where "not docked" would strand it there.
+        r = CommandResult::kAccepted;
+        fault_ = FaultCode::kNone;
+        enter(TaskState::kUndocking, in);
+      } else if (state_ == TaskState::kNotTasking || state_ == TaskState::kFault) {
+        r = CommandResult::kRejectedNotDocked;
+      } else {
+        r = CommandResult::kRejectedBusy;
+      }
+      break;
+    case HostCommandType::kTestMode: {
+      // The test runs on the dock it names: the status reports that id, like a docking's.
+      const std::uint16_t id = in.command.dock_id;
+      if (id >= 32 || ((params_.accepted_dock_ids >> id) & 1u) == 0) {
+        r = CommandResult::kRejectedDockId;
+      } else if (state_ == TaskState::kTestMode && id == dock_id_) {
+        r = CommandResult::kAccepted;
+      } else if (state_ == TaskState::kNotTasking || state_ == TaskState::kFault) {
+        r = CommandResult::kAccepted;
+        fault_ = FaultCode::kNone;
+        dock_id_ = id;
+        enter(TaskState::kTestMode, in);
+      } else {
+        r = CommandResult::kRejectedBusy;
+      }
+      break;
+    }
+    default:
+      r = CommandResult::kRejectedUnknown;
+      break;
+  }
+  out.command_result = r;
+  last_command_ = r;
+}
+
+void TaskManager::start_backoff(const TaskInput& in) {
+  backoff_start_ = in.odom_pose;
+  if (in.dock.valid) {
+    const Real d = std::sqrt(in.dock.pose.x_m * in.dock.pose.x_m + in.dock.pose.y_m * in.dock.pose.y_m);
+    backoff_needed_m_ = params_.staging_distance_m > d ? params_.staging_distance_m - d : static_cast<Real>(0);
+  } else {
+    backoff_needed_m_ = params_.fallback_backoff_m;
+  }
+}
+
+bool TaskManager::run_backoff(const TaskInput& in) {
+  const Real dx = in.odom_pose.x_m - backoff_start_.x_m;
+  const Real dy = in.odom_pose.y_m - backoff_start_.y_m;
+  if (std::sqrt(dx * dx + dy * dy) >= backoff_needed_m_) return true;
+  want_.vx_mps = -params_.backoff_speed_mps;
+  return false;
+}
+
+void TaskManager::fail_attempt(FaultCode final_fault, const TaskInput& in) {
+  retry_reason_ = final_fault;
+  pending_fault_ = retries_ >= params_.max_retries ? final_fault : FaultCode::kNone;
+  enter(TaskState::kRetry, in);
+  start_backoff(in);
+}
+
+void TaskManager::run_reach(const TaskInput& in) {
+  if (dock_fresh(in)) {
+    start_distance_m_ = std::sqrt(in.dock.pose.x_m * in.dock.pose.x_m + in.dock.pose.y_m * in.dock.pose.y_m);
+    deviation_count_ = 0;
+    ctrl_->reset();
+    enter(TaskState::kAlign, in);
+    return;
+  }
+  if (swing_leg_ == 0) {
+    if (since_s(state_since_us_, in) < params_.detect_wait_s) return;
+    swing_leg_ = 1;
+  }
+  const Real a = params_.swing_amplitude_rad;
+  const Real target = swing_origin_rad_ + (swing_leg_ == 1 ? a : (swing_leg_ == 2 ? -a : static_cast<Real>(0)));
+  const Real err = wrap_angle(target - in.odom_pose.yaw_rad);
+  if (std::fabs(err) <= params_.swing_tolerance_rad) {
+    if (swing_leg_ < 3) {
+      ++swing_leg_;
+    } else {
+      ++swings_;
+      if (swings_ >= params_.max_swings) {
+        raise(FaultCode::kDetectionFailed, in);
+        return;
+      }
+      swing_leg_ = 1;
+    }
+    return;  // one still tick between legs: the new leg's direction starts next tick
+  }
+  want_.wz_radps = err > 0 ? params_.swing_speed_radps : -params_.swing_speed_radps;
+}
+
+bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in) {
+  if (!det.fresh) return false;
+  const Pose2 detected = det.odom_at_scan.compose(det.dock_in_robot);
+  // An unconfirmed filter rests on one detection: disagreeing with it is no evidence of a push, so only the
+  // distance limit is tested (expected = detected).
+  Pose2 expected = detected;
+  if (det.expectation_set) {
+    if (det.expectation_confirmed) expected = det.expected_in_odom;
+  } else if (in.dock.valid && in.dock.confirmed) {
+    expected = in.odom_pose.compose(in.dock.pose);
+  } else if (!in.dock.valid) {
+    return false;
+  }
+  const Pose2& d = det.dock_in_robot;
+  const Real dist = std::sqrt(d.x_m * d.x_m + d.y_m * d.y_m);
+  const FaultCode f = check_pose_deviation(detected, expected, dist, start_distance_m_, params_.deviation);
+  if (f == FaultCode::kNone) {
+    deviation_count_ = 0;
+    return false;
+  }
+  // A push moves every later detection to the same new place; an outlier is alone. Count only failing
+  // detections that agree with the previous failing one (same tolerances as the push test itself).
+  const bool repeats = deviation_count_ > 0 &&
+      check_pose_deviation(detected, deviation_pose_, static_cast<Real>(0), start_distance_m_, params_.deviation) ==
+          FaultCode::kNone;
+  deviation_count_ = repeats ? static_cast<std::uint8_t>(deviation_count_ + 1) : static_cast<std::uint8_t>(1);
+  deviation_pose_ = detected;
+  if (deviation_count_ >= params_.deviation.confirm_detections) {
+    raise(f, in);
+    return true;
+  }
+  return false;
+}
+
+void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
+  // Every detection since the last tick, in order: a push followed by a stall shows only in the first scans of the
+  // backlog (the later ones may already have restarted the filter at the pushed pose).
+  const std::size_t n = in.detection_count < kMaxDetectionsPerTick ? in.detection_count : kMaxDetectionsPerTick;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (test_detection(in.detections[i], in)) return;
+  }
+  ControlInput ci;
+  ci.now_us = in.now_us;
+  ci.dt_s = dt_s_;
+  ci.dock_valid = in.dock.valid;
+  ci.dock_in_robot = in.dock.pose;
+  ci.dock_covariance = in.dock.covariance;
+  ci.dock_stamp_us = in.dock.stamp_us;
+  ci.odom_pose = in.odom_pose;
+  ci.measured_twist = in.odom_twist;
+  ci.camera = in.camera;
+  ci.scan = in.scan;
+  ci.lidar_mount = in.lidar_mount;
+  ci.contact = in.contact;
+  ci.charging = in.contact && in.charge_current_a >= params_.charge_current_threshold_a;
+  const ControlOutput co = ctrl_->step(ci);
+  out.control = co.status;
+  phase_ = co.phase;
+  if (co.status == ControlStatus::kArrived) {
+    enter(TaskState::kWaitForCharge, in);
+    return;
+  }
+  if (co.status == ControlStatus::kFailed) {
+    fail_attempt(FaultCode::kAlignFailed, in);
+    return;
+  }
+  if (!dock_fresh(in) || co.status == ControlStatus::kLost) {
+    if (!lost_) {
+      lost_ = true;
+      lost_since_us_ = in.now_us;
+    }
+    if (since_s(lost_since_us_, in) > params_.target_lost_timeout_s) {
+      raise(FaultCode::kTargetLost, in);
+      return;
+    }
+    hold_ = true;
+    out.target_lost = true;
+    return;
+  }
+  lost_ = false;
+  want_ = co.cmd;
+}
+
+void TaskManager::run_wait_for_charge(const TaskInput& in) {
+  if (in.contact && in.charge_current_a >= params_.charge_current_threshold_a) {
+    if (!charge_ok_) {
+      charge_ok_ = true;
+      charge_ok_since_us_ = in.now_us;
+    }
+    if (since_s(charge_ok_since_us_, in) >= params_.charge_confirm_hold_s) {
+      last_result_ = TaskResult::kDocked;
+      enter(TaskState::kFinishTasking, in);
+      return;
+    }
+  } else {
+    charge_ok_ = false;
+  }
+  if (since_s(state_since_us_, in) > params_.charge_confirm_timeout_s) fail_attempt(FaultCode::kChargeNotConfirmed, in);
+}
+
+void TaskManager::run_finish(const TaskInput& in) {
+  if (in.contact) {
+    contact_open_ = false;
+    return;
+  }
+  if (!contact_open_) {
+    contact_open_ = true;
+    contact_open_since_us_ = in.now_us;
+  }
+  if (since_s(contact_open_since_us_, in) > params_.contact_lost_debounce_s) raise(FaultCode::kContactsLost, in);
+}
+
+void TaskManager::run_retry(const TaskInput& in) {
+  if (run_backoff(in)) {
+    want_ = Twist2{};
+    if (pending_fault_ != FaultCode::kNone) {
+      raise(pending_fault_, in);
+      return;
+    }
+    ++retries_;
+    ctrl_->reset();
+    enter(TaskState::kReachTaskingPoint, in);
+    return;
+  }
+  if (since_s(state_since_us_, in) > params_.backoff_timeout_s) raise(retry_reason_, in);
+}
+
+void TaskManager::run_undocking(const TaskInput& in) {
+  if (!undock_backing_) {
+    if (in.charge_current_a < params_.charge_current_threshold_a) {
+      undock_backing_ = true;
+      backoff_since_us_ = in.now_us;
+      start_backoff(in);
+    } else {
+      if (since_s(state_since_us_, in) > params_.charge_off_timeout_s) raise(FaultCode::kUndockFailed, in);
+      return;
+    }
+  }
+  if (run_backoff(in)) {
+    want_ = Twist2{};
+    last_result_ = TaskResult::kUndocked;
+    enter(TaskState::kNotTasking, in);
+    return;
+  }
+  if (since_s(backoff_since_us_, in) > params_.backoff_timeout_s) raise(FaultCode::kUndockFailed, in);
+}
+
+TaskOutput TaskManager::tick(const TaskInput& in) {
+  TaskOutput out;
+  dt_s_ = params_.nominal_dt_s;
+  if (have_prev_tick_ && in.now_us > prev_tick_us_) dt_s_ = static_cast<Real>(in.now_us - prev_tick_us_) * static_cast<Real>(1e-6);
+  have_prev_tick_ = true;
+  prev_tick_us_ = in.now_us;
+  want_ = Twist2{};
+  hold_ = false;
+
+  handle_command(in, out);
+
+  if (is_active_state(state_)) {
+    if (!in.chassis_ok) {
+      raise(FaultCode::kChassisStale, in);
+    } else if (!in.lidar_ok && (is_moving_state(state_) || state_ == TaskState::kGetTaskingCmd)) {
+      raise(FaultCode::kLidarStale, in);
+    } else if (is_docking_state(state_) && since_s(task_since_us_, in) > params_.task_timeout_s) {
+      raise(FaultCode::kTaskTimeout, in);
+    }
+  }
+
+  switch (state_) {
+    case TaskState::kGetTaskingCmd:
+      // Visible for the tick the command arrived on; the search starts on the next.
+      if (state_since_us_ != in.now_us) enter(TaskState::kReachTaskingPoint, in);
+      break;
+    case TaskState::kReachTaskingPoint: run_reach(in); break;
+    case TaskState::kAlign: run_align(in, out); break;
+    case TaskState::kWaitForCharge: run_wait_for_charge(in); break;
+    case TaskState::kFinishTasking: run_finish(in); break;
+    case TaskState::kRetry: run_retry(in); break;
+    case TaskState::kUndocking: run_undocking(in); break;
+    case TaskState::kNotTasking:
+    case TaskState::kFault:
+    case TaskState::kTestMode:
+      break;
+  }
+
+  emit(in, out);
+  return out;
+}
+
+void TaskManager::emit(const TaskInput& in, TaskOutput& out) {
+  Twist2 cmd{};
+  if (is_moving_state(state_) && !hold_) {
+    cmd.vx_mps = clamp_abs(want_.vx_mps, params_.max_vx_mps);
+    cmd.vy_mps = clamp_abs(want_.vy_mps, params_.max_vy_mps);
+    cmd.wz_radps = clamp_abs(want_.wz_radps, params_.max_wz_radps);
+    if (!std::isfinite(cmd.vx_mps) || !std::isfinite(cmd.vy_mps) || !std::isfinite(cmd.wz_radps)) cmd = Twist2{};
+  }
+  if (!is_zero(cmd)) {
+    if (in.scan != nullptr) {
+      out.obstacles = obstacles_.check(*in.scan, in.lidar_mount, in.dock.valid ? &in.dock.pose : nullptr);
+    }
+    if (motion_blocked(cmd, out.obstacles, params_.gate)) {
+      cmd = Twist2{};
+      out.blocked = true;
+      if (!blocked_) {
+        blocked_ = true;
+        blocked_since_us_ = in.now_us;
+      } else if (since_s(blocked_since_us_, in) > params_.obstacle_timeout_s) {
+        raise(FaultCode::kObstacleTimeout, in);
+      }
+    } else {
+      blocked_ = false;
+    }
+  } else if (!hold_) {
+    blocked_ = false;
+  }
+  out.cmd = cmd;
+
+  TaskStatus& s = out.status;
+  s.state = state_;
+  s.phase = state_ == TaskState::kAlign ? phase_ : static_cast<std::uint8_t>(0);
+  s.fault = fault_;
+  s.retries = retries_;
+  s.retry_reason = state_ == TaskState::kRetry ? retry_reason_ : FaultCode::kNone;
+  s.dock_valid = dock_fresh(in);
+  s.dock_pose = in.dock.pose;
+  s.charge_enable = state_ == TaskState::kWaitForCharge || state_ == TaskState::kFinishTasking;
+  s.last_command = last_command_;
+  s.last_result = last_result_;
+  s.dock_id = dock_id_;
+}
+
+}  // namespace dockcore
