@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "dockcore/cli/parse_errors.hpp"
 
@@ -51,6 +52,25 @@ std::string receive(const Link& l, int timeout_ms) {
 /// the literal prefix dockd always writes first.
 bool reply_ok(const std::string& r) { return r.rfind("{\"ok\":true", 0) == 0; }
 
+/// Prints the status reply's fields named in `keys`, one value per line (strings bare, everything else as JSON).
+/// Returns 0, or 1 when the reply is no JSON object or lacks one of them (named on stderr).
+int print_fields(const std::string& reply, const std::vector<std::string>& keys) {
+  const nlohmann::json j = nlohmann::json::parse(reply, nullptr, false);
+  if (!j.is_object()) {
+    std::fprintf(stderr, "dockctl: the status reply is not a JSON object\n");
+    return 1;
+  }
+  for (const std::string& k : keys) {
+    const auto it = j.find(k);
+    if (it == j.end()) {
+      std::fprintf(stderr, "dockctl: the status has no field \"%s\"\n", k.c_str());
+      return 1;
+    }
+    std::printf("%s\n", it->is_string() ? it->get<std::string>().c_str() : it->dump().c_str());
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -70,7 +90,10 @@ int main(int argc, char** argv) {
   app.add_subcommand("undock", "leave the dock");
   app.add_subcommand("stop", "stop whatever runs (cancel; clears a fault)");
   auto* status = app.add_subcommand("status", "print dockd's status (one JSON line)");
-  status->add_flag("--follow,-f", follow, "subscribe and print the status stream until interrupted");
+  auto* follow_opt = status->add_flag("--follow,-f", follow, "subscribe and print the status stream until interrupted");
+  std::vector<std::string> fields;
+  status->add_option("--field", fields, "print only this field's value (repeatable: one line each, in order)")
+      ->excludes(follow_opt);
   auto* test =
       app.add_subcommand("test", "recognition-only test mode: report the dock estimate, never move ('stop' ends it)");
   test->add_option("--dock", dock_id, "dock id (default: dockd's default dock)")->check(CLI::Range(0, 65535));
@@ -145,6 +168,7 @@ int main(int argc, char** argv) {
     const std::string r = receive(l, static_cast<int>(deadline - now));
     if (r.empty()) break;
     if (r.rfind("{\"type\":\"status\"", 0) == 0) continue;
+    if (!fields.empty() && reply_ok(r)) return print_fields(r, fields);
     std::printf("%s\n", r.c_str());
     return reply_ok(r) ? 0 : 1;
   }

@@ -87,6 +87,13 @@ grep -q '"dock_id":3,"state":"TEST_MODE"' "$WORK/test3.json" || { kill $pid; fai
 "$DOCKCTL" --port $PORT status >"$WORK/status3.json" || { kill $pid; fail "status in test mode"; }
 grep -q '"state":"TEST_MODE"' "$WORK/status3.json" || { kill $pid; fail "test mode status: $(cat "$WORK/status3.json")"; }
 grep -q '"dock_id":3,' "$WORK/status3.json" || { kill $pid; fail "a test on dock 3 must report dock 3: $(cat "$WORK/status3.json")"; }
+# status --field: the named values, one per line, strings bare; a missing key exits 1 naming it.
+out=$("$DOCKCTL" --port $PORT status --field state --field dock_id); rc=$?
+[ $rc -eq 0 ] && [ "$out" = "$(printf 'TEST_MODE\n3')" ] || { kill $pid; fail "status --field: exit $rc: $out"; }
+out=$("$DOCKCTL" --port $PORT status --field no_such_key 2>&1); rc=$?
+[ $rc -eq 1 ] && grep -q 'no field "no_such_key"' <<<"$out" || { kill $pid; fail "status --field no_such_key: exit $rc: $out"; }
+out=$("$DOCKCTL" --port $PORT status --follow --field state 2>&1); rc=$?
+[ $rc -eq 2 ] || { kill $pid; fail "status --follow --field: exit $rc (want 2): $out"; }
 "$DOCKCTL" --port $PORT stop >/dev/null || { kill $pid; fail "stop after test"; }
 "$DOCKCTL" --port $PORT status >"$WORK/status4.json" || { kill $pid; fail "status after stop"; }
 grep -q '"state":"NOT_TASKING"' "$WORK/status4.json" || { kill $pid; fail "stop must end the test: $(cat "$WORK/status4.json")"; }
