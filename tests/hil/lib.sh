@@ -75,14 +75,41 @@ make_dockd_config() {
 # DOCKCTL_TIMEOUT_S: how long dockctl waits for the reply (dockd under memcheck answers slowly).
 DOCKCTL() { "$BUILD/app/dockctl" --port 7300 --timeout "${DOCKCTL_TIMEOUT_S:-2}" "$@"; }
 
+# json_values FILE KEY [EVENT]: KEY of every JSON object in FILE (one object, or JSON lines; "-": standard input)
+# that has it — only those whose "event" is EVENT when given —, one per line, strings bare. A torn or non-JSON line
+# (a log still being written) is skipped.
+json_values() {
+  local filter='fromjson? | objects | select(has($k) and ($ev == "" or .event == $ev)) | .[$k] | tostring'
+  if [ "$1" = - ]; then
+    jq -R -r --arg k "$2" --arg ev "${3:-}" "$filter" 2>/dev/null
+  else
+    jq -R -r --arg k "$2" --arg ev "${3:-}" "$filter" "$1" 2>/dev/null
+  fi
+}
+# json_field FILE KEY [EVENT]: the last of those values ("" when there is none).
+json_field() { json_values "$@" | tail -n 1; }
+# json_select FILE CONDITION: the JSON objects of FILE (as above) for which the jq CONDITION holds, one per line.
+# json_has: at least one does. json_count: how many do.
+json_select() {
+  if [ "$1" = - ]; then
+    jq -R -c "fromjson? | objects | select($2)" 2>/dev/null
+  else
+    jq -R -c "fromjson? | objects | select($2)" "$1" 2>/dev/null
+  fi
+}
+json_has() { [ -n "$(json_select "$@")" ]; }
+json_count() { json_select "$@" | wc -l; }
+
 # Current task state name from dockd over UDP ("" when dockd does not answer).
-dock_state() { DOCKCTL status 2>/dev/null | sed -n 's/.*"state":"\([A-Z_]*\)".*/\1/p'; }
+# The polled helpers ask dockctl for the fields (status --field): one process per poll, no JSON tool started in the
+# loaded VM.
+dock_state() { DOCKCTL status --field state 2>/dev/null; }
 state_is() { [ "$(dock_state)" = "$1" ]; }
 # dockd idle with fresh lidar and chassis data: a docking commanded now starts without a watchdog hold. (A host that
 # docks before that sees the 184/185 watchdog code in the status until the data comes, which a no-fault check counts.)
 dockd_ready() {
-  local s; s=$(DOCKCTL status 2>/dev/null)
-  [[ $s == *'"state":"NOT_TASKING"'* && $s == *'"lidar_stale":false'* && $s == *'"chassis_stale":false'* ]]
+  [ "$(DOCKCTL status --field state --field lidar_stale --field chassis_stale 2>/dev/null | paste -sd ' ')" = \
+    "NOT_TASKING false false" ]
 }
 
 # chassis-sim from this build.

@@ -46,17 +46,16 @@ check_no_fault() {
 }
 
 # Value of KEY in a flat one-line JSON object file (dockctl status), without Python (cheap in the VM).
-matrix_field() { sed -n "s/.*\"$2\":\(\"[^\"]*\"\|[^,}]*\).*/\1/p" "$1" 2>/dev/null | tr -d '"' | head -1; }
 # Wall time of the first inject.log entry NAME.
 inject_time() { awk -v n="$1" '$1 == n {print $2; exit}' "$RD/inject.log"; }
 # Prints the worst-tick figures of the row from its status snapshot.
 # (dockctl status may time out in a starved VM: then dockd's shutdown event, which carries the same statistics.)
 tick_figures() {
   local w o
-  w=$(matrix_field "$RD/status.json" tick_worst_us); o=$(matrix_field "$RD/status.json" tick_overruns)
+  w=$(json_field "$RD/status.json" tick_worst_us); o=$(json_field "$RD/status.json" tick_overruns)
   if [ -z "$w" ]; then
-    grep '"event":"shutdown"' "$RD/record/events.jsonl" 2>/dev/null | tail -1 > "$RD/shutdown.json"
-    w=$(matrix_field "$RD/shutdown.json" worst_tick_us); o=$(matrix_field "$RD/shutdown.json" overruns)
+    w=$(json_field "$RD/record/events.jsonl" worst_tick_us shutdown)
+    o=$(json_field "$RD/record/events.jsonl" overruns shutdown)
   fi
   echo "FIGURE ${ROW}_worst_tick_ms $(awk -v u="$w" 'BEGIN{printf "%.1f", u/1000}')"
   echo "FIGURE ${ROW}_tick_overruns $o"
@@ -108,12 +107,14 @@ row_dock() {
 }
 
 # truth_has EVENT: chassis-sim logged that event. motion_after S: the scenario clock passed S seconds.
-truth_has() { grep -q "\"event\":\"$1\"" "$RD/truth.jsonl" 2>/dev/null; }
+# truth_has and dockd_logged are polled every 0.2 s while the VM is loaded: a fixed-string search for the compact
+# `"event":"NAME"` their writers (chassis-sim, dockd) put in every event line, where starting jq would cost more than
+# the wait it serves. Values are read with json_field.
+truth_has() { grep -qF "\"event\":\"$1\"" "$RD/truth.jsonl" 2>/dev/null; }
 motion_after() {
-  tail -n 3 "$RD/truth.jsonl" 2>/dev/null | grep -o '"motion_t":[-0-9.]*' | tail -1 |
-    awk -F: -v s="$1" '{exit !($2 + 0 >= s + 0)}'
+  tail -n 3 "$RD/truth.jsonl" 2>/dev/null | json_field - motion_t | awk -v s="$1" '{exit !($1 + 0 >= s + 0)}'
 }
-dockd_logged() { grep -q "\"event\":\"$1\"" "$RD/record/events.jsonl" 2>/dev/null; }
+dockd_logged() { grep -qF "\"event\":\"$1\"" "$RD/record/events.jsonl" 2>/dev/null; }
 # wait_state STATE TIMEOUT: poll dockd's status.
 wait_state() { wait_for "$2" state_is "$1"; }
 
@@ -125,7 +126,7 @@ row_stop() {
   stop_bg "$PID_chassis" TERM
   stop_bg "$PID_candump" INT
   echo "INFO row $ROW: $(wc -l < "$RD/candump.log") CAN frames, $(awk -v a="$ROW_T0" -v b="$(hil_now)" \
-       'BEGIN{printf "%.1f", b-a}') s, worst tick $(matrix_field "$RD/status.json" tick_worst_us) us," \
-       "overruns $(matrix_field "$RD/status.json" tick_overruns)"
+       'BEGIN{printf "%.1f", b-a}') s, worst tick $(json_field "$RD/status.json" tick_worst_us) us," \
+       "overruns $(json_field "$RD/status.json" tick_overruns)"
   post tick_figures
 }

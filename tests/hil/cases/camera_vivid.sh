@@ -13,8 +13,7 @@ VIVID_ARGS="n_devs=1 node_types=0x1"  # one instance, video capture node only (/
 MODPROBE="$(command -v modprobe || echo /usr/sbin/modprobe)"
 RMMOD="$(command -v rmmod || echo /usr/sbin/rmmod)"
 
-json_field() { sed -n "s/.*\"$2\":\\([^,}]*\\).*/\\1/p" "$1" | tail -1; }
-summary() { grep '"type":"summary"' "$1" | tail -1 > "$1.summary"; echo "$1.summary"; }
+summary() { json_select "$1" '.type == "summary"' | tail -1 > "$1.summary"; echo "$1.summary"; }
 
 check vivid_module_loads "$MODPROBE" vivid $VIVID_ARGS
 wait_for 20 test -e /dev/video0
@@ -31,7 +30,7 @@ check grey_stamps_increase test "$(json_field "$s" stamp_backsteps)" = 0
 check grey_no_corrupt test "$(json_field "$s" corrupt)" = 0
 check grey_no_loss test "$(json_field "$s" disconnects)" = 0
 check grey_age_below_2s test "$(json_field "$s" max_age_us)" -lt 2000000
-check grey_frame_lines test "$(grep -c '"type":"frame"' "$OUT/grey.log")" -eq 30
+check grey_frame_lines test "$(json_count "$OUT/grey.log" '.type == "frame"')" -eq 30
 echo "FIGURE camera_grey_dropped $(json_field "$s" dropped)"
 echo "FIGURE camera_grey_late $(json_field "$s" late)"
 echo "FIGURE camera_grey_max_age_us $(json_field "$s" max_age_us)"
@@ -70,8 +69,8 @@ check errored_still_10_good_frames test "$(json_field "$s" frames)" = 10
 # 3. Loss and reconnect.
 bg cam "$CC" capture --device /dev/video0 --every 5 --give-up-seconds 90 --reconnect-min-ms 100 \
   --reconnect-max-ms 500 --stop-after-reconnect-frames 10 --expect-reconnect
-wait_for 60 grep -q '"type":"frame"' "$OUT/cam.log"
-check streaming_before_loss grep -q '"type":"frame"' "$OUT/cam.log"
+wait_for 60 json_has "$OUT/cam.log" '.type == "frame"'
+check streaming_before_loss json_has "$OUT/cam.log" '.type == "frame"'
 # Unbinding the platform device unregisters /dev/video0 under the open descriptor (as an unplug does); rmmod alone
 # would refuse while the driver holds the device open.
 unbound=0
@@ -81,16 +80,16 @@ for dev in /sys/bus/platform/drivers/vivid/vivid*; do
   basename "$dev" > /sys/bus/platform/drivers/vivid/unbind && unbound=1
 done
 check vivid_unbound test "$unbound" -eq 1
-wait_for 20 grep -q '"type":"state".*"connected":false' "$OUT/cam.log"
-check loss_reported grep -q '"type":"state".*"connected":false.*"disconnects":1' "$OUT/cam.log"
-check loss_names_device grep -q '"connected":false.*"error":"camera /dev/video0: ' "$OUT/cam.log"
+wait_for 20 json_has "$OUT/cam.log" '.type == "state" and .connected == false'
+check loss_reported json_has "$OUT/cam.log" '.type == "state" and .connected == false and .disconnects == 1'
+check loss_names_device json_has "$OUT/cam.log" '.connected == false and (.error | startswith("camera /dev/video0: "))'
 "$RMMOD" vivid 2>"$OUT/rmmod.err"
 check module_removed_after_close test $? -eq 0
 check video0_gone test ! -e /dev/video0
 sleep 2  # the driver keeps retrying the open meanwhile (ENOENT)
 check vivid_reloads "$MODPROBE" vivid $VIVID_ARGS
-wait_for 60 grep -q '"type":"summary"' "$OUT/cam.log"
-check reconnect_reported grep -q '"type":"state".*"connected":true.*"reconnects":1' "$OUT/cam.log"
+wait_for 60 json_has "$OUT/cam.log" '.type == "summary"'
+check reconnect_reported json_has "$OUT/cam.log" '.type == "state" and .connected == true and .reconnects == 1'
 s=$(summary "$OUT/cam.log")
 check reconnect_counted test "$(json_field "$s" reconnects)" = 1
 check frames_after_reconnect test "$(json_field "$s" frames)" -gt 10

@@ -15,13 +15,13 @@ EV="$OUT/record/events.jsonl"
 # last_total FIELD: that field of the newest can_error event (0 when there is none yet).
 last_total() {
   local v
-  v=$(grep '"event":"can_error"' "$EV" 2>/dev/null | tail -1 | sed -n "s/.*\"$1\":\([0-9]*\).*/\1/p")
+  v=$(json_field "$EV" "$1" can_error)
   echo "${v:-0}"
 }
 total_is() { [ "$(last_total "$1")" = "$2" ]; }
-status_field() { DOCKCTL status 2>/dev/null | sed -n "s/.*\"$1\":\([0-9]*\).*/\1/p"; }
+status_field() { DOCKCTL status --field "$1" 2>/dev/null; }
 
-check no_error_event_before test "$(grep -c '"event":"can_error"' "$EV")" -eq 0
+check no_error_event_before test "$(json_count "$EV" '.event == "can_error"')" -eq 0
 bad_before=$(status_field can_bad_frames)
 
 # One frame of each kind dockd's error filter takes (linux/can/error.h): controller with data[1] = TX error passive,
@@ -36,7 +36,7 @@ check no_bus_off_yet total_is bus_off 0
 cansend vcan0 20000040#0000000000000000   # CAN_ERR_BUSOFF
 check bus_off_counted wait_for 10 total_is bus_off 1
 check bus_off_is_a_bus_error total_is bus_errors 6
-check bus_off_event grep -q '"event":"can_error".*"bus_off":1' "$EV"
+check bus_off_event json_has "$EV" '.event == "can_error" and .bus_off == 1'
 cansend vcan0 20000100#0000000000000000   # CAN_ERR_RESTARTED
 check restart_counted wait_for 10 total_is bus_errors 7
 check one_bus_off total_is bus_off 1
@@ -45,14 +45,14 @@ check one_bus_off total_is bus_off 1
 for i in $(seq 1 20); do cansend vcan0 20000080#0000000000000000; done
 check burst_counted wait_for 15 total_is bus_errors 27
 # The events' `new` fields add up to the total: no error frame counted twice or skipped.
-new_sum=$(grep '"event":"can_error"' "$EV" | sed -n 's/.*"new":\([0-9]*\).*/\1/p' | awk '{s += $1} END {print s + 0}')
-echo "INFO can_error events: $(grep -c '"event":"can_error"' "$EV"), new frames in them: $new_sum"
+new_sum=$(json_values "$EV" new can_error | awk '{s += $1} END {print s + 0}')
+echo "INFO can_error events: $(json_count "$EV" '.event == "can_error"'), new frames in them: $new_sum"
 check events_add_up test "$new_sum" -eq 27
 
 DOCKCTL status > "$OUT/status.json"
 check error_frames_are_not_bad_frames test "$(status_field can_bad_frames)" = "$bad_before"
-check chassis_still_fresh grep -q '"chassis_stale":false' "$OUT/status.json"
-check still_idle grep -q '"state":"NOT_TASKING","state_code":0' "$OUT/status.json"
+check chassis_still_fresh json_has "$OUT/status.json" '.chassis_stale == false'
+check still_idle json_has "$OUT/status.json" '.state == "NOT_TASKING" and .state_code == 0'
 
 stop_bg "$PID_dockd" TERM
 check dockd_sigterm_exit_0 test "$STOP_STATUS" -eq 0

@@ -17,8 +17,8 @@ sleep 0.3
 stop_bg "$PID_candump" INT
 source "$SRC/tests/hil/canlog.sh"
 L="$OUT/candump.log"
-silent_at=$(sed -n 's/^{"wall":\([0-9.]*\),.*"event":"chassis_silent".*/\1/p' "$OUT/truth.jsonl" | head -1)
-answers_at=$(sed -n 's/^{"wall":\([0-9.]*\),.*"event":"chassis_answers".*/\1/p' "$OUT/truth.jsonl" | head -1)
+silent_at=$(json_values "$OUT/truth.jsonl" wall chassis_silent | head -1)
+answers_at=$(json_values "$OUT/truth.jsonl" wall chassis_answers | head -1)
 echo "INFO base silent from $silent_at to $answers_at (CLOCK_REALTIME); DockStatus faults: $(canlog_faults "$L")"
 check silence_happened test -n "$silent_at" -a -n "$answers_at"
 check fault_184_reported grep -qw 184 <<< "$(canlog_faults "$L")"
@@ -29,4 +29,4 @@ check zero_within_300ms_of_silence test "$reaction" != none -a "${reaction/none/
 hold_nonzero=$(canlog_nonzero "$L" "$(awk -v s="$silent_at" 'BEGIN{printf "%.6f", s + 0.3}')" "$answers_at")
 echo "INFO non-zero wheel commands while the base was silent (after the reaction): $hold_nonzero"
 check no_motion_while_silent test "$hold_nonzero" -eq 0
-grep -o '"tick_worst_us":[0-9]*,"tick_overruns":[0-9]*' "$OUT/status.json" | sed 's/^/INFO /'
+echo "INFO tick_worst_us $(json_field "$OUT/status.json" tick_worst_us) tick_overruns $(json_field "$OUT/status.json" tick_overruns)"

@@ -10,8 +10,8 @@ check dockd_up wait_for 20 dockd_ready
 check dock_accepted DOCKCTL dock --dock 0
 check charging_with_corrupt_lidar wait_for 180 state_is FINISH_TASKING
 DOCKCTL status > "$OUT/status.json"
-crc=$(sed -n 's/.*"lidar_crc_errors":\([0-9]*\).*/\1/p' "$OUT/status.json")
-scans=$(sed -n 's/.*"scans":\([0-9]*\).*/\1/p' "$OUT/status.json")
+crc=$(json_field "$OUT/status.json" lidar_crc_errors)
+scans=$(json_field "$OUT/status.json" scans)
 echo "FIGURE lidar_corrupt_crc_errors $crc"
 echo "FIGURE lidar_corrupt_scans $scans"
 check crc_counter_shows_corruption test "${crc:-0}" -gt 0
@@ -20,4 +20,4 @@ echo "FIGURE lidar_corrupt_final_lateral_mm $lat"
 check contact_error_within_1cm awk -v l="$lat" 'BEGIN{exit !(l != "" && l+0 <= 10 && l+0 >= -10)}'
 stop_bg "$PID_dockd" TERM
 check dockd_sigterm_exit_0 test "$STOP_STATUS" -eq 0
-grep -o '"tick_worst_us":[0-9]*,"tick_overruns":[0-9]*' "$OUT/status.json" | sed 's/^/INFO /'
+echo "INFO tick_worst_us $(json_field "$OUT/status.json" tick_worst_us) tick_overruns $(json_field "$OUT/status.json" tick_overruns)"

@@ -107,7 +107,7 @@ row_dock
 wait_for 30 motion_after 1
 inject bad_frames
 DOCKCTL dock --dock 0 > "$RD/udp_dup.json" 2>&1
-check can_bad_frames_udp_duplicate_rejected grep -q '"code":6' "$RD/udp_dup.json"
+check can_bad_frames_udp_duplicate_rejected json_has "$RD/udp_dup.json" '.code == 6'
 good=$("$HF" cancel 0 2 2)
 # Bad checksums: a valid frame's CRC byte inverted (WheelFbA 0x110 with zero speeds, counters 1-5; the cancel).
 badcrc() { echo "${1%??}$(printf '%02X' $(( 0x${1: -2} ^ 0xFF )))"; }
@@ -119,8 +119,8 @@ cansend vcan0 "$("$HF" dock 0 1 1)"     # the same frame again: duplicate counte
 check can_bad_frames_docked_anyway wait_state FINISH_TASKING 60
 row_stop
 post post_can_bad_frames
-bad=$(matrix_field "$RD/status.json" can_bad_frames)
-rej=$(matrix_field "$RD/status.json" can_host_rejected)
+bad=$(json_field "$RD/status.json" can_bad_frames)
+rej=$(json_field "$RD/status.json" can_host_rejected)
 echo "FIGURE can_bad_frames_counted $bad"
 echo "FIGURE can_bad_frames_can_host_rejected ${rej:-absent}"
 # 5 + 1 bad checksums, 1 stale, 1 duplicate: 8 link rejections (can_bad_frames); the replayed sequence is rejected

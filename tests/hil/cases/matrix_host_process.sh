@@ -111,9 +111,9 @@ row_stop
 post post_flood
 # Every replay that reaches dockd is rejected by the sequence rule (can_host_rejected); frames the kernel dropped
 # from dockd's full socket queue while it was starved never arrive (reported: 10000 - rejected - bad frames).
-rej=$(matrix_field "$RD/status.json" can_host_rejected)
+rej=$(json_field "$RD/status.json" can_host_rejected)
 echo "FIGURE host_flood_can_can_host_rejected ${rej:-absent}"
-echo "FIGURE host_flood_can_not_received $(( 10000 - ${rej:-0} - $(matrix_field "$RD/status.json" can_bad_frames) ))"
+echo "FIGURE host_flood_can_not_received $(( 10000 - ${rej:-0} - $(json_field "$RD/status.json" can_bad_frames) ))"
 check host_flood_can_replays_rejected test "${rej:-0}" -gt 0
 
 # Bad host requests (idle robot): malformed JSON -> 1, unknown command -> 2, unknown dock id -> 5 (UDP); on CAN an
@@ -123,7 +123,7 @@ row_start host_bad_commands
 "$UDP" send 7300 '{"cmd":"fly"}' >> "$RD/replies.txt"
 "$UDP" send 7300 '{"cmd":"dock","dock_id":9}' >> "$RD/replies.txt"
 sed 's/^/INFO host_bad_commands reply: /' "$RD/replies.txt"
-reply_code() { sed -n "${1}p" "$RD/replies.txt" | grep -q "\"code\":$2,"; }
+reply_code() { [ "$(sed -n "${1}p" "$RD/replies.txt" | json_field - code)" = "$2" ]; }
 check host_bad_commands_malformed_1 reply_code 1 1
 check host_bad_commands_unknown_command_2 reply_code 2 2
 check host_bad_commands_unknown_dock_5 reply_code 3 5
@@ -133,16 +133,16 @@ sleep 1
 check host_bad_commands_state_unchanged state_is NOT_TASKING
 row_stop
 post post_bad_commands
-rej=$(matrix_field "$RD/status.json" commands_rejected)
+rej=$(json_field "$RD/status.json" commands_rejected)
 echo "FIGURE host_bad_commands_rejected $rej"
 # 3 on UDP (malformed and unknown command refused by the link's parser, unknown dock id by dockd) + 2 on CAN (the task
 # manager's rejected_unknown / rejected_dock_id): all in commands_rejected.
 check host_bad_commands_all_counted test "${rej:-0}" -ge 5
 # CAN: the task manager's verdicts, in the event log and in DockStatus LastResult (CommandResult).
-check host_bad_commands_can_unknown_rejected grep -q '"source":"can","command":9.*"result":"rejected_unknown"' \
-  "$RD/record/events.jsonl"
-check host_bad_commands_can_dock_id_rejected grep -q '"source":"can","command":1,"dock_id":9.*"result":"rejected_dock_id"' \
-  "$RD/record/events.jsonl"
+check host_bad_commands_can_unknown_rejected json_has "$RD/record/events.jsonl" \
+  '.source == "can" and .command == 9 and .result == "rejected_unknown"'
+check host_bad_commands_can_dock_id_rejected json_has "$RD/record/events.jsonl" \
+  '.source == "can" and .command == 1 and .dock_id == 9 and .result == "rejected_dock_id"'
 
 # SIGKILL mid-approach (2 s into the motion): nothing stops the robot but the base's own command timeout (500 ms
 # after the last wheel command; chassis-sim truth event command_timeout): limit 500 ms + one 5 ms physics step +
@@ -167,8 +167,8 @@ inject restart
 row_dockd
 check process_restart_idle wait_for 30 state_is NOT_TASKING
 sleep 2
-check process_restart_reports_interrupted grep -q '"event":"previous_session".*"clean":false' "$RD/record/events.jsonl"
-grep '"previous_session"' "$RD/record/events.jsonl" | sed 's/^/INFO /'
+check process_restart_reports_interrupted json_has "$RD/record/events.jsonl" '.event == "previous_session" and .clean == false'
+json_select "$RD/record/events.jsonl" '.event == "previous_session"' | sed 's/^/INFO /'
 inject redock
 cansend vcan0 "$("$HF" dock 0 1)"
 sleep 3

@@ -49,11 +49,11 @@ sleep 3
 row_stop
 judge --fault first:HostCommand:dock --no-moving-check --code 185 --state 8 --status-limit-ms 60 --recover none
 post post_lidar_protocol
-check lidar_protocol_no_scans test "$(matrix_field "$RD/status.json" scans)" = 0
-errs=$(( $(matrix_field "$RD/status.json" lidar_crc_errors) + $(matrix_field "$RD/status.json" lidar_resyncs) ))
+check lidar_protocol_no_scans test "$(json_field "$RD/status.json" scans)" = 0
+errs=$(( $(json_field "$RD/status.json" lidar_crc_errors) + $(json_field "$RD/status.json" lidar_resyncs) ))
 echo "FIGURE lidar_protocol_parser_errors $errs"
 # RPLIDAR bytes hold no LD06 packet: every one read is dropped and counted (a CRC error or resync needs a chance
 # 0x54 0x2C pair in the stream, which a short or starved row may not contain).
-dropped=$(matrix_field "$RD/status.json" lidar_dropped_bytes)
+dropped=$(json_field "$RD/status.json" lidar_dropped_bytes)
 echo "FIGURE lidar_protocol_dropped_bytes ${dropped:-absent}"
 check lidar_protocol_garbage_counted test "${dropped:-0}" -gt 0

@@ -93,7 +93,7 @@ sleep 1
 row_stop
 judge --fault status:182 --no-moving-check --code 182 --limit-ms 40 --recover none
 post post_no_charge
-press=$(tail -2 "$RD/truth.jsonl" | head -1 | grep -o '"press_m":[-0-9.]*' | cut -d: -f2)
+press=$(tail -2 "$RD/truth.jsonl" | head -1 | json_field - press_m)
 echo "FIGURE motion_no_charge_final_distance_m ${press#-}"
 check motion_no_charge_backed_off awk -v p="$press" 'BEGIN{exit !(p != "" && p + 0 <= -0.3)}'
 

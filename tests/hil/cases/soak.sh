@@ -116,7 +116,7 @@ check soak_dockd_rss_flat awk -v s="$SOAK_RSS_SLACK_KIB" 'NR == 2 {b = $5} NR > 
 # How starved the VM was: dockd's own tick statistics and watchdog resumes.
 DOCKCTL status > "$OUT/status_end.json" 2>/dev/null
 for f in ticks tick_worst_us tick_overruns tick_work_worst_us resumes; do
-  echo "FIGURE soak_dockd_$f $(sed -n "s/.*\"$f\":\([0-9]*\).*/\1/p" "$OUT/status_end.json")"
+  echo "FIGURE soak_dockd_$f $(json_field "$OUT/status_end.json" "$f")"
 done
 stop_bg "$PID_dockd" TERM
 check dockd_sigterm_exit_0 test "$STOP_STATUS" -eq 0

@@ -16,6 +16,6 @@ DOCKCTL stop > /dev/null || true
 stop_bg "$PID_dockd" TERM
 echo "INFO dockd under memcheck exit $STOP_STATUS; status: $(cut -c1-160 "$OUT/status.json")"
 grep -E "total heap usage|ERROR SUMMARY|definitely lost|indirectly lost|possibly lost" "$OUT/memcheck.txt" | sed 's/^==[0-9]*== /INFO /'
-check status_answered_under_memcheck grep -q '"state":' "$OUT/status.json"
+check status_answered_under_memcheck json_has "$OUT/status.json" 'has("state")'
 check memcheck_exit_0 test "$STOP_STATUS" -eq 0
 check memcheck_no_errors grep -q "ERROR SUMMARY: 0 errors" "$OUT/memcheck.txt"
