@@ -119,37 +119,10 @@ Daemon::~Daemon() = default;
 
 // --- config reload (SIGHUP) ----------------------------------------------------------------------------------------
 
-namespace {
-
-// The message as a JSON string body: quotes, backslashes and control bytes escaped; cut at `max` bytes.
-std::string json_escape(const std::string& in, std::size_t max) {
-  std::string out;
-  for (char ch : in) {
-    if (out.size() >= max) {
-      out += "...";
-      break;
-    }
-    const unsigned char u = static_cast<unsigned char>(ch);
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (u < 0x20) {
-      char b[8];
-      std::snprintf(b, sizeof b, "\\u%04x", u);
-      out += b;
-    } else {
-      out += ch;
-    }
-  }
-  return out;
-}
-
-}  // namespace
-
 void Daemon::log_reload(std::uint64_t now_us, const char* result, const std::string& message, LogLevel level) {
-  const std::string line = "{\"t_us\":" + std::to_string(now_us) + ",\"event\":\"config_reload\",\"result\":\"" +
-                           result + "\",\"message\":\"" + json_escape(message, 1024) + "\"}\n";
-  emit_event(level, line.data(), line.size());
+  EventLine e(now_us, "config_reload");
+  e.w.str("result", result).str_cut("message", message.c_str(), 1024);
+  log_event(e, level);
 }
 
 ReloadResult Daemon::reload_from_file(const std::string& path, std::uint64_t now_us, std::string& message,
@@ -273,14 +246,10 @@ bool Daemon::start(std::string& error) {
   const std::uint64_t now = io_.clock->now_us();
   std::string msg;
   const StateLoadStatus st = load_state(cfg_.state_file, state_, msg);
-  char line[768];
   if (st == StateLoadStatus::kRecoveredBackup || st == StateLoadStatus::kCorruptNoBackup) {
-    const int n = std::snprintf(
-        line, sizeof line, "{\"t_us\":%llu,\"event\":\"state_file\",\"level\":\"%s\",\"message\":\"%s\"}\n",
-        static_cast<unsigned long long>(now), st == StateLoadStatus::kCorruptNoBackup ? "error" : "warn", msg.c_str());
-    if (n > 0)
-      emit_event(st == StateLoadStatus::kCorruptNoBackup ? LogLevel::kError : LogLevel::kWarn, line,
-                 static_cast<std::size_t>(n) < sizeof line ? static_cast<std::size_t>(n) : sizeof line - 1);
+    EventLine e(now, "state_file");
+    e.w.str("level", st == StateLoadStatus::kCorruptNoBackup ? "error" : "warn").str_cut("message", msg.c_str(), 1024);
+    log_event(e, st == StateLoadStatus::kCorruptNoBackup ? LogLevel::kError : LogLevel::kWarn);
   }
   if (!configure_core(cfg_.default_dock_id, false)) {
     error = "dock profile of dock " + std::to_string(cfg_.default_dock_id) + " refused by the estimator";
@@ -288,12 +257,12 @@ bool Daemon::start(std::string& error) {
   }
   start_us_ = now;
   started_ = true;
-  const int n = std::snprintf(line, sizeof line,
-                              "{\"t_us\":%llu,\"event\":\"start\",\"controller\":\"%s\",\"docks\":%zu,\"taught\":%zu,"
-                              "\"default_dock\":%u}\n",
-                              static_cast<unsigned long long>(now), controller_->name(), cfg_.docks.size(),
-                              state_.targets.size(), cfg_.default_dock_id);
-  if (n > 0) emit_event(LogLevel::kInfo, line, static_cast<std::size_t>(n));
+  EventLine e(now, "start");
+  e.w.str("controller", controller_->name())
+      .uint("docks", cfg_.docks.size())
+      .uint("taught", state_.targets.size())
+      .uint("default_dock", cfg_.default_dock_id);
+  log_event(e, LogLevel::kInfo);
   return true;
 }
 
@@ -304,11 +273,13 @@ void Daemon::emit_event(LogLevel level, const char* line, std::size_t len) {
   }
 }
 
-void Daemon::log_event(std::uint64_t now_us, const char* event, const char* fields, LogLevel level) {
-  char line[768];
-  const int n = std::snprintf(line, sizeof line, "{\"t_us\":%llu,\"event\":\"%s\"%s%s}\n",
-                              static_cast<unsigned long long>(now_us), event, fields[0] != '\0' ? "," : "", fields);
-  if (n > 0 && static_cast<std::size_t>(n) < sizeof line) emit_event(level, line, static_cast<std::size_t>(n));
+void Daemon::log_event(EventLine& e, LogLevel level) {
+  const std::size_t n = e.w.finish(true);
+  if (n > 0) {
+    emit_event(level, e.buf, n);
+  } else {
+    ++counters_.events_too_long;
+  }
 }
 
 void Daemon::send_wheels(const dockcore::hal::WheelCommand& w) {
@@ -326,11 +297,12 @@ void Daemon::send_zero(std::uint64_t, int frames) {
 void Daemon::log_shutdown(std::uint64_t now_us, const char* reason) {
   if (shutdown_logged_) return;
   shutdown_logged_ = true;
-  char f[256];
-  std::snprintf(f, sizeof f, "\"reason\":\"%s\",\"state\":\"%s\",\"worst_tick_us\":%llu,\"overruns\":%llu", reason,
-                dockcore::to_string(state()), static_cast<unsigned long long>(stats_.worst_period_us),
-                static_cast<unsigned long long>(stats_.overruns));
-  log_event(now_us, "shutdown", f, LogLevel::kInfo);
+  EventLine e(now_us, "shutdown");
+  e.w.str("reason", reason)
+      .str("state", dockcore::to_string(state()))
+      .uint("worst_tick_us", stats_.worst_period_us)
+      .uint("overruns", stats_.overruns);
+  log_event(e, LogLevel::kInfo);
 }
 
 // --- inputs ------------------------------------------------------------------------------------------------------
@@ -340,10 +312,9 @@ void Daemon::poll_chassis(std::uint64_t now_us) {
   // Error frames on the bus (bus-off, controller error passive, no ACK, ...): one event per poll that saw new ones.
   const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
   if (cc.bus_errors > reported_bus_errors_) {
-    char f[96];
-    std::snprintf(f, sizeof f, "\"bus_errors\":%u,\"bus_off\":%u,\"new\":%u", cc.bus_errors, cc.bus_off,
-                  cc.bus_errors - reported_bus_errors_);
-    log_event(now_us, "can_error", f, cc.bus_off > reported_bus_off_ ? LogLevel::kError : LogLevel::kWarn);
+    EventLine e(now_us, "can_error");
+    e.w.uint("bus_errors", cc.bus_errors).uint("bus_off", cc.bus_off).uint("new", cc.bus_errors - reported_bus_errors_);
+    log_event(e, cc.bus_off > reported_bus_off_ ? LogLevel::kError : LogLevel::kWarn);
   }
   reported_bus_errors_ = cc.bus_errors;
   reported_bus_off_ = cc.bus_off;
@@ -451,7 +422,8 @@ bool Daemon::enqueue(const PendingCommand& c) {
 }
 
 void Daemon::reply_json(const HostRequest& r, const char* json, std::size_t len) {
-  if (io_.udp_host != nullptr && len > 0) io_.udp_host->reply(r.peer, json, len);
+  // A reply that did not fit its buffer (len 0) reaches the link too, which counts it as a send failure.
+  if (io_.udp_host != nullptr) io_.udp_host->reply(r.peer, json, len);
 }
 
 void Daemon::reply_error(const HostRequest& r, HostErrorCode code, const char* msg) {
@@ -461,31 +433,28 @@ void Daemon::reply_error(const HostRequest& r, HostErrorCode code, const char* m
   ++counters_.commands_rejected;
   if (io_.udp_host != nullptr) io_.udp_host->count_rejected();
   if (!refusal_log_.admit(r.stamp_us)) return;
-  char f[256];
-  std::snprintf(f, sizeof f, "\"source\":\"udp\",\"cmd\":\"%s\",\"seq\":%u,\"error\":\"%s\"", to_string(r.kind), r.seq,
-                to_string(code));
-  log_event(r.stamp_us, "command_rejected", f, LogLevel::kWarn);
+  EventLine e(r.stamp_us, "command_rejected");
+  e.w.str("source", "udp").str("cmd", to_string(r.kind)).uint("seq", r.seq).str("error", to_string(code));
+  log_event(e, LogLevel::kWarn);
 }
 
 void Daemon::report_held_events(std::uint64_t now_us) {
   const std::uint32_t n = refusal_log_.take_held(now_us);
   if (n == 0) return;
-  char f[128];
-  std::snprintf(f, sizeof f, "\"of\":\"refusals\",\"count\":%u,\"limit_per_s\":%u", n,
-                EventRateLimit::kPerWindow);
-  log_event(now_us, "events_held_back", f, LogLevel::kWarn);
+  EventLine e(now_us, "events_held_back");
+  e.w.str("of", "refusals").uint("count", n).uint("limit_per_s", EventRateLimit::kPerWindow);
+  log_event(e, LogLevel::kWarn);
 }
 
 void Daemon::handle_udp_request(const HostRequest& r, std::uint64_t now_us) {
   switch (r.kind) {
     case HostRequestKind::kStatus: {
-      char buf[dockcore::drivers::kMaxHostReply];
-      std::size_t n = status_json(buf, sizeof buf - 64, now_us);
-      if (n == 0) return;
-      // Turn the status object into the reply: {"ok":true,"seq":N, ...status fields}.
+      // The reply is the status object with {"ok":true,"cmd":"status","seq":N} in front.
       char out[dockcore::drivers::kMaxHostReply];
-      const int m = std::snprintf(out, sizeof out, "{\"ok\":true,\"cmd\":\"status\",\"seq\":%u,%s", r.seq, buf + 1);
-      if (m > 0 && static_cast<std::size_t>(m) < sizeof out) reply_json(r, out, static_cast<std::size_t>(m));
+      dockcore::drivers::JsonWriter w(out, sizeof out);
+      w.boolean("ok", true).str("cmd", "status").uint("seq", r.seq);
+      status_fields(w, now_us);
+      reply_json(r, out, w.finish());
       return;
     }
     case HostRequestKind::kTeach:
@@ -549,10 +518,9 @@ void Daemon::poll_hosts(std::uint64_t now_us) {
         ++counters_.commands_rejected;
         if (c.type == HostCommandType::kCancel) queue_[(queue_head_ + queue_size_ - 1) % kQueue] = c;
       }
-      char f[128];
-      std::snprintf(f, sizeof f, "\"source\":\"can\",\"command\":%u,\"dock_id\":%u,\"seq\":%u", m.command, m.dock_id,
-                    m.sequence);
-      log_event(now_us, "command", f);
+      EventLine e(now_us, "command");
+      e.w.str("source", "can").uint("command", m.command).uint("dock_id", m.dock_id).uint("seq", m.sequence);
+      log_event(e);
     }
   }
 }
@@ -583,23 +551,23 @@ void Daemon::watchdogs(std::uint64_t now_us) {
     if (lidar) ++counters_.lidar_stale_trips;
     // Why it went stale, for a log read after the fact: how old the newest turn's end and the newest parse are
     // (-1: none yet). A turn that ended long ago but was parsed just now is a backlog; both old is a silent lidar.
-    char f[192];
     const auto age_ms = [now_us](std::uint64_t t) {
-      return t == 0 || t > now_us ? -1LL : static_cast<long long>((now_us - t) / 1000u);
+      return t == 0 || t > now_us ? std::int64_t{-1} : static_cast<std::int64_t>((now_us - t) / 1000u);
     };
-    std::snprintf(f, sizeof f,
-                  "\"which\":\"lidar\",\"stale\":%s,\"fault\":%u,\"turn_end_age_ms\":%lld,\"parsed_age_ms\":%lld,"
-                  "\"late_scans\":%u",
-                  lidar ? "true" : "false", static_cast<unsigned>(FaultCode::kLidarStale), age_ms(last_scan_rx_us_),
-                  age_ms(last_scan_parsed_us_), counters_.late_scans);
-    log_event(now_us, "watchdog", f, lidar ? LogLevel::kWarn : LogLevel::kInfo);
+    EventLine e(now_us, "watchdog");
+    e.w.str("which", "lidar")
+        .boolean("stale", lidar)
+        .uint("fault", static_cast<unsigned>(FaultCode::kLidarStale))
+        .sint("turn_end_age_ms", age_ms(last_scan_rx_us_))
+        .sint("parsed_age_ms", age_ms(last_scan_parsed_us_))
+        .uint("late_scans", counters_.late_scans);
+    log_event(e, lidar ? LogLevel::kWarn : LogLevel::kInfo);
   }
   if (chassis != chassis_stale_) {
     if (chassis) ++counters_.chassis_stale_trips;
-    char f[96];
-    std::snprintf(f, sizeof f, "\"which\":\"chassis\",\"stale\":%s,\"fault\":%u", chassis ? "true" : "false",
-                  static_cast<unsigned>(FaultCode::kChassisStale));
-    log_event(now_us, "watchdog", f, chassis ? LogLevel::kWarn : LogLevel::kInfo);
+    EventLine e(now_us, "watchdog");
+    e.w.str("which", "chassis").boolean("stale", chassis).uint("fault", static_cast<unsigned>(FaultCode::kChassisStale));
+    log_event(e, chassis ? LogLevel::kWarn : LogLevel::kInfo);
   }
   camera_watchdog(now_us);
   if (lidar && !lidar_stale_) lidar_stale_since_us_ = now_us;
@@ -619,14 +587,14 @@ void Daemon::camera_watchdog(std::uint64_t now_us) {
       now_us > since && now_us - since > static_cast<std::uint64_t>(cfg_.camera_device.stall_ms) * 1000u;
   if (stalled == camera_stalled_) return;
   if (stalled) ++counters_.camera_stalls;
-  char f[160];
-  std::snprintf(f, sizeof f, "\"which\":\"camera\",\"stale\":%s,\"last_frame_age_ms\":%lld,\"camera_stalls\":%u",
-                stalled ? "true" : "false",
-                last == 0       ? -1LL
-                : last > now_us ? 0LL
-                                : static_cast<long long>((now_us - last) / 1000u),
-                counters_.camera_stalls);
-  log_event(now_us, "watchdog", f, stalled ? LogLevel::kWarn : LogLevel::kInfo);
+  EventLine e(now_us, "watchdog");
+  e.w.str("which", "camera")
+      .boolean("stale", stalled)
+      .sint("last_frame_age_ms", last == 0       ? std::int64_t{-1}
+                                 : last > now_us ? std::int64_t{0}
+                                                 : static_cast<std::int64_t>((now_us - last) / 1000u))
+      .uint("camera_stalls", counters_.camera_stalls);
+  log_event(e, stalled ? LogLevel::kWarn : LogLevel::kInfo);
   camera_stalled_ = stalled;
 }
 
@@ -669,9 +637,9 @@ void Daemon::start_teach(const HostRequest& r, std::uint64_t now_us) {
   teach_.sx = teach_.sy = teach_.sc = teach_.ss = 0;
   teach_.deadline_us = now_us + static_cast<std::uint64_t>(cfg_.teach_timeout_s * 1e6);
   teach_.request = r;
-  char f[96];
-  std::snprintf(f, sizeof f, "\"dock_id\":%u,\"scans\":%u", id, teach_.wanted);
-  log_event(now_us, "teach_start", f);
+  EventLine e(now_us, "teach_start");
+  e.w.uint("dock_id", id).uint("scans", teach_.wanted);
+  log_event(e);
 }
 
 void Daemon::teach_sample(const dockcore::DockEstimate& e) {
@@ -725,21 +693,28 @@ void Daemon::finish_teach(bool ok, const char* why, std::uint64_t now_us) {
   state_ = next;
   configure_core(id, false);
   const Pose2 nom = nominal_docked_target(cfg_);
+  // The taught target, once for the event and once inside the reply.
+  char tb[256];
+  dockcore::drivers::JsonWriter target(tb, sizeof tb);
+  target.uint("dock_id", id)
+      .uint("scans", t.scans)
+      .real("target_x_m", static_cast<double>(t.target.x_m), 4)
+      .real("target_y_m", static_cast<double>(t.target.y_m), 4)
+      .real("target_yaw_deg", deg(t.target.yaw_rad), 3);
   char buf[512];
-  const int m = std::snprintf(
-      buf, sizeof buf,
-      "{\"ok\":true,\"cmd\":\"teach\",\"seq\":%u,\"dock_id\":%u,\"scans\":%u,\"target_x_m\":%.4f,"
-      "\"target_y_m\":%.4f,\"target_yaw_deg\":%.3f,\"spread_mm\":%.2f,\"offset_x_mm\":%.1f,"
-      "\"offset_y_mm\":%.1f,\"offset_yaw_deg\":%.3f}",
-      r.seq, id, t.scans, static_cast<double>(t.target.x_m), static_cast<double>(t.target.y_m), deg(t.target.yaw_rad),
-      spread * 1e3, static_cast<double>(t.target.x_m - nom.x_m) * 1e3,
-      static_cast<double>(t.target.y_m - nom.y_m) * 1e3, deg(dockcore::wrap_angle(t.target.yaw_rad - nom.yaw_rad)));
-  if (m > 0) reply_json(r, buf, static_cast<std::size_t>(m));
-  char f[256];
-  std::snprintf(f, sizeof f,
-                "\"dock_id\":%u,\"scans\":%u,\"target_x_m\":%.4f,\"target_y_m\":%.4f,\"target_yaw_deg\":%.3f", id,
-                t.scans, static_cast<double>(t.target.x_m), static_cast<double>(t.target.y_m), deg(t.target.yaw_rad));
-  log_event(now_us, "teach_done", f);
+  dockcore::drivers::JsonWriter reply(buf, sizeof buf);
+  reply.boolean("ok", true)
+      .str("cmd", "teach")
+      .uint("seq", r.seq)
+      .fields(target.body(), target.body_len())
+      .real("spread_mm", spread * 1e3, 2)
+      .real("offset_x_mm", static_cast<double>(t.target.x_m - nom.x_m) * 1e3, 1)
+      .real("offset_y_mm", static_cast<double>(t.target.y_m - nom.y_m) * 1e3, 1)
+      .real("offset_yaw_deg", deg(dockcore::wrap_angle(t.target.yaw_rad - nom.yaw_rad)), 3);
+  reply_json(r, buf, reply.finish());
+  EventLine e(now_us, "teach_done");
+  e.w.fields(target.body(), target.body_len());
+  log_event(e);
 }
 
 void Daemon::teach_progress(std::uint64_t now_us) {
@@ -811,12 +786,13 @@ void Daemon::on_tick(std::uint64_t now_us) {
       cmd.dock_id = interrupted_dock_;
       cmd.resume = true;
       have_cmd = true;
-      char f[96];
-      std::snprintf(f, sizeof f, "\"command\":%u,\"dock_id\":%u,\"resume\":%u", static_cast<unsigned>(cmd.type),
-                    cmd.dock_id, resumes_this_task_);
-      log_event(now_us, "resume", f);
+      EventLine e(now_us, "resume");
+      e.w.uint("command", static_cast<unsigned>(cmd.type)).uint("dock_id", cmd.dock_id).uint("resume", resumes_this_task_);
+      log_event(e);
     } else {
-      log_event(now_us, "resume_given_up", "\"reason\":\"max resumes reached\"", LogLevel::kWarn);
+      EventLine e(now_us, "resume_given_up");
+      e.w.str("reason", "max resumes reached");
+      log_event(e, LogLevel::kWarn);
     }
     interrupted_ = HostCommandType::kNone;
   }
@@ -852,12 +828,14 @@ void Daemon::on_tick(std::uint64_t now_us) {
     if (cmd.from_udp) {
       if (accepted) {
         char buf[256];
-        const int m =
-            std::snprintf(buf, sizeof buf,
-                          "{\"ok\":true,\"cmd\":\"%s\",\"seq\":%u,\"result\":\"%s\",\"dock_id\":%u,\"state\":\"%s\"}",
-                          to_string(cmd.request.kind), cmd.request.seq, dockcore::to_string(out.command_result),
-                          cmd.dock_id, dockcore::to_string(after));
-        if (m > 0) reply_json(cmd.request, buf, static_cast<std::size_t>(m));
+        dockcore::drivers::JsonWriter reply(buf, sizeof buf);
+        reply.boolean("ok", true)
+            .str("cmd", to_string(cmd.request.kind))
+            .uint("seq", cmd.request.seq)
+            .str("result", dockcore::to_string(out.command_result))
+            .uint("dock_id", cmd.dock_id)
+            .str("state", dockcore::to_string(after));
+        reply_json(cmd.request, buf, reply.finish());
       } else {
         char msg[128];
         std::snprintf(msg, sizeof msg, "task manager: %s (state %s)", dockcore::to_string(out.command_result),
@@ -865,12 +843,13 @@ void Daemon::on_tick(std::uint64_t now_us) {
         reply_error(cmd.request, HostErrorCode::kRejected, msg);
       }
     }
-    char f[192];
-    std::snprintf(f, sizeof f, "\"source\":\"%s\",\"command\":%u,\"dock_id\":%u,\"result\":\"%s\"",
-                  cmd.resume ? "resume" : (cmd.from_udp ? "udp" : "can"), static_cast<unsigned>(cmd.type), cmd.dock_id,
-                  dockcore::to_string(out.command_result));
     if (accepted || refusal_log_.admit(now_us)) {
-      log_event(now_us, "command_result", f, accepted ? LogLevel::kInfo : LogLevel::kWarn);
+      EventLine e(now_us, "command_result");
+      e.w.str("source", cmd.resume ? "resume" : (cmd.from_udp ? "udp" : "can"))
+          .uint("command", static_cast<unsigned>(cmd.type))
+          .uint("dock_id", cmd.dock_id)
+          .str("result", dockcore::to_string(out.command_result));
+      log_event(e, accepted ? LogLevel::kInfo : LogLevel::kWarn);
     }
   }
 
@@ -900,9 +879,9 @@ void Daemon::on_tick(std::uint64_t now_us) {
     io_.chassis->request_charging(charge);
     charge_refresh_ = 0;
     if (charge != charge_requested_) {
-      char f[48];
-      std::snprintf(f, sizeof f, "\"on\":%s", charge ? "true" : "false");
-      log_event(now_us, "charge_request", f);
+      EventLine e(now_us, "charge_request");
+      e.w.boolean("on", charge);
+      log_event(e);
     }
     charge_requested_ = charge;
   }
@@ -910,31 +889,31 @@ void Daemon::on_tick(std::uint64_t now_us) {
   // Events.
   const dockcore::TaskStatus& s = out.status;
   if (!prev_status_valid_ || s.state != prev_status_.state) {
-    char f[224];
-    int n = std::snprintf(f, sizeof f, "\"from\":\"%s\",\"to\":\"%s\",\"dock_id\":%u,\"result\":\"%s\"",
-                          prev_status_valid_ ? dockcore::to_string(prev_status_.state) : "START",
-                          dockcore::to_string(s.state), s.dock_id, to_string_result(s.last_result));
-    if (s.state == TaskState::kRetry && n > 0 && static_cast<std::size_t>(n) < sizeof f) {
+    EventLine e(now_us, "state");
+    e.w.str("from", prev_status_valid_ ? dockcore::to_string(prev_status_.state) : "START")
+        .str("to", dockcore::to_string(s.state))
+        .uint("dock_id", s.dock_id)
+        .str("result", to_string_result(s.last_result));
+    if (s.state == TaskState::kRetry) {
       // Why the attempt ended, and in which controller phase: what a user needs to tell a bad line-up from a
       // charger that never delivered.
-      std::snprintf(f + n, sizeof f - static_cast<std::size_t>(n), ",\"reason\":\"%s\",\"code\":%u,\"phase\":\"%s\"",
-                    dockcore::to_string(s.retry_reason), static_cast<unsigned>(s.retry_reason),
-                    prev_status_.state == TaskState::kAlign ? controller_->phase_name(prev_status_.phase)
-                                                            : dockcore::to_string(prev_status_.state));
+      e.w.str("reason", dockcore::to_string(s.retry_reason))
+          .uint("code", static_cast<unsigned>(s.retry_reason))
+          .str("phase", prev_status_.state == TaskState::kAlign ? controller_->phase_name(prev_status_.phase)
+                                                                : dockcore::to_string(prev_status_.state));
     }
-    log_event(now_us, "state", f);
+    log_event(e);
   }
   if (s.state == TaskState::kAlign &&
       (!prev_status_valid_ || s.phase != prev_status_.phase || prev_status_.state != TaskState::kAlign)) {
-    char f[96];
-    std::snprintf(f, sizeof f, "\"phase\":%u,\"name\":\"%s\"", s.phase, controller_->phase_name(s.phase));
-    log_event(now_us, "phase", f, LogLevel::kDebug);
+    EventLine e(now_us, "phase");
+    e.w.uint("phase", s.phase).str("name", controller_->phase_name(s.phase));
+    log_event(e, LogLevel::kDebug);
   }
   if (s.fault != FaultCode::kNone && (!prev_status_valid_ || s.fault != prev_status_.fault)) {
-    char f[96];
-    std::snprintf(f, sizeof f, "\"code\":%u,\"name\":\"%s\"", static_cast<unsigned>(s.fault),
-                  dockcore::to_string(s.fault));
-    log_event(now_us, "fault", f, LogLevel::kWarn);
+    EventLine e(now_us, "fault");
+    e.w.uint("code", static_cast<unsigned>(s.fault)).str("name", dockcore::to_string(s.fault));
+    log_event(e, LogLevel::kWarn);
   }
   const bool changed = !prev_status_valid_ || s.state != prev_status_.state || s.fault != prev_status_.fault ||
                        s.phase != prev_status_.phase || s.retries != prev_status_.retries ||
@@ -993,18 +972,13 @@ std::uint32_t Daemon::commands_rejected_total() const {
   return n;
 }
 
-namespace {
-/// Replaces the closing brace of the JSON object in `buf` (`len` bytes) by `extra` (`k` bytes from snprintf into a
-/// buffer of `extra_size`, ending in its own brace) when it fits in `size`; otherwise leaves the status as it is.
-void append_if_fits(char* buf, std::size_t size, std::size_t& len, const char* extra, int k, std::size_t extra_size) {
-  if (k > 0 && static_cast<std::size_t>(k) < extra_size && len - 1 + static_cast<std::size_t>(k) < size) {
-    std::memcpy(buf + len - 1, extra, static_cast<std::size_t>(k) + 1);
-    len += static_cast<std::size_t>(k) - 1;
-  }
-}
-}  // namespace
-
 std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_us) const {
+  dockcore::drivers::JsonWriter w(buf, size);
+  status_fields(w, now_us);
+  return w.finish();
+}
+
+void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_us) const {
   const dockcore::TaskStatus& s = last_out_.status;
   const FaultCode watchdog_fault = chassis_stale_ ? FaultCode::kChassisStale
                                    : lidar_stale_ ? FaultCode::kLidarStale
@@ -1013,81 +987,82 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
   const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
   // The latest scan's detection decision: its evidence and each cue (for a miss, the best refused candidate's).
   const dockcore::DockEstimate& e = core_->last_estimate();
-  auto cue = [&e](dockcore::EvidenceCue c) {
-    return static_cast<double>(e.evidence.cue_nats[static_cast<std::size_t>(c)]);
+  double cues[dockcore::kEvidenceCueCount];
+  for (std::size_t i = 0; i < dockcore::kEvidenceCueCount; ++i) cues[i] = static_cast<double>(e.evidence.cue_nats[i]);
+  w.str("type", "status")
+      .uint("stamp_us", now_us)
+      .str("state", dockcore::to_string(s.state))
+      .uint("state_code", static_cast<unsigned>(s.state))
+      .uint("phase", s.phase)
+      .str("phase_name", s.state == TaskState::kAlign ? controller_->phase_name(s.phase) : "")
+      .uint("fault", static_cast<unsigned>(s.fault))
+      .str("fault_name", dockcore::to_string(s.fault))
+      .uint("watchdog_fault", static_cast<unsigned>(watchdog_fault))
+      .uint("retries", s.retries)
+      .uint("dock_id", s.dock_id)
+      .boolean("dock_valid", s.dock_valid)
+      .real("dock_x_m", static_cast<double>(s.dock_pose.x_m), 4)
+      .real("dock_y_m", static_cast<double>(s.dock_pose.y_m), 4)
+      .real("dock_yaw_deg", deg(s.dock_pose.yaw_rad), 2)
+      .str("last_command", dockcore::to_string(s.last_command))
+      .str("last_result", to_string_result(s.last_result))
+      .boolean("charge_enable", s.charge_enable)
+      .boolean("contact", fb_.charging_contact)
+      .real("charge_current_a", static_cast<double>(fb_.battery_current_a), 2)
+      .real("battery_v", static_cast<double>(fb_.battery_voltage_v), 2)
+      .real("soc", static_cast<double>(fb_.soc), 3)
+      .boolean("estop", fb_.estop)
+      .boolean("lidar_stale", lidar_stale_)
+      .boolean("chassis_stale", chassis_stale_)
+      .real("odom_x_m", static_cast<double>(odom_.x_m), 4)
+      .real("odom_y_m", static_cast<double>(odom_.y_m), 4)
+      .real("odom_yaw_deg", deg(odom_.yaw_rad), 2)
+      .real("cmd_vx_mps", static_cast<double>(core_->drive_cmd().vx_mps), 3)
+      .real("cmd_wz_radps", static_cast<double>(core_->drive_cmd().wz_radps), 3)
+      .boolean("teaching", teach_.active)
+      .boolean("taught", state_.find(s.dock_id) != nullptr)
+      .uint("ticks", stats_.ticks)
+      .uint("tick_worst_us", stats_.worst_period_us)
+      .uint("tick_overruns", stats_.overruns)
+      .uint("tick_work_worst_us", stats_.worst_work_us)
+      .uint("scans", counters_.scans)
+      .uint("detections", counters_.detections)
+      .uint("lidar_crc_errors", lc.crc_errors)
+      .uint("lidar_resyncs", lc.resyncs)
+      .uint("lidar_dropped_bytes", lc.dropped_bytes)
+      .uint("lidar_foreign_datagrams", lc.foreign_datagrams)
+      .uint("lidar_reconnects", lc.reconnects)
+      .uint("lidar_late_scans", counters_.late_scans)
+      .uint("can_bad_frames", cc.bad_frames)
+      .uint("can_send_failures", cc.send_failures)
+      .uint("commands", counters_.commands)
+      .uint("commands_rejected", commands_rejected_total())
+      .uint("resumes", counters_.resumes)
+      .uint("can_host_rejected", io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u)
+      .uint("udp_not_allowed", io_.udp_host != nullptr ? io_.udp_host->counters().not_allowed : 0u)
+      .uint("config_reloads", counters_.config_reloads)
+      .uint("config_reloads_rejected", counters_.config_reloads_rejected)
+      .boolean("config_reload_pending", pending_cfg_ != nullptr)
+      .boolean("det_found", e.found)
+      .real("det_evidence_nats", static_cast<double>(e.evidence.total_nats), 1)
+      .reals("det_cues_nats", cues, dockcore::kEvidenceCueCount, 1)
+      .str("det_reject", e.found ? "none" : dockcore::to_string(e.reject))
+      .real("dock_evidence_nats", static_cast<double>(core_->filter().evidence_nats()), 1)
+      .boolean("dock_confirmed", core_->filter().confirmed());
+  // The optional groups go in only when they fit (the status must stay one datagram); each is dropped whole.
+  const auto optional = [&w](auto&& write) {
+    const std::size_t m = w.mark();
+    write();
+    if (!w.ok()) w.rollback(m);
   };
-  const int n = std::snprintf(
-      buf, size,
-      "{\"type\":\"status\",\"stamp_us\":%llu,\"state\":\"%s\",\"state_code\":%u,\"phase\":%u,\"phase_name\":\"%s\","
-      "\"fault\":%u,\"fault_name\":\"%s\",\"watchdog_fault\":%u,\"retries\":%u,\"dock_id\":%u,\"dock_valid\":%s,"
-      "\"dock_x_m\":%.4f,\"dock_y_m\":%.4f,\"dock_yaw_deg\":%.2f,\"last_command\":\"%s\",\"last_result\":\"%s\","
-      "\"charge_enable\":%s,\"contact\":%s,\"charge_current_a\":%.2f,\"battery_v\":%.2f,\"soc\":%.3f,\"estop\":%s,"
-      "\"lidar_stale\":%s,\"chassis_stale\":%s,\"odom_x_m\":%.4f,\"odom_y_m\":%.4f,\"odom_yaw_deg\":%.2f,"
-      "\"cmd_vx_mps\":%.3f,\"cmd_wz_radps\":%.3f,\"teaching\":%s,\"taught\":%s,\"ticks\":%llu,"
-      "\"tick_worst_us\":%llu,\"tick_overruns\":%llu,\"tick_work_worst_us\":%llu,\"scans\":%u,\"detections\":%u,"
-      "\"lidar_crc_errors\":%u,\"lidar_resyncs\":%u,\"lidar_dropped_bytes\":%u,\"lidar_foreign_datagrams\":%u,"
-      "\"lidar_reconnects\":%u,"
-      "\"lidar_late_scans\":%u,"
-      "\"can_bad_frames\":%u,"
-      "\"can_send_failures\":%u,\"commands\":%u,\"commands_rejected\":%u,\"resumes\":%u,\"can_host_rejected\":%u,"
-      "\"udp_not_allowed\":%u,\"config_reloads\":%u,\"config_reloads_rejected\":%u,\"config_reload_pending\":%s,"
-      "\"det_found\":%s,\"det_evidence_nats\":%.1f,\"det_cues_nats\":[%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f],"
-      "\"det_reject\":\"%s\",\"dock_evidence_nats\":%.1f,\"dock_confirmed\":%s}",
-      static_cast<unsigned long long>(now_us), dockcore::to_string(s.state), static_cast<unsigned>(s.state), s.phase,
-      s.state == TaskState::kAlign ? controller_->phase_name(s.phase) : "", static_cast<unsigned>(s.fault),
-      dockcore::to_string(s.fault), static_cast<unsigned>(watchdog_fault), s.retries, s.dock_id,
-      s.dock_valid ? "true" : "false", static_cast<double>(s.dock_pose.x_m), static_cast<double>(s.dock_pose.y_m),
-      deg(s.dock_pose.yaw_rad), dockcore::to_string(s.last_command), to_string_result(s.last_result),
-      s.charge_enable ? "true" : "false", fb_.charging_contact ? "true" : "false",
-      static_cast<double>(fb_.battery_current_a), static_cast<double>(fb_.battery_voltage_v),
-      static_cast<double>(fb_.soc), fb_.estop ? "true" : "false", lidar_stale_ ? "true" : "false",
-      chassis_stale_ ? "true" : "false", static_cast<double>(odom_.x_m), static_cast<double>(odom_.y_m),
-      deg(odom_.yaw_rad), static_cast<double>(core_->drive_cmd().vx_mps),
-      static_cast<double>(core_->drive_cmd().wz_radps), teach_.active ? "true" : "false",
-      state_.find(s.dock_id) != nullptr ? "true" : "false", static_cast<unsigned long long>(stats_.ticks),
-      static_cast<unsigned long long>(stats_.worst_period_us), static_cast<unsigned long long>(stats_.overruns),
-      static_cast<unsigned long long>(stats_.worst_work_us), counters_.scans, counters_.detections, lc.crc_errors,
-      lc.resyncs, lc.dropped_bytes, lc.foreign_datagrams, lc.reconnects, counters_.late_scans, cc.bad_frames,
-      cc.send_failures, counters_.commands, commands_rejected_total(), counters_.resumes,
-      io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u,
-      io_.udp_host != nullptr ? io_.udp_host->counters().not_allowed : 0u, counters_.config_reloads,
-      counters_.config_reloads_rejected, pending_cfg_ != nullptr ? "true" : "false", e.found ? "true" : "false",
-      static_cast<double>(e.evidence.total_nats), cue(dockcore::EvidenceCue::kFit),
-      cue(dockcore::EvidenceCue::kSeeThrough), cue(dockcore::EvidenceCue::kFreeSpace),
-      cue(dockcore::EvidenceCue::kSupport), cue(dockcore::EvidenceCue::kEdges), cue(dockcore::EvidenceCue::kWall),
-      cue(dockcore::EvidenceCue::kGeometry), cue(dockcore::EvidenceCue::kPrior),
-      e.found ? "none" : dockcore::to_string(e.reject), static_cast<double>(core_->filter().evidence_nats()),
-      core_->filter().confirmed() ? "true" : "false");
-  if (n < 0 || static_cast<std::size_t>(n) >= size) return 0;
-  std::size_t len = static_cast<std::size_t>(n);
-  // The tag fusion's counters (docs/camera.md, "Status"), likewise only when they fit.
+  // The tag fusion's counters (docs/camera.md, "Status").
   if (io_.tags != nullptr) {
-    const std::uint32_t* t = counters_.tags;
-    char extra[200];
-    const int k = std::snprintf(extra, sizeof extra, ",\"tag_fused\":%u,\"tag_refused\":[%u,%u,%u,%u,%u,%u,%u,%u]}",
-                                t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8]);
-    append_if_fits(buf, size, len, extra, k, sizeof extra);
+    optional([&] { w.uint("tag_fused", counters_.tags[0]).uints("tag_refused", counters_.tags + 1, dockcore::kTagStatusCount - 1); });
   }
-  // The stall watchdog's fields, likewise.
-  if (io_.camera_frames != nullptr) {
-    // The flag only, as for the lidar: the count is in the watchdog event (the status has no room to spare).
-    char extra[32];
-    const int k = std::snprintf(extra, sizeof extra, ",\"camera_stalled\":%s}", camera_stalled_ ? "true" : "false");
-    append_if_fits(buf, size, len, extra, k, sizeof extra);
-  }
-  // The own camera's fields go before the closing brace when they fit; otherwise the status goes without them.
-  if (io_.camera_status != nullptr) {
-    const std::size_t k = io_.camera_status(io_.camera_status_ctx, buf + len - 1, size - len);
-    if (k > 0) {
-      len += k - 1;
-      buf[len++] = '}';
-      buf[len] = '\0';
-    } else {
-      buf[len - 1] = '}';
-      buf[len] = '\0';
-    }
-  }
-  return len;
+  // The stall watchdog's flag only, as for the lidar: the count is in the watchdog event.
+  if (io_.camera_frames != nullptr) optional([&] { w.boolean("camera_stalled", camera_stalled_); });
+  // The own camera's fields.
+  if (io_.camera_status != nullptr) optional([&] { io_.camera_status(io_.camera_status_ctx, w); });
 }
 
 }  // namespace dockd

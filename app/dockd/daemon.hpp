@@ -23,6 +23,7 @@
 #include "config.hpp"
 #include "dockcore/control/controllers.hpp"
 #include "dockcore/dockcore.hpp"
+#include "dockcore/drivers/json_writer.hpp"
 #include "dockcore/drivers/udp_host_link.hpp"
 #include "dockcore/hal/camera.hpp"
 #include "dockcore/hal/chassis.hpp"
@@ -46,10 +47,9 @@ struct DaemonIo {
   dockcore::hal::TagPoseSource* tags = nullptr;
   /// dockd's own camera's frame arrivals, for the stall watchdog (camera_stalled); null: no watchdog.
   const dockcore::hal::CameraFrameMonitor* camera_frames = nullptr;
-  /// Optional: writes the own camera's status fields (",\"camera_frames\":…", no heap, never blocking) into `buf`
-  /// (`size` bytes with the NUL) and returns their length; 0 when they do not fit (the status then goes without
-  /// them). `ctx` is camera_status_ctx.
-  std::size_t (*camera_status)(const void* ctx, char* buf, std::size_t size) = nullptr;
+  /// Optional: writes the own camera's status fields ("camera_frames", …; no heap, never blocking) into the status
+  /// being written; when they do not fit the status goes without them. `ctx` is camera_status_ctx.
+  void (*camera_status)(const void* ctx, dockcore::drivers::JsonWriter& w) = nullptr;
   const void* camera_status_ctx = nullptr;
   const dockcore::hal::Clock* clock = nullptr;
   RotatingLog* event_log = nullptr;  ///< JSON-lines event log (may be closed).
@@ -112,6 +112,16 @@ class EventRateLimit {
   std::uint32_t held_total_ = 0;
 };
 
+/// One event line being written: {"t_us":…,"event":"name", then the fields added to `w`}; Daemon::log_event
+/// finishes and writes it. 1.5 KiB on the stack.
+struct EventLine {
+  EventLine(std::uint64_t t_us, const char* name) : w(buf, sizeof buf) { w.uint("t_us", t_us).str("event", name); }
+  EventLine(const EventLine&) = delete;
+  EventLine& operator=(const EventLine&) = delete;
+  char buf[1536];
+  dockcore::drivers::JsonWriter w;
+};
+
 /// Counters the daemon itself keeps (the drivers keep theirs).
 struct DaemonCounters {
   std::uint32_t commands = 0;  ///< Task commands handed to the task manager.
@@ -130,6 +140,7 @@ struct DaemonCounters {
   std::uint32_t status_sent = 0;
   std::uint32_t config_reloads = 0;           ///< Reloads applied.
   std::uint32_t config_reloads_rejected = 0;  ///< Reloads refused (invalid file, restart-only key changed).
+  std::uint32_t events_too_long = 0;          ///< Event lines that did not fit EventLine and were not written.
   /// Tag poses handed to the core, by what became of them (index: dockcore::TagStatus; kFused = fused).
   std::uint32_t tags[dockcore::kTagStatusCount] = {};
 };
@@ -166,8 +177,9 @@ class Daemon {
   void send_zero(std::uint64_t now_us, int frames = 1);
   /// Logs the shutdown event (reason) once; the caller sends the zero frames.
   void log_shutdown(std::uint64_t now_us, const char* reason);
-  /// A free-form event (SIGHUP, reconnects) into the event log: `fields` is a JSON fragment without braces.
-  void log_event(std::uint64_t now_us, const char* event, const char* fields, LogLevel level = LogLevel::kInfo);
+  /// Finishes `e` and writes it to the event log (and stderr at `level` or above); one that did not fit is counted
+  /// in counters().events_too_long instead.
+  void log_event(EventLine& e, LogLevel level = LogLevel::kInfo);
 
   /// SIGHUP: reads `path` like --check-config (parse + validation), applies `adjust` (the command-line overrides)
   /// and hands the result to request_reload(). A file that does not parse or validate is rejected with its
@@ -201,6 +213,9 @@ class Daemon {
   std::uint16_t active_dock_id() const { return active_dock_; }
   /// Current status as one JSON object (no newline). Returns the length (0 when it does not fit). O(1).
   std::size_t status_json(char* buf, std::size_t size, std::uint64_t now_us) const;
+  /// The status's fields, written into `w` (status_json and the status reply); optional groups (tag fusion, camera)
+  /// only when they fit.
+  void status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_us) const;
   /// Every host command refused, whatever refused it: dockd and the task manager (counters().commands_rejected)
   /// plus the UDP link's parse refusals (malformed, unknown command, bad field, too long). The status field
   /// `commands_rejected`. O(1).

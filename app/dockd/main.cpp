@@ -167,22 +167,17 @@ enum Tag : std::uint64_t { kTimer = 1, kSignal, kLidar, kCan, kHost, kCamera, kC
 /// The own camera's status fields (DaemonIo::camera_status): capture counters and the id of the target tag seen in
 /// the last frame (-1: none).
 /// A snapshot copy; never blocks, no heap.
-std::size_t own_camera_status(const void* ctx, char* buf, std::size_t size) {
+void own_camera_status(const void* ctx, dockcore::drivers::JsonWriter& w) {
   const auto* p = static_cast<const dockcore::drivers::CameraPipeline*>(ctx);
   const dockcore::drivers::CameraPipelineStats s = p->stats();
   // Compact: the status is about 1.2 kB of the 1400-byte reply (kMaxHostReply); camera-check reports the rest.
-  const int n = std::snprintf(
-      buf, size,
-      ",\"camera_connected\":%s,\"camera_frames\":%llu,\"camera_dropped\":%llu,\"camera_late\":%llu,"
-      "\"camera_corrupt\":%llu,\"camera_reconnects\":%u,\"camera_tag_id\":%d",
-      s.connected ? "true" : "false", static_cast<unsigned long long>(s.capture.frames),
-      static_cast<unsigned long long>(s.capture.dropped), static_cast<unsigned long long>(s.capture.late),
-      static_cast<unsigned long long>(s.capture.corrupt), s.capture.reconnects, s.have_tag ? s.last_tag.id : -1);
-  if (n < 0 || static_cast<std::size_t>(n) >= size) {
-    buf[0] = '\0';
-    return 0;
-  }
-  return static_cast<std::size_t>(n);
+  w.boolean("camera_connected", s.connected)
+      .uint("camera_frames", s.capture.frames)
+      .uint("camera_dropped", s.capture.dropped)
+      .uint("camera_late", s.capture.late)
+      .uint("camera_corrupt", s.capture.corrupt)
+      .uint("camera_reconnects", s.capture.reconnects)
+      .sint("camera_tag_id", s.have_tag ? s.last_tag.id : -1);
 }
 #endif
 
@@ -395,12 +390,13 @@ int main(int argc, char** argv) {
   }
   if (previous.found && previous.interrupted) {
     // Reported, never resumed: the robot waits for a new host command.
-    char fields[256];
-    std::snprintf(fields, sizeof fields,
-                  "\"clean\":false,\"last_event\":\"%.40s\",\"last_state\":\"%.40s\",\"torn_line\":%s,"
-                  "\"action\":\"idle until a new command\"",
-                  previous.last_event.c_str(), previous.last_state.c_str(), previous.torn ? "true" : "false");
-    daemon->log_event(mono_us(), "previous_session", fields, dockd::LogLevel::kWarn);
+    dockd::EventLine e(mono_us(), "previous_session");
+    e.w.boolean("clean", false)
+        .str_cut("last_event", previous.last_event.c_str(), 40)
+        .str_cut("last_state", previous.last_state.c_str(), 40)
+        .boolean("torn_line", previous.torn)
+        .str("action", "idle until a new command");
+    daemon->log_event(e, dockd::LogLevel::kWarn);
   }
 
   // Event loop.

@@ -1,5 +1,7 @@
 #include "dockcore/drivers/udp_host_link.hpp"
 
+#include "dockcore/drivers/json_writer.hpp"
+
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -122,24 +124,11 @@ HostErrorCode parse_host_request(const char* data, std::size_t len, HostRequest&
 
 std::size_t format_host_error(char* buf, std::size_t size, bool has_seq, std::uint32_t seq, HostErrorCode code,
                               const char* message) {
-  // Messages are dockd's own static texts; quotes and backslashes are replaced so the reply stays valid JSON.
-  char clean[256];
-  std::size_t n = 0;
-  for (const char* p = message; *p != '\0' && n + 1 < sizeof clean; ++p) {
-    const char c = *p;
-    clean[n++] = (c == '"' || c == '\\' || static_cast<unsigned char>(c) < 0x20) ? '\'' : c;
-  }
-  clean[n] = '\0';
-  int len;
-  if (has_seq) {
-    len = std::snprintf(buf, size, "{\"ok\":false,\"seq\":%u,\"code\":%u,\"error\":\"%s\",\"message\":\"%s\"}", seq,
-                        static_cast<unsigned>(code), to_string(code), clean);
-  } else {
-    len = std::snprintf(buf, size, "{\"ok\":false,\"code\":%u,\"error\":\"%s\",\"message\":\"%s\"}",
-                        static_cast<unsigned>(code), to_string(code), clean);
-  }
-  if (len < 0 || static_cast<std::size_t>(len) >= size) return 0;
-  return static_cast<std::size_t>(len);
+  JsonWriter w(buf, size);
+  w.boolean("ok", false);
+  if (has_seq) w.uint("seq", seq);
+  w.uint("code", static_cast<unsigned>(code)).str("error", to_string(code)).str_cut("message", message, 255);
+  return w.finish();
 }
 
 bool parse_ipv4_cidr(const std::string& text, std::uint32_t& addr_be, std::uint32_t& mask_be) {
@@ -322,9 +311,9 @@ class UdpHostLinkImpl final : public UdpHostLink {
       out.dock_id = r.dock_id;
       out.sequence = static_cast<std::uint16_t>(r.seq);
       out.stamp_us = r.stamp_us;
-      const int n = std::snprintf(buf, sizeof buf, "{\"ok\":true,\"cmd\":\"%s\",\"seq\":%u,\"queued\":true}",
-                                  to_string(r.kind), r.seq);
-      if (n > 0) reply(r.peer, buf, static_cast<std::size_t>(n));
+      JsonWriter w(buf, sizeof buf);
+      w.boolean("ok", true).str("cmd", to_string(r.kind)).uint("seq", r.seq).boolean("queued", true);
+      reply(r.peer, buf, w.finish());
       return true;
     }
     return false;
@@ -382,8 +371,9 @@ class UdpHostLinkImpl final : public UdpHostLink {
     char buf[256];
     if (r.kind == HostRequestKind::kUnsubscribe) {
       if (slot != nullptr) slot->used = false;
-      const int n = std::snprintf(buf, sizeof buf, "{\"ok\":true,\"cmd\":\"unsubscribe\",\"seq\":%u}", r.seq);
-      reply(r.peer, buf, static_cast<std::size_t>(n));
+      JsonWriter w(buf, sizeof buf);
+      w.boolean("ok", true).str("cmd", "unsubscribe").uint("seq", r.seq);
+      reply(r.peer, buf, w.finish());
       return;
     }
     if (slot == nullptr) {
@@ -401,9 +391,9 @@ class UdpHostLinkImpl final : public UdpHostLink {
     slot->used = true;
     slot->peer = r.peer;
     slot->until_us = now_us + static_cast<std::uint64_t>(sub_ms_) * 1000u;
-    const int n = std::snprintf(buf, sizeof buf, "{\"ok\":true,\"cmd\":\"subscribe\",\"seq\":%u,\"expires_ms\":%u}",
-                                r.seq, sub_ms_);
-    reply(r.peer, buf, static_cast<std::size_t>(n));
+    JsonWriter w(buf, sizeof buf);
+    w.boolean("ok", true).str("cmd", "subscribe").uint("seq", r.seq).uint("expires_ms", sub_ms_);
+    reply(r.peer, buf, w.finish());
   }
 
   int fd_;

@@ -60,13 +60,10 @@ struct FakeFrames final : dockcore::hal::CameraFrameMonitor {
   std::uint64_t last_frame_us() const override { return last; }
 };
 
-std::size_t fields(const void* ctx, char* buf, std::size_t size) {
-  const int n = std::snprintf(buf, size, "%s", static_cast<const char*>(ctx));
-  if (n < 0 || static_cast<std::size_t>(n) >= size) {
-    buf[0] = '\0';
-    return 0;
-  }
-  return static_cast<std::size_t>(n);
+/// The fields `ctx` holds as main.cpp would write them (",\"k\":v,…"), added as they are.
+void fields(const void* ctx, dockcore::drivers::JsonWriter& w) {
+  const char* f = static_cast<const char*>(ctx);
+  w.fields(f + 1, std::strlen(f + 1));
 }
 
 struct CameraRig {
