@@ -6,11 +6,11 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <deque>
 #include <fstream>
 #include <sstream>
 #include <string>
 
+#include "../support/fake_can_bus.hpp"
 #include "session_record.hpp"
 #include "state_file.hpp"
 
@@ -119,24 +119,6 @@ TEST(DockdState, OversizedFileIsCorruptAndTheBackupIsUsed) {
   CHECK_TRUE(out.find(2) != nullptr);
 }
 
-namespace {
-/// A CanBus whose receive queue the test fills; it counts the bytes in the record file after each call.
-struct QueueBus final : dockcore::hal::CanBus {
-  std::deque<dockcore::CanFrame> rx;
-  dockcore::hal::CanBusCounters c{};
-  bool send(const dockcore::CanFrame&) override { return true; }
-  bool receive(dockcore::CanFrame& f, std::uint64_t& stamp_us) override {
-    if (rx.empty()) return false;
-    f = rx.front();
-    rx.pop_front();
-    stamp_us = 1;
-    return true;
-  }
-  int fd() const override { return -1; }
-  const dockcore::hal::CanBusCounters& counters() const override { return c; }
-};
-}  // namespace
-
 // Received frames reach the record once the bus is drained (or before a send), sent frames at once, all in order.
 TEST(DockdState, RecordedCanFramesAreWrittenPerDrainAndInOrder) {
   const std::string dir = path + "_can";
@@ -145,14 +127,14 @@ TEST(DockdState, RecordedCanFramesAreWrittenPerDrainAndInOrder) {
     dockd::RotatingLog log;
     std::string err;
     CHECK_TRUE_TEXT(log.open(dir, "can.log", 1 << 20, 2, err), err.c_str());
-    QueueBus inner;
+    dockcore::testing::FakeCanBus inner;
     dockd::RecordingCanBus bus(inner, log, "vcan0");
     for (int i = 0; i < 300; ++i) {  // more than the gathering buffer holds
       dockcore::CanFrame f{};
       f.id = 0x100u + static_cast<std::uint32_t>(i);
       f.dlc = 1;
       f.data[0] = static_cast<std::uint8_t>(i);
-      inner.rx.push_back(f);
+      inner.inject(f);
     }
     dockcore::CanFrame f{};
     std::uint64_t t = 0;
