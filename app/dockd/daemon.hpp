@@ -83,7 +83,6 @@ class EventRateLimit {
       return true;
     }
     ++held_;
-    ++held_total_;
     return false;
   }
   /// Events held back in windows that have ended by now_us, each reported once (0 while the window runs).
@@ -93,23 +92,19 @@ class EventRateLimit {
     ready_ = 0;
     return n;
   }
-  std::uint32_t held_total() const { return held_total_; }  ///< Held back since start.
 
  private:
   void roll(std::uint64_t now_us) {
-    if (started_ && now_us - window_start_us_ < kWindowUs) return;
-    started_ = true;
+    if (now_us - window_start_us_ < kWindowUs) return;  // windows start at 0 or at the first event after one ended
     window_start_us_ = now_us;
     logged_ = 0;
     ready_ += held_;
     held_ = 0;
   }
-  bool started_ = false;
   std::uint64_t window_start_us_ = 0;
   std::uint32_t logged_ = 0;
   std::uint32_t held_ = 0;   ///< In the running window.
   std::uint32_t ready_ = 0;  ///< From ended windows, not yet reported.
-  std::uint32_t held_total_ = 0;
 };
 
 /// One event line being written: {"t_us":…,"event":"name", then the fields added to `w`}; Daemon::log_event
