@@ -75,28 +75,24 @@ make_dockd_config() {
 # DOCKCTL_TIMEOUT_S: how long dockctl waits for the reply (dockd under memcheck answers slowly).
 DOCKCTL() { "$BUILD/app/dockctl" --port 7300 --timeout "${DOCKCTL_TIMEOUT_S:-2}" "$@"; }
 
+# json_jq FILE JQ-ARGS...: jq over FILE's lines read raw ("-": standard input), its errors silenced.
+json_jq() {
+  local f=$1
+  shift
+  if [ "$f" = - ]; then jq -R "$@" 2>/dev/null; else jq -R "$@" "$f" 2>/dev/null; fi
+}
 # json_values FILE KEY [EVENT]: KEY of every JSON object in FILE (one object, or JSON lines; "-": standard input)
 # that has it — only those whose "event" is EVENT when given —, one per line, strings bare. A torn or non-JSON line
 # (a log still being written) is skipped.
 json_values() {
-  local filter='fromjson? | objects | select(has($k) and ($ev == "" or .event == $ev)) | .[$k] | tostring'
-  if [ "$1" = - ]; then
-    jq -R -r --arg k "$2" --arg ev "${3:-}" "$filter" 2>/dev/null
-  else
-    jq -R -r --arg k "$2" --arg ev "${3:-}" "$filter" "$1" 2>/dev/null
-  fi
+  json_jq "$1" -r --arg k "$2" --arg ev "${3:-}" \
+    'fromjson? | objects | select(has($k) and ($ev == "" or .event == $ev)) | .[$k] | tostring'
 }
 # json_field FILE KEY [EVENT]: the last of those values ("" when there is none).
 json_field() { json_values "$@" | tail -n 1; }
 # json_select FILE CONDITION: the JSON objects of FILE (as above) for which the jq CONDITION holds, one per line.
 # json_has: at least one does. json_count: how many do.
-json_select() {
-  if [ "$1" = - ]; then
-    jq -R -c "fromjson? | objects | select($2)" 2>/dev/null
-  else
-    jq -R -c "fromjson? | objects | select($2)" "$1" 2>/dev/null
-  fi
-}
+json_select() { json_jq "$1" -c "fromjson? | objects | select($2)"; }
 json_has() { [ -n "$(json_select "$@")" ]; }
 json_count() { json_select "$@" | wc -l; }
 
