@@ -171,8 +171,8 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   const toml::node* lidar_protocol_node = nullptr;
   // The core structs' keys, with their bounds, come from the parameter table (the same as dock-sim's scenarios).
   namespace params = dockcore::params;
-  const params::ParamTargets targets{&c.drive,   &c.limits,  &c.footprint, &c.task,   &c.estimator,
-                                     &c.seed000, &c.seed004, &c.seed003,   &c.smooth, &c.tag_fusion};
+  const params::ParamTargets targets{&c.drive,   &c.limits,  &c.footprint, &c.task,       &c.estimator, &c.seed000,
+                                     &c.seed004, &c.seed003, &c.smooth,    &c.tag_fusion, &c.watchdog};
   auto table_keys = [&](const std::string& table, Handlers h) {
     params::add_params(p, h, table, targets, params::kDockd);
     return h;
@@ -375,10 +375,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   };
 
   auto watchdog = [&]() {
-    return Handlers{{"lidar_stale_ms", p.integ(&c.lidar_stale_ms, 40, 10000)},
-                    {"chassis_stale_ms", p.integ(&c.chassis_stale_ms, 40, 10000)},
-                    {"fault_after_ms", p.integ(&c.watchdog_fault_after_ms, 0, 60000)},
-                    {"systemd_divider", p.integ(&c.systemd_watchdog_divider, 2, 10)}};
+    return table_keys("watchdog", Handlers{{"systemd_divider", p.integ(&c.systemd_watchdog_divider, 2, 10)}});
   };
 
   auto state = [&]() {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "camera_config.hpp"
 #include "dockcore/control/controllers.hpp"
 #include "dockcore/control/kinematics.hpp"
 #include "dockcore/control/safety.hpp"
@@ -21,8 +22,8 @@
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_profile.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
+#include "dockcore/task/input_watch.hpp"
 #include "dockcore/task/task_manager.hpp"
-#include "camera_config.hpp"
 
 namespace dockd {
 
@@ -112,9 +113,7 @@ struct DockdConfig {
   std::uint32_t record_max_files = 8;          ///< Rotated files kept per log.
 
   // [watchdog]
-  std::uint32_t lidar_stale_ms = 200;
-  std::uint32_t chassis_stale_ms = 200;
-  std::uint32_t watchdog_fault_after_ms = 1000;  ///< Stale this long (after the stop): the task manager faults.
+  dockcore::WatchdogParams watchdog{};         ///< [watchdog]: the core's input watch (the parameter table).
   std::uint32_t systemd_watchdog_divider = 2;  ///< WATCHDOG=1 every WatchdogSec / this.
 
   // [state]

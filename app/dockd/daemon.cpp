@@ -99,9 +99,7 @@ void Daemon::build_core() {
   core_cfg_.drive = cfg_.drive;
   core_cfg_.limits = cfg_.limits;
   core_cfg_.control_period_s = static_cast<Real>(kNominalTickUs) * static_cast<Real>(1e-6);
-  // dockd's own watchdog (receive time, lidar_stale_ms) is the tight one; Dockcore's scan-stamp check is a backstop
-  // that must not fire first (a scan's stamp is its first sample, a whole turn before delivery).
-  core_cfg_.lidar_stale_s = static_cast<Real>(cfg_.lidar_stale_ms) * static_cast<Real>(1e-3) + static_cast<Real>(0.3);
+  core_cfg_.watchdog = cfg_.watchdog;
   // The tag fusion: the model's keys, and the camera's mount, focal length and tag size (configure_core adds the
   // active dock's tag).
   core_cfg_.tag = cfg_.tag_fusion;
@@ -179,11 +177,13 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
   // The old core holds the latest scan (dockd keeps no copy of its own): alive until the new core has it.
   const std::unique_ptr<dockcore::Dockcore> previous = std::move(core_);
   build_core();
-  if (!configure_core(cfg_.default_dock_id, false, previous.get())) {
+  core_->take_inputs(*previous);  // the robot and its sensors carry on: odometry, input watch, latest scan
+  if (!configure_core(cfg_.default_dock_id, false)) {
     // A profile the estimator refuses (validated configs do not have one): back to the old config entirely.
     cfg_ = old;
     build_core();
-    configure_core(cfg_.default_dock_id, false, previous.get());
+    core_->take_inputs(*previous);
+    configure_core(cfg_.default_dock_id, false);
     if (io_.udp_host != nullptr) io_.udp_host->set_allowlist(cfg_.host.allowlist, err);
     ++counters_.config_reloads_rejected;
     message = next->source +
@@ -206,7 +206,7 @@ dockcore::FaultCode Daemon::fault() const {
   return core_->task_manager().fault();
 }
 
-bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile, const dockcore::DockcoreBase* scan_from) {
+bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
   const DockEntry* d = cfg_.find_dock(dock_id);
   if (d == nullptr) return false;
   dockcore::DockProfile prof = d->profile;
@@ -232,13 +232,10 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile, const dockc
     }
   }
   core_cfg_.tag.dock_tag = tag;
-  // configure() forgets the scan: the latest one (the core's own copy, untouched by configure()) is handed back so
-  // the next tick does not see a lidar without data.
-  const dockcore::ScanView last = (scan_from != nullptr ? *scan_from : *core_).last_scan();
   if (!core_->configure(prof, core_cfg_)) return false;
   active_dock_ = dock_id;
   active_raw_ = raw_profile;
-  if (have_scan_ && !last_scan_late_ && last.count > 0) core_->on_scan(last, last.stamp_us, odom_at(last.stamp_us));
+  core_->rescan();  // the latest scan through the new profile: the next tick sees this dock's estimate
   return true;
 }
 
@@ -318,71 +315,23 @@ void Daemon::poll_chassis(std::uint64_t now_us) {
   }
   reported_bus_errors_ = cc.bus_errors;
   reported_bus_off_ = cc.bus_off;
-  if (fb_.wheels_stamp_us == 0 || fb_.wheels_stamp_us == last_wheels_stamp_us_) return;
   dockcore::WheelSpeeds w;
   w.count = dockcore::drive_wheel_count(cfg_.drive.kind);
   for (std::size_t i = 0; i < w.count; ++i) w.radps[i] = fb_.wheel_radps[i];
-  const dockcore::Twist2 tw = dockcore::wheels_to_twist(cfg_.drive, w);
-  if (have_wheels_ && fb_.wheels_stamp_us > last_wheels_stamp_us_) {
-    // Feedback gaps longer than 0.2 s are not integrated across (the wheels' history is unknown there).
-    const std::uint64_t gap = fb_.wheels_stamp_us - last_wheels_stamp_us_;
-    const Real dt = static_cast<Real>(gap < 200000u ? gap : 0u) * static_cast<Real>(1e-6);
-    // Midpoint rule on the previous and the new twist.
-    const Real vx = (odom_twist_.vx_mps + tw.vx_mps) / 2, vy = (odom_twist_.vy_mps + tw.vy_mps) / 2;
-    const Real wz = (odom_twist_.wz_radps + tw.wz_radps) / 2;
-    const Real yaw_mid = odom_.yaw_rad + wz * dt / 2;
-    odom_.x_m += (vx * std::cos(yaw_mid) - vy * std::sin(yaw_mid)) * dt;
-    odom_.y_m += (vx * std::sin(yaw_mid) + vy * std::cos(yaw_mid)) * dt;
-    odom_.yaw_rad = dockcore::wrap_angle(odom_.yaw_rad + wz * dt);
-  }
-  odom_twist_ = tw;
-  have_wheels_ = true;
-  last_wheels_stamp_us_ = fb_.wheels_stamp_us;
-  history_[history_next_] = OdomSample{fb_.wheels_stamp_us, odom_};
-  history_next_ = (history_next_ + 1) % (sizeof history_ / sizeof history_[0]);
-}
-
-Pose2 Daemon::odom_at(std::uint64_t stamp_us) const {
-  // The newest sample not after the scan time (64 samples at 50 Hz cover 1.3 s); the current pose otherwise.
-  const OdomSample* best = nullptr;
-  for (const OdomSample& s : history_) {
-    if (s.stamp_us == 0 || s.stamp_us > stamp_us) continue;
-    if (best == nullptr || s.stamp_us > best->stamp_us) best = &s;
-  }
-  return best != nullptr ? best->pose : odom_;
+  core_->on_wheels(w, fb_.wheels_stamp_us);  // a repeated stamp is no new feedback
 }
 
 void Daemon::poll_lidar(std::uint64_t now_us) {
-  // Only the newest scan matters (poll_scan keeps the newest); bounded to a few per call.
-  const std::uint64_t max_period_us = std::max<std::uint64_t>(500000u, std::uint64_t{cfg_.lidar_stale_ms} * 1000u);
-  // The scan stays in the driver's buffer: the core reads it there (and copies it once, for its tick).
+  // Only the newest scan matters (poll_scan keeps the newest); bounded to a few per call. The scan stays in the
+  // driver's buffer: the core reads it there (and copies it once, for its tick). A late one (a backlog drained late)
+  // the core's input watch counts and leaves out.
   const dockcore::LaserScan* scan = nullptr;
   for (int i = 0; i < 4 && (scan = io_.lidar->poll_scan()) != nullptr; ++i) {
     ++counters_.scans;
-    const std::uint64_t stamp = scan->stamp_us != 0 && scan->stamp_us <= now_us ? scan->stamp_us : now_us;
-    if (prev_scan_stamp_us_ != 0 && stamp > prev_scan_stamp_us_ && stamp - prev_scan_stamp_us_ <= max_period_us)
-      scan_period_us_ = stamp - prev_scan_stamp_us_;
-    prev_scan_stamp_us_ = stamp;
-    const std::uint64_t turn_end_us = std::min(now_us, stamp + scan_period_us_);
-    if (now_us - turn_end_us > static_cast<std::uint64_t>(cfg_.lidar_stale_ms) * 1000u) {
-      // Measured longer ago than the watchdog allows (a backlog drained late): steering by it would be as wrong
-      // as by no scan, so it is counted and left to the watchdog, which holds and, if it lasts, faults and resumes.
-      ++counters_.late_scans;
-      last_scan_late_ = true;
-      continue;
-    }
-    have_scan_ = true;
-    last_scan_late_ = false;
-    last_scan_parsed_us_ = now_us;
-    // A scan is stamped with its first sample: one scan alone cannot say when its turn ended (taking its start for its
-    // end would make the first scan after start-up look one turn old and trip the watchdog just before the second).
-    // The lidar counts as fresh from the second scan on, when the turn's length is known; the first one still feeds
-    // the core.
-    if (scan_period_us_ != 0 && turn_end_us > last_scan_rx_us_) last_scan_rx_us_ = turn_end_us;
-    const dockcore::DockEstimate& e = core_->on_scan(scan->view(), stamp, odom_at(stamp));
-    if (e.found) {
+    const dockcore::DockEstimate* e = core_->on_scan(scan->view(), scan->stamp_us, now_us);
+    if (e != nullptr && e->found) {
       ++counters_.detections;
-      if (teach_.active) teach_sample(e);
+      if (teach_.active) teach_sample(*e);
     }
   }
 }
@@ -405,7 +354,7 @@ void Daemon::poll_camera(std::uint64_t) {
   if (io_.tags != nullptr) {
     dockcore::TagObservation o;
     for (int i = 0; i < 16 && io_.tags->poll_tag(o); ++i) {
-      const dockcore::TagStatus st = core_->on_tag(o, odom_at(o.stamp_us));
+      const dockcore::TagStatus st = core_->on_tag(o);
       ++counters_.tags[static_cast<std::size_t>(st)];
     }
   }
@@ -541,40 +490,31 @@ void Daemon::on_camera_readable(std::uint64_t now_us) {
 // --- watchdogs -----------------------------------------------------------------------------------------------------
 
 void Daemon::watchdogs(std::uint64_t now_us) {
-  const std::uint64_t lidar_lim = static_cast<std::uint64_t>(cfg_.lidar_stale_ms) * 1000u;
-  const std::uint64_t chassis_lim = static_cast<std::uint64_t>(cfg_.chassis_stale_ms) * 1000u;
-  const bool lidar = !have_scan_ || now_us - last_scan_rx_us_ > lidar_lim;
-  // A receive stamp after now_us is a frame read during this tick (now_us is taken when the tick starts): fresh.
-  const bool chassis =
-      !have_wheels_ || (now_us > last_wheels_stamp_us_ && now_us - last_wheels_stamp_us_ > chassis_lim);
-  if (lidar != lidar_stale_) {
-    if (lidar) ++counters_.lidar_stale_trips;
-    // Why it went stale, for a log read after the fact: how old the newest turn's end and the newest parse are
-    // (-1: none yet). A turn that ended long ago but was parsed just now is a backlog; both old is a silent lidar.
+  const dockcore::InputWatch::Change c = core_->check_inputs(now_us);
+  const dockcore::InputWatch& w = core_->inputs();
+  if (c.lidar) {
+    // Why it went stale, for a log read after the fact: how old the newest turn's end and the newest read are
+    // (-1: none yet). A turn that ended long ago but was read just now is a backlog; both old is a silent lidar.
     const auto age_ms = [now_us](std::uint64_t t) {
       return t == 0 || t > now_us ? std::int64_t{-1} : static_cast<std::int64_t>((now_us - t) / 1000u);
     };
     EventLine e(now_us, "watchdog");
     e.w.str("which", "lidar")
-        .boolean("stale", lidar)
+        .boolean("stale", w.lidar_stale())
         .uint("fault", static_cast<unsigned>(FaultCode::kLidarStale))
-        .sint("turn_end_age_ms", age_ms(last_scan_rx_us_))
-        .sint("parsed_age_ms", age_ms(last_scan_parsed_us_))
-        .uint("late_scans", counters_.late_scans);
-    log_event(e, lidar ? LogLevel::kWarn : LogLevel::kInfo);
+        .sint("turn_end_age_ms", age_ms(w.turn_end_us()))
+        .sint("parsed_age_ms", age_ms(w.scan_read_us()))
+        .uint("late_scans", w.late_scans());
+    log_event(e, w.lidar_stale() ? LogLevel::kWarn : LogLevel::kInfo);
   }
-  if (chassis != chassis_stale_) {
-    if (chassis) ++counters_.chassis_stale_trips;
+  if (c.chassis) {
     EventLine e(now_us, "watchdog");
-    e.w.str("which", "chassis").boolean("stale", chassis).uint("fault", static_cast<unsigned>(FaultCode::kChassisStale));
-    log_event(e, chassis ? LogLevel::kWarn : LogLevel::kInfo);
+    e.w.str("which", "chassis")
+        .boolean("stale", w.chassis_stale())
+        .uint("fault", static_cast<unsigned>(FaultCode::kChassisStale));
+    log_event(e, w.chassis_stale() ? LogLevel::kWarn : LogLevel::kInfo);
   }
   camera_watchdog(now_us);
-  if (lidar && !lidar_stale_) lidar_stale_since_us_ = now_us;
-  if (chassis && !chassis_stale_) chassis_stale_since_us_ = now_us;
-  lidar_stale_ = lidar;
-  chassis_stale_ = chassis;
-  if (lidar || chassis) fresh_since_us_ = now_us;
 }
 
 void Daemon::camera_watchdog(std::uint64_t now_us) {
@@ -617,11 +557,11 @@ void Daemon::start_teach(const HostRequest& r, std::uint64_t now_us) {
     reply_error(r, HostErrorCode::kTeachFailed, "teach needs an idle robot (stop the running task first)");
     return;
   }
-  if (chassis_stale_ || !fb_.charging_contact) {
+  if (chassis_stale() || !fb_.charging_contact) {
     reply_error(r, HostErrorCode::kTeachFailed, "teach needs the robot on the charger: contacts are not closed");
     return;
   }
-  if (lidar_stale_) {
+  if (lidar_stale()) {
     reply_error(r, HostErrorCode::kTeachFailed, "teach needs the lidar: no fresh scans");
     return;
   }
@@ -755,17 +695,11 @@ void Daemon::on_tick(std::uint64_t now_us) {
 
   dockcore::TickInput in;
   in.now_us = now_us;
-  in.odom_pose = odom_;
-  in.odom_twist = odom_twist_;
   in.camera = camera_;
   in.contact = fb_.charging_contact;
   in.charge_current_a = fb_.battery_current_a;
-  // The wheels stop at once (below); the task manager is told only when the data stays away for fault_after_ms,
-  // so a short gap (a late scan on a loaded board) holds the robot and then continues the same approach.
-  const std::uint64_t fault_after = static_cast<std::uint64_t>(cfg_.watchdog_fault_after_ms) * 1000u;
-  in.chassis_ok = !(chassis_stale_ && now_us - chassis_stale_since_us_ >= fault_after);
-  in.lidar_ok = !(lidar_stale_ && now_us - lidar_stale_since_us_ >= fault_after);
-  in.hold = lidar_stale_ || chassis_stale_;
+  // Stale input: the core holds the wheels at once and tells the task manager only when the data stays away for
+  // fault_after_ms, so a short gap (a late scan on a loaded board) continues the same approach.
 
   // Watchdog resume: a command interrupted by a watchdog fault is re-issued once the data has been fresh for
   // kResumeHoldUs, at most kMaxResumes times per task (docs/dockd.md, "Watchdogs").
@@ -777,8 +711,8 @@ void Daemon::on_tick(std::uint64_t now_us) {
     queue_head_ = (queue_head_ + 1) % kQueue;
     --queue_size_;
     have_cmd = true;
-  } else if (!teach_.active && interrupted_ != HostCommandType::kNone && before == TaskState::kFault && !lidar_stale_ &&
-             !chassis_stale_ && now_us - fresh_since_us_ >= kResumeHoldUs) {
+  } else if (!teach_.active && interrupted_ != HostCommandType::kNone && before == TaskState::kFault &&
+             !lidar_stale() && !chassis_stale() && now_us - core_->inputs().fresh_since_us() >= kResumeHoldUs) {
     if (resumes_this_task_ < kMaxResumes) {
       ++resumes_this_task_;
       ++counters_.resumes;
@@ -857,7 +791,7 @@ void Daemon::on_tick(std::uint64_t now_us) {
   if (after == TaskState::kFault && before != TaskState::kFault) {
     const FaultCode f = out.status.fault;
     // Only faults caused by dockd's own watchdogs resume (not, e.g., the core's backstop scan-age check).
-    if ((f == FaultCode::kChassisStale || f == FaultCode::kLidarStale) && (lidar_stale_ || chassis_stale_) &&
+    if ((f == FaultCode::kChassisStale || f == FaultCode::kLidarStale) && core_->inputs().hold() &&
         running_cmd_ != HostCommandType::kNone) {
       interrupted_ = running_cmd_;
       interrupted_dock_ = running_dock_;
@@ -917,11 +851,11 @@ void Daemon::on_tick(std::uint64_t now_us) {
   }
   const bool changed = !prev_status_valid_ || s.state != prev_status_.state || s.fault != prev_status_.fault ||
                        s.phase != prev_status_.phase || s.retries != prev_status_.retries ||
-                       s.last_command != prev_status_.last_command || lidar_stale_ != prev_lidar_stale_ ||
-                       chassis_stale_ != prev_chassis_stale_ || camera_stalled_ != prev_camera_stalled_;
+                       s.last_command != prev_status_.last_command || lidar_stale() != prev_lidar_stale_ ||
+                       chassis_stale() != prev_chassis_stale_ || camera_stalled_ != prev_camera_stalled_;
   prev_camera_stalled_ = camera_stalled_;
-  prev_lidar_stale_ = lidar_stale_;
-  prev_chassis_stale_ = chassis_stale_;
+  prev_lidar_stale_ = lidar_stale();
+  prev_chassis_stale_ = chassis_stale();
   last_out_ = out;
   prev_status_ = s;
   prev_status_valid_ = true;
@@ -944,8 +878,8 @@ void Daemon::publish_status(std::uint64_t now_us) {
     m.align_phase = s.phase;
     // The watchdogs' codes are reported even while idle (the task manager faults only in active states).
     m.fault_code = static_cast<std::uint16_t>(s.fault != FaultCode::kNone ? s.fault
-                                              : chassis_stale_            ? FaultCode::kChassisStale
-                                              : lidar_stale_              ? FaultCode::kLidarStale
+                                              : chassis_stale()           ? FaultCode::kChassisStale
+                                              : lidar_stale()             ? FaultCode::kLidarStale
                                                                           : FaultCode::kNone);
     m.retries = s.retries;
     m.last_result = static_cast<std::uint8_t>(s.last_command);
@@ -980,9 +914,9 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
 
 void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_us) const {
   const dockcore::TaskStatus& s = last_out_.status;
-  const FaultCode watchdog_fault = chassis_stale_ ? FaultCode::kChassisStale
-                                   : lidar_stale_ ? FaultCode::kLidarStale
-                                                  : FaultCode::kNone;
+  const FaultCode watchdog_fault = chassis_stale() ? FaultCode::kChassisStale
+                                   : lidar_stale() ? FaultCode::kLidarStale
+                                                   : FaultCode::kNone;
   const dockcore::hal::LidarCounters& lc = io_.lidar->counters();
   const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
   // The latest scan's detection decision: its evidence and each cue (for a miss, the best refused candidate's).
@@ -1012,11 +946,11 @@ void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_u
       .real("battery_v", static_cast<double>(fb_.battery_voltage_v), 2)
       .real("soc", static_cast<double>(fb_.soc), 3)
       .boolean("estop", fb_.estop)
-      .boolean("lidar_stale", lidar_stale_)
-      .boolean("chassis_stale", chassis_stale_)
-      .real("odom_x_m", static_cast<double>(odom_.x_m), 4)
-      .real("odom_y_m", static_cast<double>(odom_.y_m), 4)
-      .real("odom_yaw_deg", deg(odom_.yaw_rad), 2)
+      .boolean("lidar_stale", lidar_stale())
+      .boolean("chassis_stale", chassis_stale())
+      .real("odom_x_m", static_cast<double>(odom_pose().x_m), 4)
+      .real("odom_y_m", static_cast<double>(odom_pose().y_m), 4)
+      .real("odom_yaw_deg", deg(odom_pose().yaw_rad), 2)
       .real("cmd_vx_mps", static_cast<double>(core_->drive_cmd().vx_mps), 3)
       .real("cmd_wz_radps", static_cast<double>(core_->drive_cmd().wz_radps), 3)
       .boolean("teaching", teach_.active)
@@ -1032,7 +966,7 @@ void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_u
       .uint("lidar_dropped_bytes", lc.dropped_bytes)
       .uint("lidar_foreign_datagrams", lc.foreign_datagrams)
       .uint("lidar_reconnects", lc.reconnects)
-      .uint("lidar_late_scans", counters_.late_scans)
+      .uint("lidar_late_scans", core_->inputs().late_scans())
       .uint("can_bad_frames", cc.bad_frames)
       .uint("can_send_failures", cc.send_failures)
       .uint("commands", counters_.commands)

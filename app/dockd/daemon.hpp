@@ -3,15 +3,14 @@
 /// chassis link, the host links (CAN host frames, UDP JSON), the camera and the clock come in as HAL references;
 /// main.cpp only builds the real drivers and runs the epoll loop around it.
 ///
-/// Per control tick (on_tick, 50 Hz): chassis poll (odometry from the measured wheel speeds), lidar scans
-/// (Dockcore::on_scan with the odometry pose at the scan time), camera, host requests (at most one task command per
-/// tick reaches the task manager; the rest wait in a bounded queue), watchdogs, Dockcore::tick, kinematics
-/// (saturation keeping curvature, acceleration limit, twist → wheels), send_wheels, charge request, status (CAN +
-/// UDP stream at status_rate_hz and on every change), event log, teach progress, tick-period statistics.
-/// Watchdogs: lidar (no scan received for lidar_stale_ms) or chassis (no wheel feedback for chassis_stale_ms) stale
-/// → zero wheel command on that same tick and the watchdog fault code in the status; data back within
-/// fault_after_ms → the task continues; stale longer → the task manager faults (185 / 184) and, once the data has
-/// been fresh for 0.5 s, the interrupted command is re-issued (docs/dockd.md, "Watchdogs").
+/// Per control tick (on_tick, 50 Hz): chassis poll (its wheel speeds into the core's odometry), lidar scans
+/// (Dockcore::on_scan with their stamps), camera, host requests (at most one task command per tick reaches the task
+/// manager; the rest wait in a bounded queue), the core's input watch (Dockcore::check_inputs: its changes are logged),
+/// Dockcore::tick (which holds the drive on stale input and shapes the twist into wheel speeds), send_wheels, charge
+/// request, status (CAN + UDP stream at status_rate_hz and on every change), event log, teach progress, tick-period
+/// statistics. Stale lidar or chassis → zero wheel command on that same tick and the watchdog fault code in the
+/// status; data back within fault_after_ms → the task continues; stale longer → the task manager faults (185 / 184)
+/// and, once the data has been fresh for 0.5 s, dockd re-issues the interrupted command (docs/dockd.md, "Watchdogs").
 /// Allocation: the object is large (Dockcore) — create it once at start-up (heap); no allocation per tick.
 
 #include <cstddef>
@@ -125,10 +124,7 @@ struct DaemonCounters {
   std::uint32_t commands_rejected = 0;
   std::uint32_t queue_overflows = 0;
   std::uint32_t scans = 0;
-  std::uint32_t late_scans = 0;  ///< Scans whose turn had ended more than lidar_stale_ms before dockd parsed them.
   std::uint32_t detections = 0;
-  std::uint32_t lidar_stale_trips = 0;
-  std::uint32_t chassis_stale_trips = 0;
   std::uint32_t camera_stalls = 0;  ///< Times the own camera went [camera.device] stall_ms without a frame.
   std::uint32_t resumes = 0;
   std::uint32_t wheel_send_failures = 0;
@@ -194,14 +190,16 @@ class Daemon {
   dockcore::FaultCode fault() const;
   const dockcore::TaskStatus& last_status() const { return last_out_.status; }
   const dockcore::hal::WheelCommand& last_wheels() const { return last_wheels_; }
-  bool lidar_stale() const { return lidar_stale_; }
-  bool chassis_stale() const { return chassis_stale_; }
+  bool lidar_stale() const { return core_->inputs().lidar_stale(); }
+  bool chassis_stale() const { return core_->inputs().chassis_stale(); }
+  /// The core's input watch: staleness, late scans, the watchdogs' trips. O(1).
+  const dockcore::InputWatch& inputs() const { return core_->inputs(); }
   /// The own camera delivered no frame for [camera.device] stall_ms (false without DaemonIo::camera_frames). It
   /// holds nothing and faults nothing: the docking goes on with the lidar.
   bool camera_stalled() const { return camera_stalled_; }
   const TickStats& tick_stats() const { return stats_; }
   const DaemonCounters& counters() const { return counters_; }
-  const dockcore::Pose2& odom_pose() const { return odom_; }
+  const dockcore::Pose2& odom_pose() const { return core_->odometry().pose(); }
   const StateData& state_data() const { return state_; }
   bool teaching() const { return teach_.active; }
   /// The profile currently configured (after any taught/configured target correction) and its dock id.
@@ -223,10 +221,6 @@ class Daemon {
     bool from_udp = false;
     dockcore::drivers::HostRequest request{};
     bool resume = false;  ///< Re-issued by the watchdog resume, not by a host.
-  };
-  struct OdomSample {
-    std::uint64_t stamp_us = 0;
-    dockcore::Pose2 pose{};
   };
   struct Teach {
     bool active = false;
@@ -251,9 +245,7 @@ class Daemon {
   void reply_json(const dockcore::drivers::HostRequest& r, const char* json, std::size_t len);
   /// Configures Dockcore for `dock_id` (profile corrected by its taught / configured target). Resets the task
   /// manager: only while idle.
-  /// `scan_from`: the core whose latest scan the configured core is given (default: core_ itself).
-  bool configure_core(std::uint16_t dock_id, bool raw_profile, const dockcore::DockcoreBase* scan_from = nullptr);
-  dockcore::Pose2 odom_at(std::uint64_t stamp_us) const;
+  bool configure_core(std::uint16_t dock_id, bool raw_profile);
   void watchdogs(std::uint64_t now_us);
   /// The own camera's stall watchdog (part of watchdogs): sets camera_stalled_, counts and logs its changes.
   void camera_watchdog(std::uint64_t now_us);
@@ -284,26 +276,10 @@ class Daemon {
   std::uint16_t active_dock_ = 0;
   bool active_raw_ = false;
 
-  // Odometry.
-  dockcore::Pose2 odom_{};
-  dockcore::Twist2 odom_twist_{};
-  bool have_wheels_ = false;
-  std::uint64_t last_wheels_stamp_us_ = 0;
-  OdomSample history_[64];
-  std::size_t history_next_ = 0;
+  // Chassis feedback (the odometry is the core's).
   dockcore::hal::ChassisFeedback fb_{};
 
-  // Lidar and camera.
-  bool have_scan_ = false;
-  /// When the newest scan's turn ended (its stamp plus one turn), clamped to its receive time: what the stale-lidar
-  /// watchdog measures from. Parse time would let a backlog of old bytes pass for a live sensor. 0 until the turn's
-  /// length is known (the second scan).
-  std::uint64_t last_scan_rx_us_ = 0;
-  std::uint64_t last_scan_parsed_us_ = 0;  ///< When dockd last parsed a usable (not late) scan.
-  std::uint64_t prev_scan_stamp_us_ = 0;
-  bool last_scan_late_ = false;  ///< The newest scan was late (not given to the core).
-  std::uint64_t scan_period_us_ =
-      0;  ///< Spacing of the last two scan stamps, if plausible (≤ 0.5 s or lidar_stale_ms); 0 = unknown.
+  // Camera.
   dockcore::CameraTarget camera_{};
 
   // Commands.
@@ -312,15 +288,12 @@ class Daemon {
   std::size_t queue_head_ = 0, queue_size_ = 0;
 
   // Watchdogs and resume.
-  bool lidar_stale_ = true, chassis_stale_ = true;
   bool camera_stalled_ = false, prev_camera_stalled_ = false;
   std::uint64_t camera_watch_from_us_ = 0;  ///< First watchdog tick: a camera that never delivers stalls from here.
-  std::uint64_t lidar_stale_since_us_ = 0, chassis_stale_since_us_ = 0;
   bool started_ = false;
   std::uint64_t start_us_ = 0;
   dockcore::HostCommandType interrupted_ = dockcore::HostCommandType::kNone;
   std::uint16_t interrupted_dock_ = 0;
-  std::uint64_t fresh_since_us_ = 0;
   std::uint8_t resumes_this_task_ = 0;
   dockcore::HostCommandType running_cmd_ = dockcore::HostCommandType::kNone;
   std::uint16_t running_dock_ = 0;

@@ -1,13 +1,13 @@
 // Example bare-metal firmware: dockcore's whole docking stack (estimator, filter, task manager, smooth controller)
 // on a Cortex-M7 with no OS, no heap and no exceptions.
 //
-// The "lidar" is a canned scene: a `plate-v` dock at the world origin against a 4 m wall, rendered every 100 ms into a 720-beam scan
-// (LD06-like, 0.5 degree steps) by core's own ray caster (PlacedProfile::raycast) from wherever the robot is, plus a
-// fixed pseudo-random ±3 mm range noise. The "chassis" integrates the twist Dockcore sends the drive (after its limits)
-// exactly (ideal odometry) and
-// closes the contacts when the pads reach the dock face within ±10 mm / ±2 degrees; current flows 0.5 s later.
-// The main loop runs the 50 Hz control tick. With DOCKCORE_FW_SEMIHOSTING the firmware prints its timeline through
-// Arm semihosting (qemu-system-arm -semihosting, or a debug probe) and exits with status 0 when charging was
+// The "lidar" is a canned scene: a `plate-v` dock at the world origin against a 4 m wall, rendered every 100 ms into a
+// 720-beam scan (LD06-like, 0.5 degree steps) by core's own ray caster (PlacedProfile::raycast) from wherever the robot
+// is, plus a fixed pseudo-random ±3 mm range noise. The "chassis" moves the robot by the twist Dockcore sends the drive
+// (after its limits) exactly, reports the wheel speeds it ran at (Dockcore integrates them into its odometry, as on a
+// robot) and closes the contacts when the pads reach the dock face within ±10 mm / ±2 degrees; current flows 0.5 s
+// later. The main loop runs the 50 Hz control tick. With DOCKCORE_FW_SEMIHOSTING the firmware prints its timeline
+// through Arm semihosting (qemu-system-arm -semihosting, or a debug probe) and exits with status 0 when charging was
 // confirmed; without it the result is left in g_result for a debugger and the core sleeps.
 #include <cstddef>
 #include <cstdint>
@@ -176,7 +176,7 @@ int main() {
 
   // Start 1.3 m out, 0.2 m to the side, 12 degrees off the dock's axis, facing roughly towards it.
   Pose2 robot{static_cast<Real>(1.3), static_cast<Real>(0.2), kPi - static_cast<Real>(0.21)};
-  const Pose2 odom_origin = robot;  // odometry frame = the start pose
+  WheelSpeeds wheels_ran{};  // what the drive reports: the wheel speeds of the previous tick's command
   TaskState last_state = TaskState::kNotTasking;
   std::uint64_t now_us = 0;
   std::uint64_t contact_since_us = 0;
@@ -201,15 +201,15 @@ int main() {
 #endif
   unsigned k = 0;
   for (; k < kMaxTicks; ++k, now_us += kTickUs) {
-    const Pose2 odom = odom_origin.inverse().compose(robot);
+    g_core.on_wheels(wheels_ran, now_us);
     if (k % kTicksPerScan == 0) {
       render_scan(robot, now_us);
 #if DOCKCORE_FW_SEMIHOSTING
       const std::uint64_t t0 = systick_now();
-      g_core.on_scan(g_scan.view(), now_us, odom);
+      g_core.on_scan(g_scan.view(), now_us, now_us);
       scan_cost.add(instructions(systick_now() - t0));
 #else
-      g_core.on_scan(g_scan.view(), now_us, odom);
+      g_core.on_scan(g_scan.view(), now_us, now_us);
 #endif
     }
 
@@ -224,7 +224,6 @@ int main() {
     TickInput in;
     in.now_us = now_us;
     if (k == 1) in.command = HostCommand{HostCommandType::kDock, 0};
-    in.odom_pose = odom;
     in.contact = contact;
     in.charge_current_a = contact && now_us - contact_since_us >= 500000 ? static_cast<Real>(5) : 0;
 #if DOCKCORE_FW_SEMIHOSTING
@@ -257,6 +256,7 @@ int main() {
       break;
     }
     if (out.status.state == TaskState::kFault) break;
+    wheels_ran = out.wheels;
 
     // Ideal unicycle over one tick; the dock face stops the pads (no pressing through it).
     const Real dt = static_cast<Real>(kTickUs) * static_cast<Real>(1e-6);

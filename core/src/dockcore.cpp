@@ -4,9 +4,9 @@ namespace dockcore {
 
 bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& config) {
   config_ = config;
+  watch_.configure(config.watchdog);
   filter_ = DockPoseFilter(config.filter);
   tasks_.configure(config.task, config.footprint, profile);
-  have_scan_ = false;
   pending_count_ = 0;
   pending_dropped_ = 0;
   for (std::uint32_t& c : tag_counts_) c = 0;
@@ -22,7 +22,39 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
   return estimator_.configure(profile, config.estimator);
 }
 
-const DockEstimate& DockcoreBase::on_scan(const ScanView& scan, std::uint64_t stamp_us, const Pose2& odom_pose) {
+void DockcoreBase::take_inputs(const DockcoreBase& from) {
+  odometry_ = from.odometry_;
+  watch_ = from.watch_;
+  watch_.configure(config_.watchdog);
+  have_scan_ = from.have_scan_;
+  last_scan_us_ = from.last_scan_us_;
+  const std::size_t n = from.scan_.count < scan_capacity_ ? from.scan_.count : scan_capacity_;
+  for (std::size_t i = 0; i < n; ++i) {
+    scan_ranges_m_[i] = from.scan_ranges_m_[i];
+    scan_intensities_[i] = from.scan_intensities_[i];
+  }
+  scan_ = from.scan_;
+  scan_.ranges_m = scan_ranges_m_;
+  scan_.intensities = scan_intensities_;
+  scan_.count = n;
+}
+
+const DockEstimate* DockcoreBase::on_scan(const ScanView& scan, std::uint64_t stamp_us, std::uint64_t now_us) {
+  if (stamp_us == 0 || stamp_us > now_us) stamp_us = now_us;  // no stamp, or one from the future: when it was read
+  if (!watch_.on_scan(stamp_us, now_us)) return nullptr;
+  return &estimate_scan(scan, stamp_us);
+}
+
+const DockEstimate& DockcoreBase::rescan() {
+  if (!have_scan_) {
+    last_estimate_ = DockEstimate{};
+    return last_estimate_;
+  }
+  return estimate_scan(scan_, scan_.stamp_us);
+}
+
+const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint64_t stamp_us) {
+  const Pose2 odom_pose = odometry_.pose_at(stamp_us);
   const std::size_t n = scan.count < scan_capacity_ ? scan.count : scan_capacity_;
   // The tick's copy of the scan: the one copy a scan gets on its way from the parser (the estimator reads the
   // caller's). A scan fed back from that copy (last_scan()) is already there.
@@ -98,7 +130,7 @@ const DockEstimate& DockcoreBase::on_scan(const ScanView& scan, std::uint64_t st
   return last_estimate_;
 }
 
-TagStatus DockcoreBase::on_tag(const TagObservation& obs, const Pose2& odom_at_stamp) {
+TagStatus DockcoreBase::on_tag(const TagObservation& obs) {
   const TagFusionParams& p = config_.tag;
   TagStatus st = TagStatus::kFused;
   TagMeasurement m;
@@ -119,7 +151,8 @@ TagStatus DockcoreBase::on_tag(const TagObservation& obs, const Pose2& odom_at_s
     }
   }
   if (st == TagStatus::kFused) {
-    const FilterUpdate u = filter_.update_tag(m.dock_in_robot, m.covariance, odom_at_stamp, obs.stamp_us);
+    const FilterUpdate u =
+        filter_.update_tag(m.dock_in_robot, m.covariance, odometry_.pose_at(obs.stamp_us), obs.stamp_us);
     if (u == FilterUpdate::kGated) st = TagStatus::kGated;
     if (u == FilterUpdate::kInvalid) st = TagStatus::kInvalid;
     // A filter (re)started by a tag rests on it alone: the push test waits for a second lidar detection.
@@ -133,20 +166,19 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
   TaskInput t;
   t.now_us = in.now_us;
   t.command = in.command;
-  t.odom_pose = in.odom_pose;
-  t.odom_twist = in.odom_twist;
+  t.odom_pose = odometry_.pose();
+  t.odom_twist = odometry_.twist();
   t.camera = in.camera;
   t.contact = in.contact;
   t.charge_current_a = in.charge_current_a;
-  t.chassis_ok = in.chassis_ok;
-  const bool scan_recent = have_scan_ && (in.now_us <= last_scan_us_ ||
-      static_cast<Real>(in.now_us - last_scan_us_) * static_cast<Real>(1e-6) <= config_.lidar_stale_s);
-  t.lidar_ok = in.lidar_ok && scan_recent;
+  check_inputs(in.now_us);
+  t.chassis_ok = watch_.chassis_ok(in.now_us);
+  t.lidar_ok = watch_.lidar_ok(in.now_us);
   t.scan = have_scan_ ? &scan_ : nullptr;
   t.lidar_mount = config_.lidar_mount;
   if (filter_.initialised()) {
     t.dock.valid = true;
-    t.dock.pose = filter_.dock_in_robot(in.odom_pose, &t.dock.covariance);
+    t.dock.pose = filter_.dock_in_robot(t.odom_pose, &t.dock.covariance);
     t.dock.stamp_us = filter_.last_update_us();
     t.dock.confirmed = filter_confirmed_;
   }
@@ -157,7 +189,7 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
   const TaskState before = tasks_.state();
   TickOutput out;
   static_cast<TaskOutput&>(out) = tasks_.tick(t);
-  shape(in.hold, &out);
+  shape(watch_.hold(), &out);
   // A new dock task: forget the old dock (the robot may have been carried since), so the push test and the
   // controller start from this task's own detections. A resumed one keeps the pre-outage estimate for the push test.
   if (out.status.state == TaskState::kGetTaskingCmd && prev_state_ != TaskState::kGetTaskingCmd) {

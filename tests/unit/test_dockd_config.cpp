@@ -29,8 +29,8 @@ TEST_GROUP(DockdConfig){};
 TEST(DockdConfig, DefaultsAreUsable) {
   const dockd::DockdConfig c = dockd::parse_config_toml("", "t.toml");
   STRCMP_EQUAL("can0", c.can_interface.c_str());
-  CHECK_EQUAL(200u, c.lidar_stale_ms);
-  CHECK_EQUAL(200u, c.chassis_stale_ms);
+  CHECK_EQUAL(200u, c.watchdog.lidar_stale_ms);
+  CHECK_EQUAL(200u, c.watchdog.chassis_stale_ms);
   STRCMP_EQUAL("127.0.0.1", c.host.bind_address.c_str());
   CHECK_EQUAL(1u, c.docks.size());
   CHECK_EQUAL(1u, c.task.accepted_dock_ids);

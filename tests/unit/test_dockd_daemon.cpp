@@ -278,7 +278,7 @@ TEST(DockdDaemon, ChassisStaleStopsWithinOneTickFaultsAndResumes) {
   r.link.silent = false;
   CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
   CHECK_EQUAL(1u, r.daemon->counters().resumes);
-  CHECK_EQUAL(1u, r.daemon->counters().chassis_stale_trips);
+  CHECK_EQUAL(1u, r.daemon->inputs().chassis_trips());
 }
 
 TEST(DockdDaemon, LidarOutageMidUndockResumesTheBackOff) {
@@ -341,8 +341,8 @@ TEST(DockdDaemon, LidarWatchdogDoesNotFlapAtStartUp) {
   }
   CHECK_TRUE(was_fresh);
   CHECK_EQUAL(0, flaps);
-  CHECK_EQUAL(0u, r.daemon->counters().lidar_stale_trips);
-  CHECK_EQUAL(0u, r.daemon->counters().late_scans);
+  CHECK_EQUAL(0u, r.daemon->inputs().lidar_trips());
+  CHECK_EQUAL(0u, r.daemon->inputs().late_scans());
   // The watchdog's events say how old the data was: the one that went fresh carries the ages.
   const std::string ev = r.events("watchdog");
   CHECK_TRUE(ev.find("\"which\":\"lidar\",\"stale\":false") != std::string::npos);
@@ -364,10 +364,13 @@ TEST(DockdDaemon, ScansDeliveredLateDoNotKeepTheLidarFresh) {
   CHECK_TRUE(r.daemon->lidar_stale());
   CHECK_TRUE(r.wheels_zero());
   CHECK(r.daemon->counters().scans >= scans_before + 4);  // they kept coming...
-  CHECK(r.daemon->counters().late_scans >= 4);            // ...and were counted as late
-  // 0.8 s without a usable scan: the core's own scan-age backstop (lidar_stale_ms + 0.3 s) has faulted 185 while
-  // dockd's watchdog held; live scans again resume the docking.
-  CHECK_EQUAL(185, static_cast<int>(r.daemon->fault()));
+  CHECK(r.daemon->inputs().late_scans() >= 4);            // ...and were counted as late
+  // 0.8 s without a usable scan: held, not faulted; the task manager hears of it once the lidar has been stale for
+  // fault_after_ms (1 s), then faults 185. Live scans again resume the docking.
+  CHECK_EQUAL(0, static_cast<int>(r.daemon->fault()));
+  CHECK_TRUE(r.daemon->state() == TaskState::kAlign);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->fault() == dockcore::FaultCode::kLidarStale; }, 0.6));
+  CHECK_TRUE(r.wheels_zero());
   r.scan_lag_us = 0;
   CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
   CHECK_EQUAL(1u, r.daemon->counters().resumes);
@@ -406,7 +409,7 @@ TEST(DockdDaemon, ShortLidarGapHoldsTheRobotAndTheDockingContinues) {
   r.lidar_blocked = false;
   CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
   CHECK_EQUAL(0u, r.daemon->counters().resumes);
-  CHECK_EQUAL(1u, r.daemon->counters().lidar_stale_trips);
+  CHECK_EQUAL(1u, r.daemon->inputs().lidar_trips());
 }
 
 TEST(DockdDaemon, UdpFloodStaysConsistentAndUnknownDockIsRejected) {
@@ -557,12 +560,12 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   dockd::DockdConfig next = r.cfg;
   next.source = "good.toml";
   next.log_level = dockd::LogLevel::kError;  // the reload applies [log] level to stderr: keep the test quiet
-  next.chassis_stale_ms = 300;
+  next.watchdog.chassis_stale_ms = 300;
   next.smooth.v_max_mps = static_cast<dockcore::Real>(0.15);
   CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kApplied),
               static_cast<int>(r.daemon->request_reload(next, r.clock.t, msg)));
   STRCMP_CONTAINS("good.toml: config reloaded", msg.c_str());
-  CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
+  CHECK_EQUAL(300u, r.daemon->config().watchdog.chassis_stale_ms);
   CHECK_EQUAL(1u, r.daemon->counters().config_reloads);
 
   // A file that does not parse: rejected with file:line:col, nothing changes.
@@ -576,18 +579,18 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
               static_cast<int>(r.daemon->reload_from_file(bad, r.clock.t, msg)));
   STRCMP_CONTAINS((bad + ":3:18: watchdog.lidar_stale_ms must be an integer").c_str(), msg.c_str());
   STRCMP_CONTAINS("running configuration stays", msg.c_str());
-  CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
+  CHECK_EQUAL(300u, r.daemon->config().watchdog.chassis_stale_ms);
   std::remove(bad.c_str());
 
   // A restart-only key: the whole reload is refused, the runtime keys in it included.
   dockd::DockdConfig other = r.daemon->config();
   other.source = "restart.toml";
   other.can_interface = "vcan7";
-  other.chassis_stale_ms = 400;
+  other.watchdog.chassis_stale_ms = 400;
   CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kRejected),
               static_cast<int>(r.daemon->request_reload(other, r.clock.t, msg)));
   STRCMP_CONTAINS("restart-only keys changed (can.interface)", msg.c_str());
-  CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
+  CHECK_EQUAL(300u, r.daemon->config().watchdog.chassis_stale_ms);
   STRCMP_EQUAL("can0", r.daemon->config().can_interface.c_str());
   CHECK_EQUAL(2u, r.daemon->counters().config_reloads_rejected);
 
@@ -597,7 +600,7 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   dockd::DockdConfig slow = r.daemon->config();
   slow.source = "slow.toml";
   slow.smooth.v_max_mps = static_cast<dockcore::Real>(0.05);
-  slow.chassis_stale_ms = 250;
+  slow.watchdog.chassis_stale_ms = 250;
   CHECK_EQUAL(static_cast<int>(dockd::ReloadResult::kPending),
               static_cast<int>(r.daemon->request_reload(slow, r.clock.t, msg)));
   STRCMP_CONTAINS("pending until the task is idle (state ALIGN)", msg.c_str());
@@ -607,7 +610,7 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
     CHECK_EQUAL(static_cast<int>(TaskState::kAlign), static_cast<int>(r.daemon->state()));
     CHECK_FALSE(r.wheels_zero());
   }
-  CHECK_EQUAL(300u, r.daemon->config().chassis_stale_ms);
+  CHECK_EQUAL(300u, r.daemon->config().watchdog.chassis_stale_ms);
   char json[dockcore::drivers::kMaxHostReply];
   CHECK(r.daemon->status_json(json, sizeof json - 64, r.clock.t) > 0);  // still fits the status reply
   // The latest scan's decision: the dock in view is accepted, with its evidence above the threshold and each cue.
@@ -621,7 +624,7 @@ TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   r.host.command(2, 0);  // stop: idle -> the pending reload applies on that tick
   CHECK_TRUE(r.run_until([&] { return !r.daemon->reload_pending(); }, 1.0));
   CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
-  CHECK_EQUAL(250u, r.daemon->config().chassis_stale_ms);
+  CHECK_EQUAL(250u, r.daemon->config().watchdog.chassis_stale_ms);
   CHECK_EQUAL(2u, r.daemon->counters().config_reloads);
   // The rebuilt core docks with the new parameters.
   r.host.command(1, 0);
@@ -726,7 +729,7 @@ TEST(DockdDaemon, ACameraStallIsReportedAndTheDockingGoesOnWithTheLidar) {
   CHECK_TRUE(r.daemon->camera_stalled());
   CHECK_EQUAL(1u, r.daemon->counters().camera_stalls);
   CHECK_EQUAL(0u, r.daemon->counters().resumes);
-  CHECK_EQUAL(0u, r.daemon->counters().lidar_stale_trips);
+  CHECK_EQUAL(0u, r.daemon->inputs().lidar_trips());
   CHECK_EQUAL(0, static_cast<int>(r.daemon->last_status().retries));
   const std::string ev = r.events("watchdog");
   CHECK_TRUE(ev.find("\"which\":\"camera\",\"stale\":true") != std::string::npos);

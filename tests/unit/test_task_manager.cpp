@@ -885,24 +885,27 @@ struct FacadeSim {
   };
   std::vector<Past> past;
   bool scans_on = true;  // false: a lidar gap (the host drops late scans); ticks and odometry go on
+  /// The chassis's odometry at the current time, as a host hands it over (ideal: odometry = w.odom).
+  void feed_odom() { core->on_odometry(w.odom, Twist2{}, w.now_us); }
+  bool odom_on = true;  // false: the chassis is silent (no feedback); the robot still moves by the last command
   TickOutput step(HostCommand cmd = HostCommand{}, bool resume = false) {
+    if (odom_on) feed_odom();
     if (scans_on && w.ticks % 5 == 0) {
       simulate_scan(w.world_model(), w.world, w.model, w.rng, &w.scan, w.now_us);
       if (!lidar_sees_dock) {
         for (std::size_t i = 0; i < w.scan.count; ++i) w.scan.ranges_m[i] = 0;
       }
-      core->on_scan(w.scan.view(), w.now_us, w.odom);
+      core->on_scan(w.scan.view(), w.now_us, w.now_us);
     }
     past.push_back(Past{w.now_us, w.world, w.odom});
     if (tags_on && w.ticks % 2 == 0 && past.size() > 2) {
       const Past& then = past[past.size() - 3];  // two ticks ago: 40 ms
-      core->on_tag(observe_tag(then.world, w.dock, tag_truth, &tag_rng, tag_sigma_px, then.stamp_us), then.odom);
+      core->on_tag(observe_tag(then.world, w.dock, tag_truth, &tag_rng, tag_sigma_px, then.stamp_us));
     }
     TickInput in;
     in.now_us = w.now_us;
     in.command = cmd;
     in.resume = resume;
-    in.odom_pose = w.odom;
     in.contact = w.contact;
     const bool current = w.contact && w.charge_enable && w.now_us - w.contact_since_us >= 500000;
     in.charge_current_a = current ? 2.0 : 0.0;
@@ -955,13 +958,14 @@ TEST(Dockcore, DocksWithTheRealEstimatorAndFilter) {
          sizeof(TaskManager), sizeof(DockPoseEstimator), sizeof(LaserScan));
 }
 
-TEST(Dockcore, ScanIsCopiedOnceAndItsOwnCopyCanBeFedBack) {
-  // on_scan() copies the scan once, for the tick; fed its own last_scan() (what dockd does after reconfiguring),
-  // it copies nothing and estimates the same dock.
+TEST(Dockcore, ScanIsCopiedOnceAndRescanAfterConfigureCopiesNothing) {
+  // on_scan() copies the scan once, for the tick; configure() keeps it, and rescan() (what dockd does after
+  // reconfiguring) copies nothing and estimates the same dock.
   FacadeSim f;
   CHECK_EQUAL(0u, f.core->last_scan().count);
   simulate_scan(f.w.world_model(), f.w.world, f.w.model, f.w.rng, &f.w.scan, f.w.now_us);
-  const DockEstimate first = f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.odom);
+  f.feed_odom();
+  const DockEstimate first = *f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.now_us);
   CHECK_TRUE(first.found);
   CHECK_EQUAL(2 * f.w.scan.count * sizeof(Real), f.core->scan_copy_bytes());
   const ScanView kept = f.core->last_scan();
@@ -970,9 +974,9 @@ TEST(Dockcore, ScanIsCopiedOnceAndItsOwnCopyCanBeFedBack) {
   for (std::size_t i = 0; i < kept.count; ++i) CHECK_TRUE(kept.ranges_m[i] == f.w.scan.ranges_m[i]);
   DockcoreConfig cfg;
   cfg.task.detect_wait_s = 0.3;
-  CHECK(f.core->configure(f.w.profile, cfg));  // forgets the scan, keeps the copy's storage
-  CHECK_EQUAL(0u, f.core->last_scan().count);
-  const DockEstimate again = f.core->on_scan(kept, kept.stamp_us, f.w.odom);
+  CHECK(f.core->configure(f.w.profile, cfg));  // forgets the detections, keeps the scan
+  CHECK_EQUAL(kept.count, f.core->last_scan().count);
+  const DockEstimate again = f.core->rescan();
   CHECK_EQUAL(0u, f.core->scan_copy_bytes());
   CHECK_EQUAL(kept.count, f.core->last_scan().count);
   CHECK_TRUE(again.found);
@@ -998,6 +1002,7 @@ TEST(Dockcore, NoScansMeansLidarStaleWhenMoving) {
   FacadeSim f;
   TickInput in;
   in.now_us = 1000000;
+  f.core->on_odometry(Pose2{}, Twist2{}, in.now_us);  // the chassis answers; the lidar never did
   in.command = HostCommand{HostCommandType::kDock, 0};
   const TickOutput o = f.core->tick(in);
   CHECK(o.status.state == TaskState::kFault);
@@ -1024,12 +1029,12 @@ TEST(Dockcore, PushFollowedByAScanBacklogIsStillReported) {
       for (int k = 0; k < backlog; ++k) {
         f.w.now_us += 100000;
         simulate_scan(f.w.world_model(), f.w.world, f.w.model, f.w.rng, &f.w.scan, f.w.now_us);
-        f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.odom);
+        f.feed_odom();
+        f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.now_us);
       }
       CHECK(f.core->filter().reinitialisations() >= (backlog >= 3 ? 1u : 0u));  // the filter did adopt the push
       TickInput in;
       in.now_us = f.w.now_us + 1000;
-      in.odom_pose = f.w.odom;
       const TickOutput o = f.core->tick(in);
       CHECK_TEXT(o.status.state == TaskState::kFault, (std::string("backlog ") + std::to_string(backlog)).c_str());
       LONGS_EQUAL(turned != 0 ? 179 : 178, static_cast<int>(o.status.fault));
@@ -1058,7 +1063,10 @@ TEST(Dockcore, PushRightAfterGatedDetectionsIsStillReported) {
     for (int k = 0; k < gated; ++k) {
       while (f.w.ticks % 5 != 0) f.step();
       simulate_scan(f.w.world_model(), f.w.world, f.w.model, f.w.rng, &f.w.scan, f.w.now_us);
-      f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.odom.compose(Pose2{-0.05, 0, 0}));
+      // The lagging odometry sample is the one at the scan's stamp; the true pose follows a microsecond later.
+      f.core->on_odometry(f.w.odom.compose(Pose2{-0.05, 0, 0}), Twist2{}, f.w.now_us);
+      f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.now_us);
+      f.core->on_odometry(f.w.odom, Twist2{}, f.w.now_us + 1);
       f.step();
     }
     LONGS_EQUAL_TEXT(gated, static_cast<long>(f.core->filter().gated() - gated0 +
@@ -1075,10 +1083,10 @@ TEST(Dockcore, PushRightAfterGatedDetectionsIsStillReported) {
 // dockd stalls ~0.9 s around a 0.5 m push and then drops the late scans, so the core gets no detection for ~1 s and
 // then only post-push ones. Wheel odometry runs through a lidar gap, so the pre-gap estimate carried by odometry is
 // still the expectation: the push must be reported on the second agreeing post-gap detection (178 sideways, 179
-// turned about the dock). When the ticks run through the gap the scan-age backstop (185 after lidar_stale_s) stops the
-// robot first, and dockd's watchdog resume re-issues the dock command: the resumed task must still report the push
-// (the new task resets the filter, so the pre-push estimate is the only reference). `ticking`: the host kept ticking
-// through the gap (dropped scans) or stalled (no ticks).
+// turned about the dock). When the ticks run through a long gap the input watch holds the robot and then faults 185
+// (after lidar_stale_ms + fault_after_ms), and dockd's watchdog resume re-issues the dock command: the resumed task
+// must still report the push (the new task resets the filter, so the pre-push estimate is the only reference).
+// `ticking`: the host kept ticking through the gap (dropped scans) or stalled (no ticks).
 TEST(Dockcore, PushDuringALidarGapIsStillReported) {
   const double gaps_s[] = {0.6, 1.0, 2.0};
   for (int ticking = 0; ticking <= 1; ++ticking) {
@@ -1118,11 +1126,11 @@ TEST(Dockcore, PushDuringALidarGapIsStillReported) {
         }
         f.scans_on = true;
         if (fault != FaultCode::kNone) {
-          // The scan-age backstop fired in the gap (documented: lidar_stale_s), the robot stands. A host's watchdog
-          // resume re-issues the dock command once scans are fresh again (dockd: after 0.5 s); the resumed task
-          // must still report the push, not dock on from the pushed pose.
+          // The input watch faulted 185 in the gap (lidar_stale_ms + fault_after_ms), the robot stands. A host's
+          // watchdog resume re-issues the dock command once scans are fresh again (dockd: after 0.5 s); the resumed
+          // task must still report the push, not dock on from the pushed pose.
           LONGS_EQUAL_TEXT(185, static_cast<int>(fault), what);
-          CHECK_TEXT(ticking != 0 && gap_s > 0.5, what);
+          CHECK_TEXT(ticking != 0 && gap_s > 1.2, what);
           const Pose2 at = f.w.world;
           for (int i = 0; i < 25; ++i) f.step();
           CHECK_TEXT(f.core->task_manager().state() == TaskState::kFault, what);
@@ -1185,7 +1193,7 @@ TEST(Dockcore, DriveCommandIsSaturatedRateLimitedAndZeroedAtOnce) {
   CHECK(moved);
 }
 
-TEST(Dockcore, HoldZeroesTheDriveAndTheRampRestartsFromRest) {
+TEST(Dockcore, StaleChassisHoldsTheDriveThenFaultsAndTheRampRestartsFromRest) {
   FacadeSim f;
   f.step(HostCommand{HostCommandType::kDock, 0});
   TickOutput o;
@@ -1194,21 +1202,70 @@ TEST(Dockcore, HoldZeroesTheDriveAndTheRampRestartsFromRest) {
     if (o.drive_cmd.vx_mps != 0) break;
   }
   CHECK(o.drive_cmd.vx_mps != 0);
-  // A host hold: the task manager still wants to move, the drive gets zero.
-  TickInput in;
-  in.now_us = f.w.now_us;
-  in.odom_pose = f.w.odom;
-  in.hold = true;
-  const TickOutput held = f.core->tick(in);
+  // The chassis falls silent (scans go on): held once its newest feedback is older than chassis_stale_ms. The task
+  // manager still wants to move; the drive gets zero.
+  const WatchdogParams wd = f.core->config().watchdog;
+  const std::uint64_t silent_from_us = f.w.now_us - Sim::kTickUs;  // the last feedback's stamp
+  f.odom_on = false;
+  TickOutput held;
+  while (f.w.now_us - silent_from_us <= wd.chassis_stale_ms * 1000u) {
+    held = f.step();
+    CHECK(!f.core->inputs().chassis_stale());
+  }
+  held = f.step();
+  CHECK(f.core->inputs().chassis_stale());
+  CHECK(held.status.state == TaskState::kAlign || held.status.state == TaskState::kReachTaskingPoint);
   CHECK(held.cmd.vx_mps != 0 || held.cmd.wz_radps != 0);
   CHECK(held.drive_cmd.vx_mps == 0 && held.drive_cmd.wz_radps == 0);
   CHECK(held.wheels.radps[0] == 0 && held.wheels.radps[1] == 0);
-  // Released: the acceleration limit ramps up from rest again.
-  in.hold = false;
-  in.now_us += 20000;
-  const TickOutput next = f.core->tick(in);
+  // Back before fault_after_ms: the same task continues, the acceleration limit ramping up from rest.
+  f.odom_on = true;
+  const TickOutput next = f.step();
+  CHECK(!f.core->inputs().chassis_stale());
+  CHECK(next.status.fault == FaultCode::kNone);
   const DriveLimits lim = f.core->config().limits;
   CHECK(std::fabs(next.drive_cmd.vx_mps) <= lim.max_linear_accel_mps2 * f.core->config().control_period_s + 1e-5);
+  // Silent for the hold and fault_after_ms: fault 184, the wheels at zero throughout.
+  const std::uint64_t again_us = f.w.now_us - Sim::kTickUs;
+  f.odom_on = false;
+  TickOutput last;
+  while (f.w.now_us - again_us <= (wd.chassis_stale_ms + wd.fault_after_ms) * 1000u + 20000u) {
+    last = f.step();
+    if (f.w.now_us - again_us > wd.chassis_stale_ms * 1000u + 20000u) {
+      CHECK(last.wheels.radps[0] == 0 && last.wheels.radps[1] == 0);
+    }
+  }
+  CHECK(last.status.state == TaskState::kFault);
+  LONGS_EQUAL(184, static_cast<int>(last.status.fault));
+  CHECK_EQUAL(2u, f.core->inputs().chassis_trips());
+}
+
+TEST(Dockcore, LateScansAreNotUsedAndALongLidarGapFaults) {
+  FacadeSim f;
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  CHECK(f.run_until(TaskState::kAlign, 5));
+  const std::uint32_t found = f.core->estimator().counters().found;
+  // A scan read more than lidar_stale_ms after its turn ended (a backlog): counted, not used.
+  const WatchdogParams wd = f.core->config().watchdog;
+  simulate_scan(f.w.world_model(), f.w.world, f.w.model, f.w.rng, &f.w.scan, f.w.now_us);
+  const std::uint64_t read_us = f.w.now_us + 100000 + wd.lidar_stale_ms * 1000u + 1000u;
+  CHECK(f.core->on_scan(f.w.scan.view(), f.w.now_us, read_us) == nullptr);
+  CHECK_EQUAL(1u, f.core->inputs().late_scans());
+  CHECK_EQUAL(found, f.core->estimator().counters().found);
+  // No scans: held after lidar_stale_ms, fault 185 after fault_after_ms more.
+  f.scans_on = false;
+  bool held = false;
+  TickOutput o;
+  for (int i = 0; i < 100 && o.status.state != TaskState::kFault; ++i) {
+    o = f.step();
+    if (f.core->inputs().lidar_stale() && o.status.state != TaskState::kFault) {
+      held = true;
+      CHECK(o.drive_cmd.vx_mps == 0 && o.drive_cmd.wz_radps == 0);
+    }
+  }
+  CHECK(held);
+  CHECK(o.status.state == TaskState::kFault);
+  LONGS_EQUAL(185, static_cast<int>(o.status.fault));
 }
 
 TEST(TaskManager, StatesAndCommandResultsHaveTheirStableNames) {
@@ -1298,7 +1355,7 @@ TEST(Dockcore, WrongIdStaleAndOutOfOrderTagsAreCountedAndChangeNothing) {
     const Pose2 dock = f.core->filter().dock_in_odom();
     const Mat3 cov = f.core->filter().covariance_odom();
     const std::uint32_t fused = f.core->filter().tag_fused(), before = f.core->tag_count(want);
-    CHECK_EQUAL_TEXT(static_cast<int>(want), static_cast<int>(f.core->on_tag(o, f.w.odom)), to_string(want));
+    CHECK_EQUAL_TEXT(static_cast<int>(want), static_cast<int>(f.core->on_tag(o)), to_string(want));
     const Pose2 d = f.core->filter().dock_in_odom();
     CHECK(d.x_m == dock.x_m && d.y_m == dock.y_m && d.yaw_rad == dock.yaw_rad);
     CHECK(f.core->filter().covariance_odom() == cov);
@@ -1306,7 +1363,7 @@ TEST(Dockcore, WrongIdStaleAndOutOfOrderTagsAreCountedAndChangeNothing) {
     LONGS_EQUAL(before + 1, f.core->tag_count(want));
   };
   check_refused(tag_at(scan_us - 60000), TagStatus::kStale);  // 60 ms before the newest scan (bound 50 ms)
-  CHECK(f.core->on_tag(tag_at(scan_us - 40000), f.w.odom) == TagStatus::kFused);
+  CHECK(f.core->on_tag(tag_at(scan_us - 40000)) == TagStatus::kFused);
   LONGS_EQUAL(1, f.core->filter().tag_fused());
   check_refused(tag_at(scan_us - 45000), TagStatus::kOutOfOrder);  // older than the previous frame
   check_refused(tag_at(scan_us - 40000), TagStatus::kOutOfOrder);  // the same frame again
@@ -1319,7 +1376,7 @@ TEST(Dockcore, WrongIdStaleAndOutOfOrderTagsAreCountedAndChangeNothing) {
   TagObservation nan = tag_at(scan_us + 2);
   nan.rotation(0, 0) = std::nan("");
   check_refused(nan, TagStatus::kInvalid);
-  CHECK(f.core->on_tag(tag_at(scan_us + 3), f.w.odom) == TagStatus::kFused);
+  CHECK(f.core->on_tag(tag_at(scan_us + 3)) == TagStatus::kFused);
   // A dock without a tag (id −1) takes none.
   TagFusionParams none = p;
   none.dock_tag.id = -1;

@@ -407,7 +407,8 @@ json run_cost(const Options& o) {
     dockcore::DockcoreConfig cfg;
     cfg.estimator = params;
     core->configure(prof, cfg);
-    core->on_scan(scans.front()->view(), scans.front()->stamp_us, Pose2{});
+    const std::uint64_t t_us = scans.front()->stamp_us;
+    core->on_scan(scans.front()->view(), t_us, t_us);  // read as it is taken; the robot stands: no odometry fed
     return core->scan_copy_bytes();
   };
   if (want("estimator")) {

@@ -119,15 +119,7 @@ class SoakWorld {
         geom_(docksim::core_drive_geometry(sc.chassis.geometry)),
         target_world_(sc.dock_pose.transform(sc.camera.target_in_dock)) {
     core_ = std::make_unique<dockcore::Dockcore>(ctl);  // ~330 KiB: heap, not stack
-    dockcore::DockcoreConfig cfg;
-    cfg.estimator = sc.estimator;
-    cfg.task = sc.task;
-    cfg.footprint = sc.safety;
-    cfg.lidar_mount = sc.lidar_mount;
-    cfg.drive = geom_;
-    cfg.limits = sc.limits;
-    cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
-    configured_ = core_->configure(sc.profile, cfg);
+    configured_ = core_->configure(sc.profile, docksim::core_config(sc));
     docksim::DockPlacement dp;
     dp.pose_world = sc.dock_pose;
     dp.face_half_width_m = sc.dock_face_half_width_m;
@@ -170,7 +162,6 @@ class SoakWorld {
   struct Pending {
     dockcore::LaserScan scan;
     std::uint64_t stamp_us = 0;
-    Pose2 odom{};
   };
 
   /// One 5 ms step; true when it held a control tick.
@@ -178,6 +169,10 @@ class SoakWorld {
     const double t = t_s();
     const std::uint64_t now_us = static_cast<std::uint64_t>(std::llround(t * 1e6));
     const docksim::ChassisState& cs = chassis_.state();
+    {
+      AllocScope scope;
+      core_->on_odometry(cs.odom_pose, docksim::measured_twist(geom_, cs), now_us);
+    }
 
     if (t + 1e-9 >= next_scan_t_) {
       next_scan_t_ += 1.0 / sc_.lidar.rate_hz;
@@ -185,7 +180,6 @@ class SoakWorld {
         Pending& p = *ring_[(head_ + count_) % ring_.size()];
         docksim::simulate_scan(world_, cs.true_pose.compose(sc_.lidar_mount), sc_.lidar, lidar_rng_, &p.scan, now_us);
         p.stamp_us = now_us;
-        p.odom = cs.odom_pose;
         ++count_;
       } else {
         ++scans_dropped_;
@@ -196,11 +190,10 @@ class SoakWorld {
       if (static_cast<double>(now_us - p.stamp_us) * 1e-6 + 1e-9 < sc_.scan_latency_s) break;
       {
         AllocScope scope;
-        core_->on_scan(p.scan.view(), p.stamp_us, p.odom);
+        core_->on_scan(p.scan.view(), p.stamp_us, now_us);
       }
       head_ = (head_ + 1) % ring_.size();
       --count_;
-      have_scan_ = true;
     }
     if (sc_.camera.enabled) camera_.update(now_us, cs.true_pose, target_world_, true);
 
@@ -209,16 +202,9 @@ class SoakWorld {
       dockcore::TickInput in;
       in.now_us = now_us;
       in.command = dockcore::HostCommand{cmd, 0};
-      in.odom_pose = cs.odom_pose;
-      dockcore::WheelSpeeds m;
-      m.count = cs.wheel_count;
-      for (std::size_t i = 0; i < m.count; ++i) m.radps[i] = static_cast<Real>(cs.wheel_measured_radps[i]);
-      in.odom_twist = dockcore::wheels_to_twist(geom_, m);
       if (sc_.camera.enabled) in.camera = camera_.latest();
       in.contact = cs.contact;
       in.charge_current_a = static_cast<Real>(cs.charge_current_a);
-      in.chassis_ok = true;
-      in.lidar_ok = have_scan_;
       {
         AllocScope scope;
         last_ = core_->tick(in);
@@ -258,7 +244,6 @@ class SoakWorld {
   std::array<std::unique_ptr<Pending>, 8> ring_{};
   std::size_t head_ = 0, count_ = 0;
   std::uint64_t scans_dropped_ = 0;
-  bool have_scan_ = false;
   dockcore::TickOutput last_{};
   double odom_err_m_ = 0;
 };

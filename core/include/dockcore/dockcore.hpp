@@ -1,8 +1,14 @@
 #pragma once
 /// @file Dockcore: the whole docking stack behind two calls, as dockd and dock-sim run it.
 ///
-/// Owns a DockPoseEstimator (per-scan detection), a DockPoseFilter (the dock in the odometry frame, fed by the
-/// detections) and a TaskManager (states, safety, faults); drives a DockingController given by reference.
+/// Owns the Odometry (the robot in the odometry frame, from the chassis's feedback), a DockPoseEstimator (per-scan
+/// detection), a DockPoseFilter (the dock in the odometry frame, fed by the detections) and a TaskManager (states,
+/// safety, faults); drives a DockingController given by reference.
+/// - on_wheels() / on_odometry(): the chassis's feedback, by its stamp (dockcore/control/odometry.hpp). Scans and tag
+///   frames are placed at the odometry pose of their own stamp; the tick uses the newest.
+/// - The InputWatch (dockcore/task/input_watch.hpp) judges every input's freshness with one set of thresholds
+///   (DockcoreConfig::watchdog): a late scan is not used, stale input holds the drive at zero at once, and input that
+///   stays stale faults the task (184/185). check_inputs() gives the host the verdict's changes before the tick.
 /// - on_scan(): detection with the filter's prediction as the estimator's hint (tracking mode; global search when
 ///   the filter has no dock or the hint fails), then the filter update. The scan is copied so the tick can run the
 ///   obstacle check and give controllers (seed003) the latest ranges.
@@ -35,6 +41,7 @@
 
 #include "dockcore/control/controller.hpp"
 #include "dockcore/control/kinematics.hpp"
+#include "dockcore/control/odometry.hpp"
 #include "dockcore/control/safety.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
@@ -42,6 +49,7 @@
 #include "dockcore/perception/dock_pose_filter.hpp"
 #include "dockcore/perception/dock_profile.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
+#include "dockcore/task/input_watch.hpp"
 #include "dockcore/task/task_manager.hpp"
 
 namespace dockcore {
@@ -57,7 +65,7 @@ struct DockcoreConfig {
   DriveLimits limits{};                              ///< Velocity and acceleration limits tick() applies.
   /// The control tick's nominal period, s: the acceleration limit's step. > 0.
   Real control_period_s = static_cast<Real>(0.02);
-  Real lidar_stale_s = static_cast<Real>(0.5);       ///< No scan for this long: lidar stale (fault 185 when moving).
+  WatchdogParams watchdog{};  ///< When scans and chassis feedback count as stale.
   /// A resumed dock command (TickInput::resume) keeps the dock estimate from before the outage as the push test's
   /// reference when its last detection is at most this old at the resume (s). Wheel odometry runs through a lidar
   /// outage, so the old estimate carried by odometry still says where the dock must be; beyond this, odometry drift
@@ -72,21 +80,14 @@ struct DockcoreConfig {
 struct TickInput {
   std::uint64_t now_us = 0;   ///< Monotonic time, same clock as the scan stamps.
   HostCommand command{};      ///< Command arriving on this tick (edge).
-  Pose2 odom_pose{};
-  Twist2 odom_twist{};
   CameraTarget camera{};
   bool contact = false;
   Real charge_current_a = 0;
-  bool chassis_ok = true;     ///< Chassis feedback fresh (host's judgement).
-  bool lidar_ok = true;       ///< Host's lidar health; Dockcore also checks scan age against lidar_stale_s.
   /// `command` re-issues a dock command that a data-outage fault (lidar/chassis stale) interrupted — the host's
   /// watchdog resume — not a new task: the robot has not been carried, so a push during the outage must still be
   /// reported (178/179). Dockcore then keeps the pre-outage dock estimate (push_check_max_gap_s) as the push test's
   /// reference until a detection in ALIGN has agreed with it. False for every command a host or operator sends.
   bool resume = false;
-  /// The host holds the robot still this tick (its own watchdog saw a data gap the task manager is not yet told
-  /// of): drive_cmd and wheels are zero whatever the task manager wants.
-  bool hold = false;
 };
 
 /// The task manager's output plus what the drive is sent.
@@ -102,17 +103,48 @@ class DockcoreBase {
   DockcoreBase(const DockcoreBase&) = delete;
   DockcoreBase& operator=(const DockcoreBase&) = delete;
 
-  /// Configures every part; false (unusable until a good call) when the profile has no segments. O(vertices).
+  /// Configures every part but the inputs: the odometry, the input watch's history and the latest scan run on across
+  /// docks and configurations (rescan() runs that scan through the new profile). False (unusable until a good call)
+  /// when the profile has no segments. O(vertices).
   bool configure(const DockProfile& profile, const DockcoreConfig& config);
 
-  /// One scan: detection (hint = the filter's prediction for `odom_pose`), filter update, scan copy.
-  /// `odom_pose`: robot odometry pose at the scan time; `stamp_us`: scan time. Cost: the estimator's plus O(count).
-  const DockEstimate& on_scan(const ScanView& scan, std::uint64_t stamp_us, const Pose2& odom_pose);
+  /// Measured wheel speeds (rad/s, DockcoreConfig::drive's order) at `stamp_us`, integrated into the odometry
+  /// (Odometry::add_wheels). False when the stamp is 0 or repeats the previous feedback's. O(1).
+  bool on_wheels(const WheelSpeeds& measured, std::uint64_t stamp_us) {
+    return odometry_.add_wheels(config_.drive, measured, stamp_us);
+  }
+  /// A base's own odometry pose and body twist at `stamp_us` (Odometry::add_pose). Same stamp rules. O(1).
+  bool on_odometry(const Pose2& pose, const Twist2& twist, std::uint64_t stamp_us) {
+    return odometry_.add_pose(pose, twist, stamp_us);
+  }
+  /// The odometry and its history. O(1).
+  const Odometry& odometry() const { return odometry_; }
+  /// Continues another core's inputs: its odometry, input watch and latest scan (copied, up to scan_capacity()
+  /// beams). dockd rebuilding the core on a config reload: the robot and its sensors carry on. O(count).
+  void take_inputs(const DockcoreBase& from);
 
-  /// One tag detection from a camera frame captured at `obs.stamp_us` (file comment); `odom_at_stamp`: the robot's
-  /// odometry pose at that stamp (the host's odometry history, not the current pose). Returns what became of it;
-  /// anything but kFused leaves the filter unchanged. Counted in tag_counts(). O(1).
-  TagStatus on_tag(const TagObservation& obs, const Pose2& odom_at_stamp);
+  /// One scan stamped `stamp_us` (its first sample; 0 or later than `now_us` is taken as `now_us`), read at `now_us`:
+  /// the input watch's check (a late scan is not used: nullptr, counted), then detection (hint = the filter's
+  /// prediction for the odometry pose at the stamp), filter update, scan copy. Feed the chassis feedback up to the
+  /// scan's time first. Returns the scan's estimate (last_estimate()). Cost: the estimator's plus
+  /// O(count + Odometry::kHistory).
+  const DockEstimate* on_scan(const ScanView& scan, std::uint64_t stamp_us, std::uint64_t now_us);
+  /// The latest scan (last_scan()) through detection again, e.g. for a profile configure() just set; copies nothing.
+  /// An empty estimate before the first scan. Cost: the estimator's.
+  const DockEstimate& rescan();
+
+  /// The input watch's verdict at `now_us` (tick() makes the same call): which of lidar and chassis changed between
+  /// fresh and stale. A host calls it before the tick to log the changes and act on them. O(1).
+  InputWatch::Change check_inputs(std::uint64_t now_us) {
+    return watch_.update(now_us, odometry_.valid(), odometry_.stamp_us());
+  }
+  /// The input watch (staleness, late scans, trips). O(1).
+  const InputWatch& inputs() const { return watch_; }
+
+  /// One tag detection from a camera frame captured at `obs.stamp_us` (file comment), placed at the odometry pose of
+  /// that stamp. Returns what became of it; anything but kFused leaves the filter unchanged. Counted in
+  /// tag_counts(). O(Odometry::kHistory).
+  TagStatus on_tag(const TagObservation& obs);
   /// Tag detections by outcome since configure(), indexed by TagStatus. O(1).
   std::uint32_t tag_count(TagStatus s) const { return tag_counts_[static_cast<std::size_t>(s)]; }
 
@@ -124,11 +156,10 @@ class DockcoreBase {
   const DockPoseEstimatorBase& estimator() const { return estimator_; }
   /// Most beams a scan may have: larger scans are refused by the estimator (kBadScan) and their copy truncated.
   std::size_t scan_capacity() const { return scan_capacity_; }
-  /// The latest scan as kept for the tick (empty before the first). It may be given to on_scan() again (e.g. after
-  /// reconfigure()), which then copies nothing. Valid until the next on_scan(). O(1).
+  /// The latest scan as kept for the tick (empty before the first). Valid until the next on_scan(). O(1).
   ScanView last_scan() const { return have_scan_ ? scan_ : ScanView{}; }
-  /// Bytes the last on_scan() copied (ranges and intensities for the tick): 2 · count · sizeof(Real), 0 when it
-  /// was fed its own last_scan(). O(1).
+  /// Bytes the last on_scan() copied (ranges and intensities for the tick): 2 · count · sizeof(Real); 0 after
+  /// rescan(). O(1).
   std::size_t scan_copy_bytes() const { return scan_copy_bytes_; }
   const TaskManager& task_manager() const { return tasks_; }
   const DockcoreConfig& config() const { return config_; }
@@ -152,7 +183,11 @@ class DockcoreBase {
  private:
   /// Fills out->drive_cmd and out->wheels from out->cmd (file comment). O(1).
   void shape(bool hold, TickOutput* out);
+  /// Copies `scan` (unless it is the kept copy) and runs detection and the filter on it. Cost: the estimator's.
+  const DockEstimate& estimate_scan(const ScanView& scan, std::uint64_t stamp_us);
   DockcoreConfig config_{};
+  Odometry odometry_{};
+  InputWatch watch_{};
   DockPoseEstimatorBase& estimator_;
   DockPoseFilter filter_{};
   TaskManager tasks_;

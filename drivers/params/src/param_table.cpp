@@ -239,6 +239,14 @@ const ParamSpec kTable[] = {
     DC_INT("estimator.segments", "max_split_iterations", "–", 1, 1000000, kBoth, estimator,
            segments.max_split_iterations, "Split-step evaluations per scan."),
 
+    // [watchdog]: WatchdogParams, the core's input watch (docs/dockd.md, "Watchdogs").
+    DC_INT("watchdog", "lidar_stale_ms", "ms", 40, 10000, kBoth, watchdog, lidar_stale_ms,
+           "The newest scan's turn ended longer ago: the drive is held at zero; a scan this late is not used."),
+    DC_INT("watchdog", "chassis_stale_ms", "ms", 40, 10000, kBoth, watchdog, chassis_stale_ms,
+           "No chassis feedback for longer: the drive is held at zero."),
+    DC_INT("watchdog", "fault_after_ms", "ms", 0, 60000, kBoth, watchdog, fault_after_ms,
+           "Stale this long after the hold began: fault 185 (lidar) or 184 (chassis)."),
+
     // [task]: TaskParams (docs/task-manager.md).
     DC_REAL("task", "detect_wait_s", "s", 0, 60, kBoth, task, detect_wait_s,
             "Stand still this long for a detection before swinging."),
@@ -517,8 +525,9 @@ std::string markdown_table(const std::string& table, ParamUse use) {
   Seed003Params seed003;
   SmoothParams smooth;
   TagFusionParams tag_fusion;
-  const ParamTargets defaults{&drive,   &limits,  &footprint, &task,   &estimator,
-                              &seed000, &seed004, &seed003,   &smooth, &tag_fusion};
+  WatchdogParams watchdog;
+  const ParamTargets defaults{&drive,   &limits,  &footprint, &task,       &estimator, &seed000,
+                              &seed004, &seed003, &smooth,    &tag_fusion, &watchdog};
   apply_defaults(defaults, use);
   std::ostringstream out;
   bool any = false;

@@ -24,11 +24,11 @@ dockcore::CameraTarget project_target(const CameraSimParams& p, const dockcore::
 }
 
 void CameraSim::update(std::uint64_t t_us, const dockcore::Pose2& robot_world, const dockcore::Vec2& target_world,
-                       bool visible, const dockcore::Pose2& odom_pose, const World* occluders) {
+                       bool visible, const World* occluders) {
   const std::uint64_t period_us = static_cast<std::uint64_t>(std::llround(1e6 / p_.rate_hz));
   const std::uint64_t latency_us = static_cast<std::uint64_t>(std::llround(p_.latency_s * 1e6));
   if (t_us >= next_capture_us_) {
-    InFlight f{CameraFrameOutput{}, odom_pose};
+    InFlight f{CameraFrameOutput{}};
     if (frame_camera_ != nullptr) {
       f.frame = frame_camera_->capture(robot_world, visible, occluders, rng_);
     } else {
@@ -53,15 +53,14 @@ void CameraSim::update(std::uint64_t t_us, const dockcore::Pose2& robot_world, c
     latest_ = f.frame.target;
     ++frames_delivered_;
     if (latest_.valid) ++frames_with_target_;
-    if (f.frame.has_tag) tags_.emplace_back(f.frame.tag, f.odom);
+    if (f.frame.has_tag) tags_.push_back(f.frame.tag);
     in_flight_.pop_front();
   }
 }
 
-bool CameraSim::pop_tag(dockcore::TagObservation& tag, dockcore::Pose2& odom_at_stamp) {
+bool CameraSim::pop_tag(dockcore::TagObservation& tag) {
   if (tags_.empty()) return false;
-  tag = tags_.front().first;
-  odom_at_stamp = tags_.front().second;
+  tag = tags_.front();
   tags_.pop_front();
   return true;
 }

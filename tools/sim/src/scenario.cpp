@@ -185,8 +185,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   // dockcore's parameters: the keys, bounds and defaults of the parameter table, the same as dockd's config. The
   // obstacle footprint's body is derived from the chassis below.
   namespace params = dockcore::params;
-  const params::ParamTargets targets{nullptr,     &sc.limits,  &sc.safety,  &sc.task,   &sc.estimator,
-                                     &sc.seed000, &sc.seed004, &sc.seed003, &sc.smooth, &sc.tag_fusion};
+  const params::ParamTargets targets{nullptr,     &sc.limits,  &sc.safety, &sc.task,       &sc.estimator, &sc.seed000,
+                                     &sc.seed004, &sc.seed003, &sc.smooth, &sc.tag_fusion, &sc.watchdog};
   params::apply_defaults(targets, params::kScenario);
   auto table_keys = [&](const std::string& table, Handlers h) {
     params::add_params(p, h, table, targets, params::kScenario);
@@ -517,8 +517,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
 
   auto host_handlers = [&]() {
     HostSpec& h = sc.host;
-    return Handlers{{"chassis_stale_s", p.num(&h.chassis_stale_s, 0.001, 100)},
-                    {"redock_after_fault",
+    return Handlers{{"redock_after_fault",
                      [&](const toml::node& n) { h.redock_after_fault = static_cast<int>(p.integer(n, 0, 100)); }},
                     {"redock_delay_s", p.num(&h.redock_delay_s, 0, 100)}};
   };
@@ -552,6 +551,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
                                                                                       params::kScenario)}});
                           })},
       {"host", p.sub("host.", host_handlers)},
+      {"watchdog", params::param_sub(p, "watchdog", targets, params::kScenario)},
       {"controller", p.sub("controller.", controller_handlers)},
       {"camera", p.sub("camera.",
                        [&]() {

@@ -169,6 +169,26 @@ dockcore::DriveGeometry core_drive_geometry(const DriveGeometry& g) {
   return c;
 }
 
+dockcore::DockcoreConfig core_config(const Scenario& sc) {
+  dockcore::DockcoreConfig cfg;
+  cfg.estimator = sc.estimator;
+  cfg.task = sc.task;
+  cfg.footprint = sc.safety;
+  cfg.lidar_mount = sc.lidar_mount;
+  cfg.drive = core_drive_geometry(sc.chassis.geometry);
+  cfg.limits = sc.limits;
+  cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
+  cfg.watchdog = sc.watchdog;
+  return cfg;
+}
+
+dockcore::Twist2 measured_twist(const dockcore::DriveGeometry& g, const ChassisState& reported) {
+  dockcore::WheelSpeeds m;
+  m.count = reported.wheel_count;
+  for (std::size_t i = 0; i < m.count; ++i) m.radps[i] = static_cast<Real>(reported.wheel_measured_radps[i]);
+  return dockcore::wheels_to_twist(g, m);
+}
+
 dockcore::TagFusionParams tag_fusion_params(const Scenario& sc) {
   dockcore::TagFusionParams p = sc.tag_fusion;
   const dockcore::CameraModel& m = sc.camera.model;
@@ -275,14 +295,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
 
   // Dockcore is large (estimator buffers, a scan copy): heap, not stack.
   auto core = std::make_unique<dockcore::Dockcore>(*ctl);
-  dockcore::DockcoreConfig cfg;
-  cfg.estimator = sc.estimator;
-  cfg.task = sc.task;
-  cfg.footprint = sc.safety;
-  cfg.lidar_mount = sc.lidar_mount;
-  cfg.drive = core_drive_geometry(sc.chassis.geometry);
-  cfg.limits = sc.limits;
-  cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
+  dockcore::DockcoreConfig cfg = core_config(sc);
   // A rendered camera: images of the dock's tag through the detector; its tag poses fused with the lidar.
   std::unique_ptr<FrameCamera> frame_camera;
   const bool rendered = sc.camera.enabled && sc.camera.render;
@@ -339,7 +352,6 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   struct PendingScan {
     dockcore::LaserScan scan;
     std::uint64_t stamp_us;
-    Pose2 odom;
     Pose2 lidar_world;
   };
   std::vector<std::unique_ptr<PendingScan>> pending;
@@ -360,7 +372,6 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   bool first_dock_sent = false;
   double dock_cmd_t = 0;
   double end_at = -1;
-  double last_responding_t = 0;
   ChassisState reported = chassis.state();  // what the host last heard from the chassis
   int last_vx_sign = 0;
   double inplace_acc = 0;
@@ -441,7 +452,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     const ChassisState& cs = chassis.state();
     if (cs.responding) {
       reported = cs;
-      last_responding_t = t;
+      // The chassis firmware's odometry, as its feedback reaches the host (a stalled host reads none): the core
+      // places each scan and tag frame by it, as in dockd.
+      if (!host_stalled) core->on_odometry(reported.odom_pose, measured_twist(geom, reported), now_us);
     }
 
     // 2. Lidar: capture at the model's rate from the true lidar pose, deliver after the scan latency.
@@ -454,7 +467,6 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
         for (const auto& o : active_obs) w.add_circle(o.c, o.r);
         simulate_scan(w, ps->lidar_world, sc.lidar, lidar_rng, &ps->scan, now_us);
         ps->stamp_us = now_us;
-        ps->odom = reported.odom_pose;
         pending.push_back(std::move(ps));
       }
     }
@@ -462,7 +474,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     // order, when it runs again.
     while (!host_stalled && !pending.empty() &&
            static_cast<double>(now_us - pending.front()->stamp_us) * 1e-6 + 1e-9 >= sc.scan_latency_s) {
-      core->on_scan(pending.front()->scan.view(), pending.front()->stamp_us, pending.front()->odom);
+      core->on_scan(pending.front()->scan.view(), pending.front()->stamp_us, now_us);
       last_scan = std::move(pending.front());
       pending.erase(pending.begin());
     }
@@ -473,17 +485,16 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       if (rendered && !active_obs.empty() && camera.frame_due(now_us)) {
         World frame_occluders = occluders;
         for (const auto& o : active_obs) frame_occluders.add_circle(o.c, o.r);
-        camera.update(now_us, cs.true_pose, target_world, !occluded, reported.odom_pose, &frame_occluders);
+        camera.update(now_us, cs.true_pose, target_world, !occluded, &frame_occluders);
       } else {
-        camera.update(now_us, cs.true_pose, target_world, !occluded, reported.odom_pose, &occluders);
+        camera.update(now_us, cs.true_pose, target_world, !occluded, &occluders);
       }
     }
-    // The tag poses delivered, in frame order, through the odometry pose at each frame's capture (as dockd does).
+    // The tag poses delivered, in frame order; the core places each at the odometry pose of its frame's capture.
     dockcore::TagObservation tag_obs;
-    Pose2 tag_odom;
-    while (!host_stalled && camera.pop_tag(tag_obs, tag_odom)) {
+    while (!host_stalled && camera.pop_tag(tag_obs)) {
       if (!rendered || !sc.camera.fuse_tags) continue;
-      if (core->on_tag(tag_obs, tag_odom) == dockcore::TagStatus::kFused) {
+      if (core->on_tag(tag_obs) == dockcore::TagStatus::kFused) {
         ++out.tags_fused;
       } else {
         ++out.tags_refused;
@@ -505,15 +516,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
         send_dock = false;
         add(t, TimelineKind::kHost, 1, "host: dock");
       }
-      in.odom_pose = reported.odom_pose;
-      dockcore::WheelSpeeds m;
-      m.count = cs.wheel_count;
-      for (std::size_t i = 0; i < m.count; ++i) m.radps[i] = static_cast<Real>(reported.wheel_measured_radps[i]);
-      in.odom_twist = dockcore::wheels_to_twist(geom, m);
       if (sc.camera.enabled) in.camera = camera.latest();
       in.contact = reported.contact;
       in.charge_current_a = static_cast<Real>(reported.charge_current_a);
-      in.chassis_ok = t - last_responding_t <= sc.host.chassis_stale_s;
       const dockcore::TickOutput o = core->tick(in);
 
       const dockcore::WheelSpeeds& w = o.wheels;

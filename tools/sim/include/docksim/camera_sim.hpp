@@ -65,19 +65,19 @@ class CameraSim {
   CameraSim(const CameraSimParams& p, std::uint64_t seed, FrameCamera* frame_camera = nullptr)
       : p_(p), rng_(seed), frame_camera_(frame_camera) {}
 
-  /// Advances to time t_us: captures a frame when one is due (from `robot_world`, with the host's odometry pose
-  /// `odom_pose` at that moment; `visible` false = the target is hidden; `occluders` as FrameCamera::capture, used
-  /// by rendered frames only) and delivers every frame whose latency has passed. Call at least once per frame
-  /// period. O(1) amortised (plus a render and a detection per rendered frame).
+  /// Advances to time t_us: captures a frame when one is due (from `robot_world`; `visible` false = the target is
+  /// hidden; `occluders` as FrameCamera::capture, used by rendered frames only) and delivers every frame whose latency
+  /// has passed. Call at least once per frame period. O(1) amortised (plus a render and a detection per rendered
+  /// frame).
   void update(std::uint64_t t_us, const dockcore::Pose2& robot_world, const dockcore::Vec2& target_world, bool visible,
-              const dockcore::Pose2& odom_pose = dockcore::Pose2{}, const World* occluders = nullptr);
+              const World* occluders = nullptr);
   /// True when update(t_us, ...) will capture a frame (so a caller builds a frame's inputs only then). O(1).
   bool frame_due(std::uint64_t t_us) const { return t_us >= next_capture_us_; }
   /// The most recently delivered frame (invalid until the first one; an empty frame is delivered as invalid with
   /// its stamp).
   const dockcore::CameraTarget& latest() const { return latest_; }
-  /// The oldest delivered tag pose not yet taken, with the odometry pose at its frame's capture. False when none.
-  bool pop_tag(dockcore::TagObservation& tag, dockcore::Pose2& odom_at_stamp);
+  /// The oldest delivered tag pose not yet taken (stamped with its frame's capture). False when none.
+  bool pop_tag(dockcore::TagObservation& tag);
   /// Frames delivered so far, and those that carried a valid target.
   std::uint64_t frames_delivered() const { return frames_delivered_; }
   std::uint64_t frames_with_target() const { return frames_with_target_; }
@@ -86,14 +86,13 @@ class CameraSim {
  private:
   struct InFlight {
     CameraFrameOutput frame;
-    dockcore::Pose2 odom;
   };
   CameraSimParams p_;
   Rng rng_;
   FrameCamera* frame_camera_ = nullptr;
   std::uint64_t next_capture_us_ = 0;
   std::deque<InFlight> in_flight_;
-  std::deque<std::pair<dockcore::TagObservation, dockcore::Pose2>> tags_;
+  std::deque<dockcore::TagObservation> tags_;
   dockcore::CameraTarget latest_{};
   std::uint64_t frames_delivered_ = 0;
   std::uint64_t frames_with_target_ = 0;

@@ -19,6 +19,7 @@
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_profile.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
+#include "dockcore/task/input_watch.hpp"
 #include "dockcore/task/task_manager.hpp"
 #include "docksim/chassis.hpp"
 #include "docksim/lidar_sim.hpp"
@@ -156,7 +157,6 @@ constexpr double kFurnitureWallClearanceM = 0.01;
 
 /// Host behaviour around the task manager.
 struct HostSpec {
-  double chassis_stale_s = 0.1;  ///< No chassis feedback for this long: chassis_ok = false.
   int redock_after_fault = 0;    ///< Re-send the dock command this many times after a fault (a host retrying).
   double redock_delay_s = 1.0;   ///< Wait this long in FAULT before re-sending (cancel, then dock).
 };
@@ -177,6 +177,7 @@ struct Scenario {
   CameraSpec camera{};
   DockTagSpec dock_tag{};
   dockcore::TagFusionParams tag_fusion{};  ///< [camera.fusion]: the tag covariance model (the parameter table).
+  dockcore::WatchdogParams watchdog{};     ///< [watchdog]: the core's input watch (the parameter table).
 
   // Lidar.
   LidarModel lidar{};

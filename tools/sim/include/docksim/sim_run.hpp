@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "dockcore/control/kinematics.hpp"
+#include "dockcore/dockcore.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/task/task_manager.hpp"
 #include "docksim/camera_sim.hpp"
@@ -41,6 +42,13 @@ std::uint64_t trial_seed(std::uint64_t base, std::uint64_t index);
 
 /// dockcore's drive geometry (kinematics.hpp) for the simulated chassis' geometry. O(1).
 dockcore::DriveGeometry core_drive_geometry(const DriveGeometry& g);
+/// The core's configuration for a scenario: estimator, task, footprint, lidar mount, drive geometry and limits,
+/// watchdog, and the control period (the simulator ticks every 4 chassis steps). The camera's tag fusion is the
+/// caller's (tag_fusion_params). O(1).
+dockcore::DockcoreConfig core_config(const Scenario& sc);
+/// The body twist of the chassis's reported (measured) wheel speeds under dockcore's drive geometry `g`: what a host
+/// hands the core with the chassis's odometry pose (DockcoreBase::on_odometry). O(1).
+dockcore::Twist2 measured_twist(const dockcore::DriveGeometry& g, const ChassisState& reported);
 /// The camera simulator's parameters for a scenario's camera (rate, latency, noise, dropouts, depth range). O(1).
 CameraSimParams camera_sim_params(const Scenario& sc);
 /// The tag fusion's parameters for a scenario's camera and dock tag: [camera.fusion], the camera's mount (level, at

@@ -16,6 +16,7 @@
 #include "dockcore/control/safety.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
+#include "dockcore/task/input_watch.hpp"
 #include "dockcore/task/task_manager.hpp"
 
 namespace dockcore::params {
@@ -48,6 +49,7 @@ struct ParamTargets {
   Seed003Params* seed003 = nullptr;
   SmoothParams* smooth = nullptr;
   TagFusionParams* tag_fusion = nullptr;  ///< dockd only: [camera.fusion].
+  WatchdogParams* watchdog = nullptr;
 };
 
 /// One parameter.
