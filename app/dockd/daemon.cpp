@@ -22,8 +22,6 @@ using dockcore::drivers::HostRequestKind;
 namespace {
 
 constexpr std::uint64_t kNominalTickUs = 20000;
-constexpr std::uint64_t kResumeHoldUs = 500000;  // data fresh this long before an interrupted command is re-issued
-constexpr std::uint8_t kMaxResumes = 3;          // per task: a flapping link ends in the fault, not in a loop
 
 double deg(Real rad) {
   return static_cast<double>(rad) * 180.0 / 3.14159265358979323846;
@@ -159,7 +157,7 @@ ReloadResult Daemon::request_reload(const DockdConfig& next, std::uint64_t now_u
 bool Daemon::reload_can_apply() const {
   // Rebuilding the core resets the task manager: only while nothing runs, no fault is latched (the host must see
   // it) and no watchdog resume waits — so no motion, charge or fault report changes under a reload.
-  return state() == TaskState::kNotTasking && !teach_.active && interrupted_ == HostCommandType::kNone;
+  return state() == TaskState::kNotTasking && !teach_.active && !core_->resume_pending();
 }
 
 bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
@@ -360,14 +358,32 @@ void Daemon::poll_camera(std::uint64_t) {
   }
 }
 
-bool Daemon::enqueue(const PendingCommand& c) {
-  if (queue_size_ >= kQueue) {
-    ++counters_.queue_overflows;
-    return false;
-  }
-  queue_[(queue_head_ + queue_size_) % kQueue] = c;
-  ++queue_size_;
-  return true;
+std::uint32_t Daemon::hold_reply(const HostRequest& r) {
+  if (++next_token_ == 0) next_token_ = 1;  // 0: no reply (CAN, resumes)
+  UdpReply& slot = replies_[next_token_ % kReplySlots];
+  slot.token = next_token_;
+  slot.request = r;
+  return next_token_;
+}
+
+const Daemon::UdpReply* Daemon::take_reply(std::uint32_t token) {
+  if (token == 0) return nullptr;
+  UdpReply& slot = replies_[token % kReplySlots];
+  if (slot.token != token) return nullptr;
+  slot.token = 0;
+  return &slot;
+}
+
+dockcore::SubmitResult Daemon::submit(dockcore::HostCommandType type, std::uint16_t dock_id, std::uint32_t token) {
+  dockcore::QueuedCommand c;
+  c.command = dockcore::HostCommand{type, dock_id};
+  c.token = token;
+  dockcore::QueuedCommand replaced;
+  const dockcore::SubmitResult res = core_->submit(c, &replaced);
+  if (res != dockcore::SubmitResult::kQueued) ++counters_.queue_overflows;
+  if (res == dockcore::SubmitResult::kReplacedNewest) take_reply(replaced.token);  // that request goes unanswered
+  if (res == dockcore::SubmitResult::kFull) take_reply(token);
+  return res;
 }
 
 void Daemon::reply_json(const HostRequest& r, const char* json, std::size_t len) {
@@ -418,29 +434,21 @@ void Daemon::handle_udp_request(const HostRequest& r, std::uint64_t now_us) {
         reply_error(r, HostErrorCode::kUnknownDockId, msg);
         return;
       }
-      PendingCommand c;
-      c.type = r.kind == HostRequestKind::kDock ? HostCommandType::kDock : HostCommandType::kTestMode;
-      c.dock_id = id;
-      c.from_udp = true;
-      c.request = r;
-      if (!enqueue(c)) reply_error(r, HostErrorCode::kBusy, "command queue full (8 pending): retry later");
+      const HostCommandType type =
+          r.kind == HostRequestKind::kDock ? HostCommandType::kDock : HostCommandType::kTestMode;
+      if (submit(type, id, hold_reply(r)) != dockcore::SubmitResult::kQueued) {
+        reply_error(r, HostErrorCode::kBusy, "command queue full (8 pending): retry later");
+      }
       return;
     }
     case HostRequestKind::kUndock:
     case HostRequestKind::kStop: {
-      PendingCommand c;
-      c.type = r.kind == HostRequestKind::kUndock ? HostCommandType::kUndock : HostCommandType::kCancel;
-      c.dock_id = active_dock_;
-      c.from_udp = true;
-      c.request = r;
+      const HostCommandType type =
+          r.kind == HostRequestKind::kUndock ? HostCommandType::kUndock : HostCommandType::kCancel;
       if (r.kind == HostRequestKind::kStop && teach_.active) finish_teach(false, "cancelled by stop", now_us);
-      if (!enqueue(c)) {
-        if (r.kind == HostRequestKind::kStop) {
-          // A stop must never be lost: it replaces the newest queued command.
-          queue_[(queue_head_ + queue_size_ - 1) % kQueue] = c;
-        } else {
-          reply_error(r, HostErrorCode::kBusy, "command queue full (8 pending): retry later");
-        }
+      // A stop is never lost: when the queue is full it replaces the newest queued command.
+      if (submit(type, active_dock_, hold_reply(r)) == dockcore::SubmitResult::kFull) {
+        reply_error(r, HostErrorCode::kBusy, "command queue full (8 pending): retry later");
       }
       return;
     }
@@ -459,14 +467,9 @@ void Daemon::poll_hosts(std::uint64_t now_us) {
   if (io_.can_host != nullptr) {
     dockcore::hal::HostCommandMessage m;
     for (int i = 0; i < 16 && io_.can_host->poll_command(m); ++i) {
-      PendingCommand c;
-      c.type = static_cast<HostCommandType>(m.command);
-      c.dock_id = m.dock_id;
-      if (c.type == HostCommandType::kCancel && teach_.active) finish_teach(false, "cancelled by stop", now_us);
-      if (!enqueue(c)) {
-        ++counters_.commands_rejected;
-        if (c.type == HostCommandType::kCancel) queue_[(queue_head_ + queue_size_ - 1) % kQueue] = c;
-      }
+      const HostCommandType type = static_cast<HostCommandType>(m.command);
+      if (type == HostCommandType::kCancel && teach_.active) finish_teach(false, "cancelled by stop", now_us);
+      if (submit(type, m.dock_id, 0) != dockcore::SubmitResult::kQueued) ++counters_.commands_rejected;
       EventLine e(now_us, "command");
       e.w.str("source", "can").uint("command", m.command).uint("dock_id", m.dock_id).uint("seq", m.sequence);
       log_event(e);
@@ -698,111 +701,69 @@ void Daemon::on_tick(std::uint64_t now_us) {
   in.camera = camera_;
   in.contact = fb_.charging_contact;
   in.charge_current_a = fb_.battery_current_a;
-  // Stale input: the core holds the wheels at once and tells the task manager only when the data stays away for
-  // fault_after_ms, so a short gap (a late scan on a loaded board) continues the same approach.
-
-  // Watchdog resume: a command interrupted by a watchdog fault is re-issued once the data has been fresh for
-  // kResumeHoldUs, at most kMaxResumes times per task (docs/dockd.md, "Watchdogs").
+  // The core takes the oldest queued command, else its resume policy's (docs/dockd.md, "Watchdogs"); none while a
+  // teach runs. A dock/test for another dock (or after a teach changed the correction) needs the core configured for
+  // it; that resets the task manager, so only while it is idle (otherwise the task manager answers "busy").
   const TaskState before = state();
-  PendingCommand cmd;
-  bool have_cmd = false;
-  if (!teach_.active && queue_size_ > 0) {
-    cmd = queue_[queue_head_];
-    queue_head_ = (queue_head_ + 1) % kQueue;
-    --queue_size_;
-    have_cmd = true;
-  } else if (!teach_.active && interrupted_ != HostCommandType::kNone && before == TaskState::kFault &&
-             !lidar_stale() && !chassis_stale() && now_us - core_->inputs().fresh_since_us() >= kResumeHoldUs) {
-    if (resumes_this_task_ < kMaxResumes) {
-      ++resumes_this_task_;
-      ++counters_.resumes;
-      cmd.type = interrupted_;
-      cmd.dock_id = interrupted_dock_;
-      cmd.resume = true;
-      have_cmd = true;
-      EventLine e(now_us, "resume");
-      e.w.uint("command", static_cast<unsigned>(cmd.type)).uint("dock_id", cmd.dock_id).uint("resume", resumes_this_task_);
-      log_event(e);
-    } else {
-      EventLine e(now_us, "resume_given_up");
-      e.w.str("reason", "max resumes reached");
-      log_event(e, LogLevel::kWarn);
-    }
-    interrupted_ = HostCommandType::kNone;
-  }
-  if (have_cmd) {
-    // A dock/test for another dock (or after a teach changed the correction) needs the core configured for it;
-    // that resets the task manager, so only while it is idle (otherwise the task manager answers "busy").
-    if ((cmd.type == HostCommandType::kDock || cmd.type == HostCommandType::kTestMode) && idle_state(before) &&
-        (cmd.dock_id != active_dock_ || active_raw_)) {
-      configure_core(cmd.dock_id, false);
-    }
-    // Dock (and undock on the contacts) are accepted from FAULT directly: the task manager clears the fault.
-    in.command = dockcore::HostCommand{cmd.type, cmd.dock_id};
-    in.resume = cmd.resume;  // the core keeps the pre-outage dock for the push test (docs/faults.md, 178)
-    ++counters_.commands;
+  in.hold_commands = teach_.active;
+  const dockcore::QueuedCommand* next = teach_.active ? nullptr : core_->next_command();
+  if (next != nullptr &&
+      (next->command.type == HostCommandType::kDock || next->command.type == HostCommandType::kTestMode) &&
+      idle_state(before) && (next->command.dock_id != active_dock_ || active_raw_)) {
+    configure_core(next->command.dock_id, false);
   }
 
   const dockcore::TickOutput out = core_->tick(in);
-  const TaskState after = out.status.state;
-
-  if (have_cmd) {
+  if (out.resume == dockcore::ResumeEvent::kResumed) {
+    ++counters_.resumes;
+    EventLine e(now_us, "resume");
+    e.w.uint("command", static_cast<unsigned>(out.command.command.type))
+        .uint("dock_id", out.command.command.dock_id)
+        .uint("resume", out.resumes);
+    log_event(e);
+  } else if (out.resume == dockcore::ResumeEvent::kGivenUp) {
+    EventLine e(now_us, "resume_given_up");
+    e.w.str("reason", "max resumes reached");
+    log_event(e, LogLevel::kWarn);
+  }
+  if (out.command_taken) {
+    ++counters_.commands;
+    const HostCommandType type = out.command.command.type;
+    const std::uint16_t dock_id = out.command.command.dock_id;
     const bool accepted = out.command_result == dockcore::CommandResult::kAccepted ||
                           out.command_result == dockcore::CommandResult::kAlreadyDocked;
-    if (accepted && !cmd.resume) resumes_this_task_ = 0;
-    if (accepted && (cmd.type == HostCommandType::kDock || cmd.type == HostCommandType::kUndock)) {
-      running_cmd_ = cmd.type;
-      running_dock_ = cmd.dock_id;
-    }
-    if (cmd.type == HostCommandType::kCancel) {
-      running_cmd_ = HostCommandType::kNone;
-      interrupted_ = HostCommandType::kNone;
-    }
+    const UdpReply* udp = take_reply(out.command.token);
+    const TaskState after = out.status.state;
     if (!accepted) ++counters_.commands_rejected;
-    if (cmd.from_udp) {
+    if (udp != nullptr) {
       if (accepted) {
         char buf[256];
         dockcore::drivers::JsonWriter reply(buf, sizeof buf);
         reply.boolean("ok", true)
-            .str("cmd", to_string(cmd.request.kind))
-            .uint("seq", cmd.request.seq)
+            .str("cmd", to_string(udp->request.kind))
+            .uint("seq", udp->request.seq)
             .str("result", dockcore::to_string(out.command_result))
-            .uint("dock_id", cmd.dock_id)
+            .uint("dock_id", dock_id)
             .str("state", dockcore::to_string(after));
-        reply_json(cmd.request, buf, reply.finish());
+        reply_json(udp->request, buf, reply.finish());
       } else {
         char msg[128];
         std::snprintf(msg, sizeof msg, "task manager: %s (state %s)", dockcore::to_string(out.command_result),
                       dockcore::to_string(before));
-        reply_error(cmd.request, HostErrorCode::kRejected, msg);
+        reply_error(udp->request, HostErrorCode::kRejected, msg);
       }
     }
     if (accepted || refusal_log_.admit(now_us)) {
       EventLine e(now_us, "command_result");
-      e.w.str("source", cmd.resume ? "resume" : (cmd.from_udp ? "udp" : "can"))
-          .uint("command", static_cast<unsigned>(cmd.type))
-          .uint("dock_id", cmd.dock_id)
+      e.w.str("source", out.command.resume ? "resume" : (udp != nullptr ? "udp" : "can"))
+          .uint("command", static_cast<unsigned>(type))
+          .uint("dock_id", dock_id)
           .str("result", dockcore::to_string(out.command_result));
       log_event(e, accepted ? LogLevel::kInfo : LogLevel::kWarn);
     }
   }
 
-  // A watchdog fault interrupting a running dock/undock remembers it for the resume.
-  if (after == TaskState::kFault && before != TaskState::kFault) {
-    const FaultCode f = out.status.fault;
-    // Only faults caused by dockd's own watchdogs resume (not, e.g., the core's backstop scan-age check).
-    if ((f == FaultCode::kChassisStale || f == FaultCode::kLidarStale) && core_->inputs().hold() &&
-        running_cmd_ != HostCommandType::kNone) {
-      interrupted_ = running_cmd_;
-      interrupted_dock_ = running_dock_;
-    } else {
-      interrupted_ = HostCommandType::kNone;
-    }
-  }
-  if (after == TaskState::kNotTasking || after == TaskState::kFinishTasking) running_cmd_ = HostCommandType::kNone;
-
-  // Motion: Dockcore's shaped wheel speeds; zero while a watchdog holds (the task manager faults on the same tick
-  // anyway once the gap lasts).
+  // Motion: Dockcore's shaped wheel speeds (zero while stale input holds the robot).
   dockcore::hal::WheelCommand wc;
   wc.count = static_cast<std::uint8_t>(out.wheels.count);
   for (std::size_t i = 0; i < out.wheels.count && i < 4; ++i) wc.radps[i] = out.wheels.radps[i];

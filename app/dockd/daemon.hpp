@@ -215,13 +215,13 @@ class Daemon {
   std::uint32_t commands_rejected_total() const;
 
  private:
-  struct PendingCommand {
-    dockcore::HostCommandType type = dockcore::HostCommandType::kNone;
-    std::uint16_t dock_id = 0;
-    bool from_udp = false;
+  /// A UDP request whose command waits in the core's queue: answered when the core takes the command.
+  struct UdpReply {
+    std::uint32_t token = 0;  ///< 0: free.
     dockcore::drivers::HostRequest request{};
-    bool resume = false;  ///< Re-issued by the watchdog resume, not by a host.
   };
+  /// More than the core's queue holds, so a queued request's slot is never reused before it is answered.
+  static constexpr std::size_t kReplySlots = 2 * dockcore::CommandQueue::kCapacity;
   struct Teach {
     bool active = false;
     std::uint16_t dock_id = 0;
@@ -240,7 +240,13 @@ class Daemon {
   void handle_udp_request(const dockcore::drivers::HostRequest& r, std::uint64_t now_us);
   /// Logs how many refusal events refusal_log_ held back, once their window has ended.
   void report_held_events(std::uint64_t now_us);
-  bool enqueue(const PendingCommand& c);
+  /// Keeps `r` for its answer; returns its token. O(1).
+  std::uint32_t hold_reply(const dockcore::drivers::HostRequest& r);
+  /// The request held under `token` (nullptr for 0 or one no longer held), released. O(1).
+  const UdpReply* take_reply(std::uint32_t token);
+  /// Queues a command in the core (counted as an overflow unless queued; a refused or displaced request's reply slot
+  /// is released). O(1).
+  dockcore::SubmitResult submit(dockcore::HostCommandType type, std::uint16_t dock_id, std::uint32_t token);
   void reply_error(const dockcore::drivers::HostRequest& r, dockcore::drivers::HostErrorCode code, const char* msg);
   void reply_json(const dockcore::drivers::HostRequest& r, const char* json, std::size_t len);
   /// Configures Dockcore for `dock_id` (profile corrected by its taught / configured target). Resets the task
@@ -282,21 +288,15 @@ class Daemon {
   // Camera.
   dockcore::CameraTarget camera_{};
 
-  // Commands.
-  static constexpr std::size_t kQueue = 8;
-  PendingCommand queue_[kQueue];
-  std::size_t queue_head_ = 0, queue_size_ = 0;
+  // UDP requests waiting for their command's result.
+  UdpReply replies_[kReplySlots];
+  std::uint32_t next_token_ = 0;
 
   // Watchdogs and resume.
   bool camera_stalled_ = false, prev_camera_stalled_ = false;
   std::uint64_t camera_watch_from_us_ = 0;  ///< First watchdog tick: a camera that never delivers stalls from here.
   bool started_ = false;
   std::uint64_t start_us_ = 0;
-  dockcore::HostCommandType interrupted_ = dockcore::HostCommandType::kNone;
-  std::uint16_t interrupted_dock_ = 0;
-  std::uint8_t resumes_this_task_ = 0;
-  dockcore::HostCommandType running_cmd_ = dockcore::HostCommandType::kNone;
-  std::uint16_t running_dock_ = 0;
 
   // Output.
   dockcore::TickOutput last_out_{};

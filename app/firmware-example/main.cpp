@@ -223,7 +223,11 @@ int main() {
 
     TickInput in;
     in.now_us = now_us;
-    if (k == 1) in.command = HostCommand{HostCommandType::kDock, 0};
+    if (k == 1) {
+      QueuedCommand dock;
+      dock.command = HostCommand{HostCommandType::kDock, 0};
+      g_core.submit(dock);
+    }
     in.contact = contact;
     in.charge_current_a = contact && now_us - contact_since_us >= 500000 ? static_cast<Real>(5) : 0;
 #if DOCKCORE_FW_SEMIHOSTING

@@ -26,6 +26,7 @@ void DockcoreBase::take_inputs(const DockcoreBase& from) {
   odometry_ = from.odometry_;
   watch_ = from.watch_;
   watch_.configure(config_.watchdog);
+  queue_ = from.queue_;
   have_scan_ = from.have_scan_;
   last_scan_us_ = from.last_scan_us_;
   const std::size_t n = from.scan_.count < scan_capacity_ ? from.scan_.count : scan_capacity_;
@@ -163,15 +164,40 @@ TagStatus DockcoreBase::on_tag(const TagObservation& obs) {
 }
 
 TickOutput DockcoreBase::tick(const TickInput& in) {
+  check_inputs(in.now_us);
+  const TaskState before = tasks_.state();
+  TickOutput out;
+  // The command of this tick: the oldest queued, else the resume policy's.
+  QueuedCommand cmd;
+  bool have_cmd = false;
+  if (!in.hold_commands && queue_.front() != nullptr) {
+    cmd = *queue_.front();
+    queue_.pop();
+    have_cmd = true;
+  } else if (!in.hold_commands && interrupted_.type != HostCommandType::kNone && before == TaskState::kFault &&
+             !watch_.hold() &&
+             in.now_us - watch_.fresh_since_us() >=
+                 static_cast<std::uint64_t>(config_.watchdog.resume_after_ms) * 1000u) {
+    if (resumes_ < config_.watchdog.max_resumes) {
+      ++resumes_;
+      cmd.command = interrupted_;
+      cmd.resume = true;
+      have_cmd = true;
+      out.resume = ResumeEvent::kResumed;
+    } else {
+      out.resume = ResumeEvent::kGivenUp;
+    }
+    interrupted_ = HostCommand{};
+  }
+
   TaskInput t;
   t.now_us = in.now_us;
-  t.command = in.command;
+  if (have_cmd) t.command = cmd.command;
   t.odom_pose = odometry_.pose();
   t.odom_twist = odometry_.twist();
   t.camera = in.camera;
   t.contact = in.contact;
   t.charge_current_a = in.charge_current_a;
-  check_inputs(in.now_us);
   t.chassis_ok = watch_.chassis_ok(in.now_us);
   t.lidar_ok = watch_.lidar_ok(in.now_us);
   t.scan = have_scan_ ? &scan_ : nullptr;
@@ -186,15 +212,13 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
   t.detection_count = pending_count_;
   pending_count_ = 0;
 
-  const TaskState before = tasks_.state();
-  TickOutput out;
   static_cast<TaskOutput&>(out) = tasks_.tick(t);
   shape(watch_.hold(), &out);
   // A new dock task: forget the old dock (the robot may have been carried since), so the push test and the
   // controller start from this task's own detections. A resumed one keeps the pre-outage estimate for the push test.
   if (out.status.state == TaskState::kGetTaskingCmd && prev_state_ != TaskState::kGetTaskingCmd) {
     push_ref_set_ = false;
-    if (in.resume && in.command.type == HostCommandType::kDock) {
+    if (have_cmd && cmd.resume && cmd.command.type == HostCommandType::kDock) {
       // The filter may have restarted at a pushed pose while the task stood in the fault: its estimate from before
       // that restart is the pre-outage one.
       const bool own = filter_.initialised() && filter_confirmed_ && !restart_ref_set_;
@@ -222,7 +246,33 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
   }
   if (out.status.state == TaskState::kFault) push_ref_set_ = false;
   prev_state_ = out.status.state;
+  resume_policy(before, have_cmd, cmd, &out);
   return out;
+}
+
+void DockcoreBase::resume_policy(TaskState before, bool have_cmd, const QueuedCommand& cmd, TickOutput* out) {
+  const TaskState after = out->status.state;
+  if (have_cmd) {
+    out->command_taken = true;
+    out->command = cmd;
+    const bool accepted =
+        out->command_result == CommandResult::kAccepted || out->command_result == CommandResult::kAlreadyDocked;
+    if (accepted && !cmd.resume) resumes_ = 0;  // a host's command is a new task
+    const HostCommandType type = cmd.command.type;
+    if (accepted && (type == HostCommandType::kDock || type == HostCommandType::kUndock)) running_ = cmd.command;
+    if (type == HostCommandType::kCancel) {  // a stop forgets the interrupted command too
+      running_ = HostCommand{};
+      interrupted_ = HostCommand{};
+    }
+  }
+  // A fault caused by stale input while a dock or undock ran remembers it for the resume; any other fault, none.
+  if (after == TaskState::kFault && before != TaskState::kFault) {
+    const FaultCode f = out->status.fault;
+    const bool stale_input = (f == FaultCode::kChassisStale || f == FaultCode::kLidarStale) && watch_.hold();
+    interrupted_ = stale_input ? running_ : HostCommand{};
+  }
+  if (after == TaskState::kNotTasking || after == TaskState::kFinishTasking) running_ = HostCommand{};
+  out->resumes = resumes_;
 }
 
 void DockcoreBase::shape(bool hold, TickOutput* out) {

@@ -80,7 +80,11 @@ static int facade_run() {
     }
     TickInput in;
     in.now_us = now_us;
-    if (k == 0) in.command = HostCommand{HostCommandType::kDock, 0};
+    if (k == 0) {
+      QueuedCommand dock;
+      dock.command = HostCommand{HostCommandType::kDock, 0};
+      g_core.submit(dock);
+    }
     in.contact = contact;
     in.charge_current_a = contact && charge_enable && now_us - contact_since_us >= 500000 ? static_cast<Real>(2) : 0;
     const std::size_t b1 = g_allocs;

@@ -888,7 +888,12 @@ struct FacadeSim {
   /// The chassis's odometry at the current time, as a host hands it over (ideal: odometry = w.odom).
   void feed_odom() { core->on_odometry(w.odom, Twist2{}, w.now_us); }
   bool odom_on = true;  // false: the chassis is silent (no feedback); the robot still moves by the last command
-  TickOutput step(HostCommand cmd = HostCommand{}, bool resume = false) {
+  TickOutput step(HostCommand cmd = HostCommand{}) {
+    if (cmd.type != HostCommandType::kNone) {
+      QueuedCommand q;
+      q.command = cmd;
+      core->submit(q);
+    }
     if (odom_on) feed_odom();
     if (scans_on && w.ticks % 5 == 0) {
       simulate_scan(w.world_model(), w.world, w.model, w.rng, &w.scan, w.now_us);
@@ -904,8 +909,6 @@ struct FacadeSim {
     }
     TickInput in;
     in.now_us = w.now_us;
-    in.command = cmd;
-    in.resume = resume;
     in.contact = w.contact;
     const bool current = w.contact && w.charge_enable && w.now_us - w.contact_since_us >= 500000;
     in.charge_current_a = current ? 2.0 : 0.0;
@@ -1003,7 +1006,9 @@ TEST(Dockcore, NoScansMeansLidarStaleWhenMoving) {
   TickInput in;
   in.now_us = 1000000;
   f.core->on_odometry(Pose2{}, Twist2{}, in.now_us);  // the chassis answers; the lidar never did
-  in.command = HostCommand{HostCommandType::kDock, 0};
+  QueuedCommand dock;
+  dock.command = HostCommand{HostCommandType::kDock, 0};
+  f.core->submit(dock);
   const TickOutput o = f.core->tick(in);
   CHECK(o.status.state == TaskState::kFault);
   LONGS_EQUAL(185, static_cast<int>(o.status.fault));
@@ -1126,17 +1131,23 @@ TEST(Dockcore, PushDuringALidarGapIsStillReported) {
         }
         f.scans_on = true;
         if (fault != FaultCode::kNone) {
-          // The input watch faulted 185 in the gap (lidar_stale_ms + fault_after_ms), the robot stands. A host's
-          // watchdog resume re-issues the dock command once scans are fresh again (dockd: after 0.5 s); the resumed
-          // task must still report the push, not dock on from the pushed pose.
+          // The input watch faulted 185 in the gap (lidar_stale_ms + fault_after_ms), the robot stands. The resume
+          // policy re-issues the dock command once scans have been fresh for resume_after_ms; the resumed task must
+          // still report the push, not dock on from the pushed pose.
           LONGS_EQUAL_TEXT(185, static_cast<int>(fault), what);
           CHECK_TEXT(ticking != 0 && gap_s > 1.2, what);
+          CHECK_TEXT(f.core->resume_pending(), what);
           const Pose2 at = f.w.world;
-          for (int i = 0; i < 25; ++i) f.step();
-          CHECK_TEXT(f.core->task_manager().state() == TaskState::kFault, what);
+          TickOutput resumed;
+          for (int i = 0; i < 100 && resumed.resume == ResumeEvent::kNone; ++i) resumed = f.step();
+          CHECK_TEXT(resumed.resume == ResumeEvent::kResumed && resumed.command_taken && resumed.command.resume, what);
+          CHECK_TEXT(resumed.command_result == CommandResult::kAccepted, what);
+          // Resumed on the first tick at which both inputs had been fresh for resume_after_ms.
+          const std::uint64_t fresh_for_us = f.w.now_us - Sim::kTickUs - f.core->inputs().fresh_since_us();
+          const std::uint64_t resume_after_us = f.core->config().watchdog.resume_after_ms * 1000u;
+          CHECK_TEXT(fresh_for_us >= resume_after_us && fresh_for_us < resume_after_us + Sim::kTickUs, what);
           const Pose2 moved = at.inverse().compose(f.w.world);
-          CHECK_TEXT(std::fabs(moved.x_m) < 1e-4 && std::fabs(moved.y_m) < 1e-4, what);  // float rounding only
-          f.step(HostCommand{HostCommandType::kDock, 0}, true);
+          CHECK_TEXT(std::fabs(moved.x_m) < 1e-4 && std::fabs(moved.y_m) < 1e-4, what);  // stood still until then
           TickOutput o;
           for (int i = 0; i < 500; ++i) {
             o = f.step();
@@ -1238,6 +1249,79 @@ TEST(Dockcore, StaleChassisHoldsTheDriveThenFaultsAndTheRampRestartsFromRest) {
   CHECK(last.status.state == TaskState::kFault);
   LONGS_EQUAL(184, static_cast<int>(last.status.fault));
   CHECK_EQUAL(2u, f.core->inputs().chassis_trips());
+}
+
+TEST(Dockcore, AChassisOutageFaultIsResumedAtMostMaxResumesTimes) {
+  FacadeSim f;
+  const WatchdogParams wd = f.core->config().watchdog;
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  CHECK(f.run_until(TaskState::kAlign, 5));
+  // Silent chassis: held, then fault 184 after fault_after_ms; the dock command waits for fresh data.
+  auto outage = [&f, &wd]() {
+    f.odom_on = false;
+    TickOutput o;
+    for (int i = 0; i < 200 && o.status.state != TaskState::kFault; ++i) o = f.step();
+    LONGS_EQUAL(184, static_cast<int>(o.status.fault));
+    CHECK(f.core->resume_pending());
+    f.odom_on = true;
+    // Fresh again: the command is issued again after resume_after_ms, not before.
+    int ticks = 0;
+    for (; ticks < 200 && o.resume == ResumeEvent::kNone; ++ticks) o = f.step();
+    CHECK(ticks * 20 >= static_cast<int>(wd.resume_after_ms));
+    return o;
+  };
+  for (std::uint8_t n = 1; n <= wd.max_resumes; ++n) {
+    const TickOutput o = outage();
+    CHECK(o.resume == ResumeEvent::kResumed);
+    CHECK(o.command_taken && o.command.resume && o.command.command.type == HostCommandType::kDock);
+    CHECK(o.command_result == CommandResult::kAccepted);
+    LONGS_EQUAL(n, o.resumes);
+    CHECK(f.run_until(TaskState::kAlign, 5));
+  }
+  const TickOutput last = outage();
+  CHECK(last.resume == ResumeEvent::kGivenUp);
+  CHECK_FALSE(last.command_taken);
+  CHECK(last.status.state == TaskState::kFault);
+  CHECK_FALSE(f.core->resume_pending());
+  // A host's dock is a new task: its resumes count from zero.
+  TickOutput o = f.step(HostCommand{HostCommandType::kDock, 0});
+  CHECK(o.command_taken && !o.command.resume);
+  LONGS_EQUAL(0, o.resumes);
+}
+
+TEST(Dockcore, AStopWhileFaultedForgetsTheInterruptedCommand) {
+  FacadeSim f;
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  CHECK(f.run_until(TaskState::kAlign, 5));
+  f.odom_on = false;
+  TickOutput o;
+  for (int i = 0; i < 200 && o.status.state != TaskState::kFault; ++i) o = f.step();
+  CHECK(f.core->resume_pending());
+  f.step(HostCommand{HostCommandType::kCancel, 0});
+  CHECK_FALSE(f.core->resume_pending());
+  f.odom_on = true;
+  for (int i = 0; i < 100; ++i) CHECK(f.step().resume == ResumeEvent::kNone);
+}
+
+TEST(Dockcore, CommandsWaitWhileTheHostHoldsThem) {
+  FacadeSim f;
+  QueuedCommand dock;
+  dock.command = HostCommand{HostCommandType::kDock, 0};
+  dock.token = 7;
+  CHECK(f.core->submit(dock) == SubmitResult::kQueued);
+  CHECK(f.core->next_command() != nullptr && f.core->next_command()->token == 7);
+  f.feed_odom();
+  TickInput in;
+  in.now_us = f.w.now_us;
+  in.hold_commands = true;
+  TickOutput o = f.core->tick(in);
+  CHECK_FALSE(o.command_taken);
+  CHECK(o.status.state == TaskState::kNotTasking);
+  in.hold_commands = false;
+  o = f.core->tick(in);
+  CHECK(o.command_taken);
+  LONGS_EQUAL(7, static_cast<long>(o.command.token));
+  CHECK(f.core->next_command() == nullptr);
 }
 
 TEST(Dockcore, LateScansAreNotUsedAndALongLidarGapFaults) {

@@ -137,11 +137,16 @@ class SoakWorld {
   /// Places the robot (truth only; odometry does not see it) at rest-ish. O(1).
   void carry_to(const Pose2& world) { chassis_.set_true_pose(world); }
 
-  /// Advances to the end of the next control tick, giving `cmd` to that tick. Returns its output.
+  /// Advances to the end of the next control tick, queueing `cmd` for it. Returns its output.
   const dockcore::TickOutput& run_tick(dockcore::HostCommandType cmd = dockcore::HostCommandType::kNone) {
+    if (cmd != dockcore::HostCommandType::kNone) {
+      AllocScope scope;
+      dockcore::QueuedCommand q;
+      q.command = dockcore::HostCommand{cmd, 0};
+      core_->submit(q);
+    }
     for (;;) {
-      const bool ticked = step(cmd);
-      if (ticked) return last_;
+      if (step()) return last_;
     }
   }
 
@@ -165,7 +170,7 @@ class SoakWorld {
   };
 
   /// One 5 ms step; true when it held a control tick.
-  bool step(dockcore::HostCommandType cmd) {
+  bool step() {
     const double t = t_s();
     const std::uint64_t now_us = static_cast<std::uint64_t>(std::llround(t * 1e6));
     const docksim::ChassisState& cs = chassis_.state();
@@ -201,7 +206,6 @@ class SoakWorld {
     if (k_ % kStepsPerTick == 0) {
       dockcore::TickInput in;
       in.now_us = now_us;
-      in.command = dockcore::HostCommand{cmd, 0};
       if (sc_.camera.enabled) in.camera = camera_.latest();
       in.contact = cs.contact;
       in.charge_current_a = static_cast<Real>(cs.charge_current_a);

@@ -9,6 +9,10 @@
 /// - The InputWatch (dockcore/task/input_watch.hpp) judges every input's freshness with one set of thresholds
 ///   (DockcoreConfig::watchdog): a late scan is not used, stale input holds the drive at zero at once, and input that
 ///   stays stale faults the task (184/185). check_inputs() gives the host the verdict's changes before the tick.
+/// - submit(): host commands wait in a queue (CommandQueue, 8 deep); each tick hands the oldest to the task manager,
+///   else the resume policy's: a dock or undock that stale input faulted is issued again once both inputs have been
+///   fresh for WatchdogParams::resume_after_ms, at most max_resumes times per task. TickOutput says which command
+///   was taken and what became of it.
 /// - on_scan(): detection with the filter's prediction as the estimator's hint (tracking mode; global search when
 ///   the filter has no dock or the hint fails), then the filter update. The scan is copied so the tick can run the
 ///   obstacle check and give controllers (seed003) the latest ranges.
@@ -24,9 +28,9 @@
 ///   ticks (a host draining a backlog after a stall): the filter restarts at a pushed pose on its third jump, and a
 ///   test against the filter as it is at the tick would find nothing wrong.
 /// The filter is reset when a new dock task starts (the robot may have been carried since the last one). A resumed
-/// dock command (TickInput::resume: the host's watchdog re-issues a command a lidar/chassis outage interrupted) resets
-/// it too, but the push test keeps the confirmed estimate from before the outage as its reference — the filter's own,
-/// or the one it had before it restarted at a pushed pose during the outage — carried by odometry, up to
+/// dock command (the resume policy re-issues a command a lidar/chassis outage interrupted) resets it too, but the push
+/// test keeps the confirmed estimate from before the outage as its reference — the filter's own, or the one it had
+/// before it restarted at a pushed pose during the outage — carried by odometry, up to
 /// DockcoreConfig::push_check_max_gap_s old, until a detection in ALIGN agrees with it (docs/faults.md, 178).
 /// - on_tag(): a camera's tag detection (docs/camera.md, "Fusion"): the active dock's tag only, in stamp order, not
 ///   older than the newest scan by more than TagFusionParams::max_lag_s, turned into a dock pose
@@ -49,6 +53,7 @@
 #include "dockcore/perception/dock_pose_filter.hpp"
 #include "dockcore/perception/dock_profile.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
+#include "dockcore/task/command_queue.hpp"
 #include "dockcore/task/input_watch.hpp"
 #include "dockcore/task/task_manager.hpp"
 
@@ -66,7 +71,7 @@ struct DockcoreConfig {
   /// The control tick's nominal period, s: the acceleration limit's step. > 0.
   Real control_period_s = static_cast<Real>(0.02);
   WatchdogParams watchdog{};  ///< When scans and chassis feedback count as stale.
-  /// A resumed dock command (TickInput::resume) keeps the dock estimate from before the outage as the push test's
+  /// A resumed dock command (the resume policy's) keeps the dock estimate from before the outage as the push test's
   /// reference when its last detection is at most this old at the resume (s). Wheel odometry runs through a lidar
   /// outage, so the old estimate carried by odometry still says where the dock must be; beyond this, odometry drift
   /// (and the chance that the robot was carried) make it no evidence of a push, and the task starts afresh.
@@ -78,22 +83,22 @@ struct DockcoreConfig {
 
 /// Per-tick input from the chassis and the host.
 struct TickInput {
-  std::uint64_t now_us = 0;   ///< Monotonic time, same clock as the scan stamps.
-  HostCommand command{};      ///< Command arriving on this tick (edge).
+  std::uint64_t now_us = 0;  ///< Monotonic time, same clock as the scan stamps.
   CameraTarget camera{};
   bool contact = false;
   Real charge_current_a = 0;
-  /// `command` re-issues a dock command that a data-outage fault (lidar/chassis stale) interrupted — the host's
-  /// watchdog resume — not a new task: the robot has not been carried, so a push during the outage must still be
-  /// reported (178/179). Dockcore then keeps the pre-outage dock estimate (push_check_max_gap_s) as the push test's
-  /// reference until a detection in ALIGN has agreed with it. False for every command a host or operator sends.
-  bool resume = false;
+  /// The host is busy (teaching a dock): queued commands and resumes wait.
+  bool hold_commands = false;
 };
 
-/// The task manager's output plus what the drive is sent.
+/// The task manager's output plus what the drive is sent and which command was taken.
 struct TickOutput : TaskOutput {
   Twist2 drive_cmd{};    ///< `cmd` saturated, acceleration-limited and zeroed as the file comment says.
   WheelSpeeds wheels{};  ///< drive_cmd as wheel speeds of DockcoreConfig::drive (count from its kind).
+  bool command_taken = false;               ///< A command reached the task manager (its result: command_result).
+  QueuedCommand command{};                  ///< That command (a resume has `resume` set and token 0).
+  ResumeEvent resume = ResumeEvent::kNone;  ///< What the resume policy did this tick.
+  std::uint8_t resumes = 0;                 ///< Resumes of the current task so far.
 };
 
 /// The docking stack over an estimator and a scan buffer it does not own (DockcoreN<N> gives them, for scans of up
@@ -119,8 +124,9 @@ class DockcoreBase {
   }
   /// The odometry and its history. O(1).
   const Odometry& odometry() const { return odometry_; }
-  /// Continues another core's inputs: its odometry, input watch and latest scan (copied, up to scan_capacity()
-  /// beams). dockd rebuilding the core on a config reload: the robot and its sensors carry on. O(count).
+  /// Continues another core's inputs: its odometry, input watch, latest scan (copied, up to scan_capacity() beams)
+  /// and queued commands. dockd rebuilding the core on a config reload (only while idle): the robot, its sensors and
+  /// the host carry on. O(count).
   void take_inputs(const DockcoreBase& from);
 
   /// One scan stamped `stamp_us` (its first sample; 0 or later than `now_us` is taken as `now_us`), read at `now_us`:
@@ -140,6 +146,15 @@ class DockcoreBase {
   }
   /// The input watch (staleness, late scans, trips). O(1).
   const InputWatch& inputs() const { return watch_; }
+
+  /// Queues a host command for the tick (CommandQueue::submit: a cancel is never lost). O(1).
+  SubmitResult submit(const QueuedCommand& c, QueuedCommand* replaced = nullptr) { return queue_.submit(c, replaced); }
+  /// The command the next tick will take from the queue (nullptr: none), so a host can prepare for it (dockd
+  /// configures the core for its dock while idle). O(1).
+  const QueuedCommand* next_command() const { return queue_.front(); }
+  const CommandQueue& commands() const { return queue_; }
+  /// A command that stale input interrupted waits for the inputs to be fresh again (resume policy). O(1).
+  bool resume_pending() const { return interrupted_.type != HostCommandType::kNone; }
 
   /// One tag detection from a camera frame captured at `obs.stamp_us` (file comment), placed at the odometry pose of
   /// that stamp. Returns what became of it; anything but kFused leaves the filter unchanged. Counted in
@@ -183,11 +198,19 @@ class DockcoreBase {
  private:
   /// Fills out->drive_cmd and out->wheels from out->cmd (file comment). O(1).
   void shape(bool hold, TickOutput* out);
+  /// The resume policy's bookkeeping after the task manager's tick: what the taken command started or stopped, and
+  /// which fault left a command to resume (file comment). O(1).
+  void resume_policy(TaskState before, bool have_cmd, const QueuedCommand& cmd, TickOutput* out);
   /// Copies `scan` (unless it is the kept copy) and runs detection and the filter on it. Cost: the estimator's.
   const DockEstimate& estimate_scan(const ScanView& scan, std::uint64_t stamp_us);
   DockcoreConfig config_{};
   Odometry odometry_{};
   InputWatch watch_{};
+  CommandQueue queue_{};
+  // The resume policy: the dock/undock running now, the one stale input interrupted, resumes this task.
+  HostCommand running_{};
+  HostCommand interrupted_{};
+  std::uint8_t resumes_ = 0;
   DockPoseEstimatorBase& estimator_;
   DockPoseFilter filter_{};
   TaskManager tasks_;
@@ -213,7 +236,7 @@ class DockcoreBase {
   bool restart_ref_set_ = false;
   Pose2 restart_ref_in_odom_{};
   std::uint64_t restart_ref_us_ = 0;  ///< Last detection fused into it.
-  /// The push test's reference after a resume (see TickInput::resume), replacing the restarted filter.
+  /// The push test's reference after a resume (the resume policy's command), replacing the restarted filter.
   bool push_ref_set_ = false;
   Pose2 push_ref_in_odom_{};
   /// This task's newest confirmed estimate (dock in odom; equal to the filter's while filter_confirmed_) and the

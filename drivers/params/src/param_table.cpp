@@ -246,6 +246,10 @@ const ParamSpec kTable[] = {
            "No chassis feedback for longer: the drive is held at zero."),
     DC_INT("watchdog", "fault_after_ms", "ms", 0, 60000, kBoth, watchdog, fault_after_ms,
            "Stale this long after the hold began: fault 185 (lidar) or 184 (chassis)."),
+    DC_INT("watchdog", "resume_after_ms", "ms", 0, 60000, kBoth, watchdog, resume_after_ms,
+           "A dock or undock such a fault interrupted is issued again once both inputs are fresh this long."),
+    DC_INT("watchdog", "max_resumes", "–", 0, 20, kBoth, watchdog, max_resumes,
+           "Resumes per task; then the fault stays."),
 
     // [task]: TaskParams (docs/task-manager.md).
     DC_REAL("task", "detect_wait_s", "s", 0, 60, kBoth, task, detect_wait_s,

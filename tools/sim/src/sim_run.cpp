@@ -512,7 +512,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
         dock_cmd_t = t;
       }
       if (send_dock) {
-        in.command = dockcore::HostCommand{dockcore::HostCommandType::kDock, 0};
+        dockcore::QueuedCommand q;
+        q.command = dockcore::HostCommand{dockcore::HostCommandType::kDock, 0};
+        core->submit(q);
         send_dock = false;
         add(t, TimelineKind::kHost, 1, "host: dock");
       }
@@ -567,12 +569,15 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
             o.target_lost ? "target lost: holding" : "target reacquired");
         prev_lost = o.target_lost;
       }
+      if (o.resume == dockcore::ResumeEvent::kResumed)
+        add(t, TimelineKind::kHost, 1, "resume: the interrupted command again");
+      if (o.resume == dockcore::ResumeEvent::kGivenUp) add(t, TimelineKind::kHost, 0, "resume given up (max_resumes)");
       if (s.state == dockcore::TaskState::kFault) {
         if (prev_state != dockcore::TaskState::kFault) fault_since = t;
         if (redocks_left > 0 && t - fault_since >= sc.host.redock_delay_s) {
           --redocks_left;
           send_dock = true;
-        } else if (redocks_left == 0 && end_at < 0) {
+        } else if (redocks_left == 0 && end_at < 0 && !core->resume_pending()) {
           end_at = t + sc.settle_after_end_s;
         }
       }

@@ -22,6 +22,9 @@ struct WatchdogParams {
   std::uint32_t lidar_stale_ms = 200;    ///< Newest turn ended longer ago than this: lidar stale, robot held.
   std::uint32_t chassis_stale_ms = 200;  ///< Newest chassis feedback older than this: chassis stale, robot held.
   std::uint32_t fault_after_ms = 1000;   ///< Stale this long after the hold began: the task manager faults.
+  /// A dock or undock that such a fault interrupted is issued again once both inputs have been fresh this long.
+  std::uint32_t resume_after_ms = 500;
+  std::uint8_t max_resumes = 3;  ///< Resumes per task; then the fault stays (a flapping link ends, not loops).
 };
 
 class InputWatch {
