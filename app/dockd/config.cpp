@@ -371,7 +371,8 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   auto record = [&]() {
     return Handlers{{"dir", p.str(&c.record_dir)},
                     {"max_bytes", p.integ(&c.record_max_bytes, 4096, std::int64_t{1} << 40)},
-                    {"max_files", p.integ(&c.record_max_files, 1, 1000)}};
+                    {"max_files", p.integ(&c.record_max_files, 1, 1000)},
+                    {"loop", p.flag(&c.record_loop)}};
   };
 
   auto watchdog = [&]() {
@@ -574,6 +575,7 @@ std::vector<std::string> restart_only_changes(const DockdConfig& a, const DockdC
   check(a.record_dir == b.record_dir, "record.dir");
   check(a.record_max_bytes == b.record_max_bytes, "record.max_bytes");
   check(a.record_max_files == b.record_max_files, "record.max_files");
+  check(a.record_loop == b.record_loop, "record.loop");
   check(a.systemd_watchdog_divider == b.systemd_watchdog_divider, "watchdog.systemd_divider");
   check(a.state_file == b.state_file, "state.file");
   return out;

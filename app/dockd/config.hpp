@@ -111,6 +111,9 @@ struct DockdConfig {
   std::string record_dir;                      ///< "" = no session record.
   std::uint64_t record_max_bytes = 16u << 20;  ///< Per file before rotation.
   std::uint32_t record_max_files = 8;          ///< Rotated files kept per log.
+  /// Also record every call into the core (DIR/loop.rec, for `dock-sim replay`); it stops growing at
+  /// record_max_bytes × record_max_files.
+  bool record_loop = false;
 
   // [watchdog]
   dockcore::WatchdogParams watchdog{};         ///< [watchdog]: the core's input watch (the parameter table).

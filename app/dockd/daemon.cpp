@@ -75,6 +75,16 @@ Daemon::Daemon(const DockdConfig& config, const DaemonIo& io)
   build_core();
 }
 
+dockcore::drivers::LoopController Daemon::loop_controller() const {
+  dockcore::drivers::LoopController c;
+  std::snprintf(c.name, sizeof c.name, "%s", controller_->name());
+  c.seed000 = cfg_.seed000;
+  c.seed004 = cfg_.seed004;
+  c.seed003 = cfg_.seed003;
+  c.smooth = cfg_.smooth;
+  return c;
+}
+
 void Daemon::build_core() {
   seed000_ = dockcore::Seed000Controller(cfg_.seed000);
   seed004_ = dockcore::Seed004Controller(cfg_.seed004);
@@ -176,11 +186,13 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
   const std::unique_ptr<dockcore::Dockcore> previous = std::move(core_);
   build_core();
   core_->take_inputs(*previous);  // the robot and its sensors carry on: odometry, input watch, latest scan
+  if (loop_record_) loop_record_->take_inputs();
   if (!configure_core(cfg_.default_dock_id, false)) {
     // A profile the estimator refuses (validated configs do not have one): back to the old config entirely.
     cfg_ = old;
     build_core();
     core_->take_inputs(*previous);
+    if (loop_record_) loop_record_->take_inputs();
     configure_core(cfg_.default_dock_id, false);
     if (io_.udp_host != nullptr) io_.udp_host->set_allowlist(cfg_.host.allowlist, err);
     ++counters_.config_reloads_rejected;
@@ -230,9 +242,11 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
     }
   }
   core_cfg_.tag.dock_tag = tag;
+  if (loop_record_) loop_record_->configure(loop_controller(), prof, core_cfg_);
   if (!core_->configure(prof, core_cfg_)) return false;
   active_dock_ = dock_id;
   active_raw_ = raw_profile;
+  if (loop_record_) loop_record_->rescan();
   core_->rescan();  // the latest scan through the new profile: the next tick sees this dock's estimate
   return true;
 }
@@ -245,6 +259,14 @@ bool Daemon::start(std::string& error) {
     EventLine e(now, "state_file");
     e.w.str("level", st == StateLoadStatus::kCorruptNoBackup ? "error" : "warn").str_cut("message", msg.c_str(), 1024);
     log_event(e, st == StateLoadStatus::kCorruptNoBackup ? LogLevel::kError : LogLevel::kWarn);
+  }
+  if (cfg_.record_loop && !cfg_.record_dir.empty()) {
+    loop_record_ = std::make_unique<dockcore::drivers::LoopRecordWriter>();
+    std::string err;
+    if (!loop_record_->open(cfg_.record_dir + "/loop.rec", cfg_.record_max_bytes * cfg_.record_max_files, err)) {
+      error = "loop record: " + err;
+      return false;
+    }
   }
   if (!configure_core(cfg_.default_dock_id, false)) {
     error = "dock profile of dock " + std::to_string(cfg_.default_dock_id) + " refused by the estimator";
@@ -316,6 +338,7 @@ void Daemon::poll_chassis(std::uint64_t now_us) {
   dockcore::WheelSpeeds w;
   w.count = dockcore::drive_wheel_count(cfg_.drive.kind);
   for (std::size_t i = 0; i < w.count; ++i) w.radps[i] = fb_.wheel_radps[i];
+  if (loop_record_) loop_record_->wheels(w, fb_.wheels_stamp_us);
   core_->on_wheels(w, fb_.wheels_stamp_us);  // a repeated stamp is no new feedback
 }
 
@@ -326,6 +349,7 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
   const dockcore::LaserScan* scan = nullptr;
   for (int i = 0; i < 4 && (scan = io_.lidar->poll_scan()) != nullptr; ++i) {
     ++counters_.scans;
+    if (loop_record_) loop_record_->scan(scan->view(), scan->stamp_us, now_us);
     const dockcore::DockEstimate* e = core_->on_scan(scan->view(), scan->stamp_us, now_us);
     if (e != nullptr && e->found) {
       ++counters_.detections;
@@ -352,6 +376,7 @@ void Daemon::poll_camera(std::uint64_t) {
   if (io_.tags != nullptr) {
     dockcore::TagObservation o;
     for (int i = 0; i < 16 && io_.tags->poll_tag(o); ++i) {
+      if (loop_record_) loop_record_->tag(o);
       const dockcore::TagStatus st = core_->on_tag(o);
       ++counters_.tags[static_cast<std::size_t>(st)];
     }
@@ -359,19 +384,25 @@ void Daemon::poll_camera(std::uint64_t) {
 }
 
 std::uint32_t Daemon::hold_reply(const HostRequest& r) {
-  if (++next_token_ == 0) next_token_ = 1;  // 0: no reply (CAN, resumes)
-  UdpReply& slot = replies_[next_token_ % kReplySlots];
-  slot.token = next_token_;
-  slot.request = r;
-  return next_token_;
+  // A free slot always exists: at most the queue's capacity of requests wait, plus the one being submitted.
+  for (UdpReply& slot : replies_) {
+    if (slot.token != 0) continue;
+    if (++next_token_ == 0) next_token_ = 1;  // 0: no reply (CAN, resumes)
+    slot.token = next_token_;
+    slot.request = r;
+    return next_token_;
+  }
+  return 0;
 }
 
 const Daemon::UdpReply* Daemon::take_reply(std::uint32_t token) {
   if (token == 0) return nullptr;
-  UdpReply& slot = replies_[token % kReplySlots];
-  if (slot.token != token) return nullptr;
-  slot.token = 0;
-  return &slot;
+  for (UdpReply& slot : replies_) {
+    if (slot.token != token) continue;
+    slot.token = 0;
+    return &slot;
+  }
+  return nullptr;
 }
 
 dockcore::SubmitResult Daemon::submit(dockcore::HostCommandType type, std::uint16_t dock_id, std::uint32_t token) {
@@ -379,6 +410,7 @@ dockcore::SubmitResult Daemon::submit(dockcore::HostCommandType type, std::uint1
   c.command = dockcore::HostCommand{type, dock_id};
   c.token = token;
   dockcore::QueuedCommand replaced;
+  if (loop_record_) loop_record_->submit(c);
   const dockcore::SubmitResult res = core_->submit(c, &replaced);
   if (res != dockcore::SubmitResult::kQueued) ++counters_.queue_overflows;
   if (res == dockcore::SubmitResult::kReplacedNewest) take_reply(replaced.token);  // that request goes unanswered
@@ -493,6 +525,7 @@ void Daemon::on_camera_readable(std::uint64_t now_us) {
 // --- watchdogs -----------------------------------------------------------------------------------------------------
 
 void Daemon::watchdogs(std::uint64_t now_us) {
+  if (loop_record_) loop_record_->check_inputs(now_us);
   const dockcore::InputWatch::Change c = core_->check_inputs(now_us);
   const dockcore::InputWatch& w = core_->inputs();
   if (c.lidar) {
@@ -714,6 +747,16 @@ void Daemon::on_tick(std::uint64_t now_us) {
   }
 
   const dockcore::TickOutput out = core_->tick(in);
+  if (loop_record_) {
+    loop_record_->tick(in, out);
+    loop_record_->flush();
+    if (loop_record_->full() && !loop_record_full_logged_) {
+      loop_record_full_logged_ = true;
+      EventLine e(now_us, "loop_record_full");
+      e.w.str("message", "loop.rec reached record.max_bytes x record.max_files: no more calls recorded");
+      log_event(e, LogLevel::kWarn);
+    }
+  }
   if (out.resume == dockcore::ResumeEvent::kResumed) {
     ++counters_.resumes;
     EventLine e(now_us, "resume");

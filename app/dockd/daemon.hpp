@@ -23,6 +23,7 @@
 #include "dockcore/control/controllers.hpp"
 #include "dockcore/dockcore.hpp"
 #include "dockcore/drivers/json_writer.hpp"
+#include "dockcore/drivers/loop_record.hpp"
 #include "dockcore/drivers/udp_host_link.hpp"
 #include "dockcore/hal/camera.hpp"
 #include "dockcore/hal/chassis.hpp"
@@ -220,8 +221,8 @@ class Daemon {
     std::uint32_t token = 0;  ///< 0: free.
     dockcore::drivers::HostRequest request{};
   };
-  /// More than the core's queue holds, so a queued request's slot is never reused before it is answered.
-  static constexpr std::size_t kReplySlots = 2 * dockcore::CommandQueue::kCapacity;
+  /// More than the core's queue holds plus the request being submitted: a waiting request always keeps its slot.
+  static constexpr std::size_t kReplySlots = dockcore::CommandQueue::kCapacity + 2;
   struct Teach {
     bool active = false;
     std::uint16_t dock_id = 0;
@@ -240,9 +241,9 @@ class Daemon {
   void handle_udp_request(const dockcore::drivers::HostRequest& r, std::uint64_t now_us);
   /// Logs how many refusal events refusal_log_ held back, once their window has ended.
   void report_held_events(std::uint64_t now_us);
-  /// Keeps `r` for its answer; returns its token. O(1).
+  /// Keeps `r` in a free slot for its answer; returns its token. O(kReplySlots).
   std::uint32_t hold_reply(const dockcore::drivers::HostRequest& r);
-  /// The request held under `token` (nullptr for 0 or one no longer held), released. O(1).
+  /// The request held under `token` (nullptr for 0 or one no longer held), released. O(kReplySlots).
   const UdpReply* take_reply(std::uint32_t token);
   /// Queues a command in the core (counted as an overflow unless queued; a refused or displaced request's reply slot
   /// is released). O(1).
@@ -263,6 +264,8 @@ class Daemon {
   void send_wheels(const dockcore::hal::WheelCommand& w);
   void emit_event(LogLevel level, const char* line, std::size_t len);
   void build_core();
+  /// The active controller and every controller's parameters, as the loop record keeps them. O(1).
+  dockcore::drivers::LoopController loop_controller() const;
   bool reload_can_apply() const;
   bool apply_reload(std::uint64_t now_us, std::string& message);
   void log_reload(std::uint64_t now_us, const char* result, const std::string& message, LogLevel level);
@@ -316,6 +319,9 @@ class Daemon {
   EventRateLimit refusal_log_{};  ///< command_rejected and refused command_result events (one per refused request).
   bool shutdown_logged_ = false;
   std::unique_ptr<DockdConfig> pending_cfg_;  ///< A validated reload waiting for an idle task.
+  /// [record] loop: every call into the core, for dock-sim replay (null when off).
+  std::unique_ptr<dockcore::drivers::LoopRecordWriter> loop_record_;
+  bool loop_record_full_logged_ = false;
 };
 
 /// Short stable name of a task result ("none", "docked", ...). Never null.

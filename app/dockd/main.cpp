@@ -209,6 +209,9 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", log_level, "error | warn | info | debug (overrides [log] level)")
       ->check(CLI::IsMember({"error", "warn", "info", "debug"}));
   app.add_option("--record-dir", record_dir, "session record directory (overrides [record] dir)");
+  bool record_loop = false;
+  app.add_flag("--record-loop", record_loop,
+               "also record every call into the core to DIR/loop.rec, for dock-sim replay (sets [record] loop)");
   app.add_flag("--foreground", foreground, "stay in the foreground (dockd never forks; accepted for init scripts)");
   app.add_flag("--allow-fake-can", allow_fake_can,
                "DEVELOPMENT ONLY: permit [can] interface = \"fake\" (no chassis; the robot never moves)");
@@ -228,6 +231,7 @@ int main(int argc, char** argv) {
   }
   if (!log_level.empty()) dockd::parse_log_level(log_level, cfg.log_level);
   if (!record_dir.empty()) cfg.record_dir = record_dir;
+  if (record_loop) cfg.record_loop = true;
   if (cfg.can_interface == "fake" && !allow_fake_can) {
     std::fprintf(stderr, "%s: [can] interface = \"fake\" is for development only and needs --allow-fake-can\n",
                  config_path.c_str());
@@ -486,6 +490,7 @@ int main(int argc, char** argv) {
               daemon->reload_from_file(config_path, now, msg, [&](dockd::DockdConfig& next) {
                 if (!log_level.empty()) dockd::parse_log_level(log_level, next.log_level);
                 if (!record_dir.empty()) next.record_dir = record_dir;
+                if (record_loop) next.record_loop = true;
               });
             }
           }

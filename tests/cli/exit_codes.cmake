@@ -51,11 +51,16 @@ expect_run(2 "bad_profile.toml:3:3: unknown key 'depth'" scene --profile "${DIR}
 expect_run(2 "unknown lidar" scene --lidar hokuyo)
 expect_run(2 "bad_profile.toml:3:3" profile --name "${DIR}/bad_profile.toml")
 
+# dock-sim replay: a file that is no loop record, or none at all, is refused with its reason (exit 2).
+expect_run(2 "not a dockcore loop record" replay "${DIR}/bad_profile.toml")
+expect_run(2 "does-not-exist.rec: No such file" replay "${WORK}/does-not-exist.rec")
+expect_run(2 "record is required" replay)
+
 # Command-line errors: exit 2 (never CLI11's own codes 104-114) with CLI11's message; --help exits 0.
 expect_run(0 "" --help)
 expect_run(0 "" scene --help)
 expect_run(2 "A subcommand is required")
-expect_run(2 "unknown subcommand 'fly' \\(valid: scene, profile, detect, perception, run, montecarlo, soak, features, params\\)" fly)
+expect_run(2 "unknown subcommand 'fly' \\(valid: scene, profile, detect, perception, run, montecarlo, soak, features, params, replay\\)" fly)
 expect_run(2 "--bogus" scene --bogus)
 expect_run(2 "unknown option '--bogus'" --bogus)
 expect_run(2 "--clutter" scene --clutter x)

@@ -72,6 +72,8 @@ struct Rig {
       ::mkdir(record_dir.c_str(), 0700);
       std::string err;
       CHECK_TRUE_TEXT(event_log.open(record_dir, "events.jsonl", 1 << 20, 2, err), err.c_str());
+      cfg.record_dir = record_dir;
+      cfg.record_loop = true;
     }
     cfg.teach_scans = 10;
     dockd::DockEntry d3 = cfg.docks[0];
@@ -108,7 +110,7 @@ struct Rig {
     if (!record_dir.empty()) remove_record();
   }
   void remove_record() const {
-    for (const char* f : {"/events.jsonl", "/events.jsonl.1", "/can.log", "/can.log.1"})
+    for (const char* f : {"/events.jsonl", "/events.jsonl.1", "/can.log", "/can.log.1", "/loop.rec"})
       std::remove((record_dir + f).c_str());
     ::rmdir(record_dir.c_str());
   }
@@ -152,6 +154,14 @@ struct Rig {
     }
     return false;
   }
+  /// A UDP socket for requests to dockd's host link (a rig `with_udp`); `to` receives the link's address.
+  int udp_client(sockaddr_in& to) const {
+    to = sockaddr_in{};
+    to.sin_family = AF_INET;
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    to.sin_port = htons(udp->bound_port());
+    return ::socket(AF_INET, SOCK_DGRAM, 0);
+  }
   bool wheels_zero() const {
     for (int i = 0; i < link.last.count; ++i) {
       if (link.last.radps[i] != 0) return false;
@@ -166,6 +176,63 @@ struct Rig {
 static const bool kNamesWarm = !docksim::controller_names().empty();
 
 TEST_GROUP(DockdDaemon){};
+
+TEST(DockdDaemon, TheLoopRecordReplaysEveryTickBitForBit) {
+  // A docking with a chassis outage long enough for fault 184 and the resume, recorded with [record] loop; a fresh
+  // core fed the record's calls must produce every tick's output exactly as dockd's core did.
+  Rig r("replay", false, 1.2, true);
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kAlign && !r.wheels_zero(); }, 20.0));
+  r.link.silent = true;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->fault() == dockcore::FaultCode::kChassisStale; }, 3.0));
+  r.link.silent = false;
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
+  CHECK_EQUAL(1u, r.daemon->counters().resumes);
+  const std::uint64_t ticks = r.daemon->tick_stats().ticks;
+  r.daemon.reset();  // flushes the record
+  const std::string rec = r.record_dir + "/loop.rec";
+  const dockcore::drivers::ReplayResult ok = dockcore::drivers::replay_loop_record(rec);
+  CHECK_TRUE_TEXT(ok.error.empty(), ok.error.c_str());
+  CHECK_TRUE_TEXT(!ok.diverged, ok.diverged_field.c_str());
+  CHECK_TRUE(ok.ok);
+  CHECK_FALSE(ok.truncated);
+  CHECK_EQUAL(ticks, ok.ticks);
+  CHECK(ok.scans > 100);
+  std::printf("\nloop record: %llu records, %llu ticks, %llu scans, %llu commands replayed bit for bit\n",
+              static_cast<unsigned long long>(ok.records), static_cast<unsigned long long>(ok.ticks),
+              static_cast<unsigned long long>(ok.scans), static_cast<unsigned long long>(ok.commands));
+  CHECK(ok.commands >= 1);
+  // The replay can fail: a record whose core got other inputs diverges, and says where.
+  std::FILE* f = std::fopen(rec.c_str(), "r+b");
+  CHECK(f != nullptr);
+  std::vector<unsigned char> bytes;
+  for (int ch; (ch = std::fgetc(f)) != EOF;) bytes.push_back(static_cast<unsigned char>(ch));
+  // The last wheel feedback record (kind 2): its first wheel speed changed, so the odometry differs from there on.
+  std::size_t off = 0, last_wheels = 0;
+  const std::size_t header = std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()).find('\n', 8) + 1;
+  for (off = header; off + 5 <= bytes.size();) {
+    const std::size_t len = bytes[off + 1] | (bytes[off + 2] << 8) | (bytes[off + 3] << 16) |
+                            (static_cast<std::size_t>(bytes[off + 4]) << 24);
+    if (bytes[off] == 2 && off < bytes.size() / 2) last_wheels = off;
+    off += 5 + len;
+  }
+  CHECK_EQUAL(bytes.size(), off);
+  CHECK(last_wheels > 0);
+  bytes[last_wheels + 5 + sizeof(dockcore::Real) - 1] ^= 0x40;  // the sign/exponent byte of wheel 0 (little-endian)
+  std::fseek(f, 0, SEEK_SET);
+  CHECK_EQUAL(bytes.size(), std::fwrite(bytes.data(), 1, bytes.size(), f));
+  std::fclose(f);
+  const dockcore::drivers::ReplayResult bad = dockcore::drivers::replay_loop_record(rec);
+  CHECK_TRUE(bad.diverged);
+  CHECK(bad.diverged_tick > 0 && bad.diverged_tick < ticks);
+  // A truncated record replays up to its cut; a file that is no record is refused with its reason.
+  CHECK_EQUAL(0, ::truncate(rec.c_str(), static_cast<off_t>(last_wheels + 3)));
+  const dockcore::drivers::ReplayResult cut = dockcore::drivers::replay_loop_record(rec);
+  CHECK_TRUE(cut.ok && cut.truncated && !cut.diverged);
+  const dockcore::drivers::ReplayResult none = dockcore::drivers::replay_loop_record(r.record_dir + "/events.jsonl");
+  STRCMP_CONTAINS("not a dockcore loop record", none.error.c_str());
+}
 
 TEST(DockdDaemon, DocksChargesAndUndocksInSimulation) {
   Rig r("dock");
@@ -415,11 +482,8 @@ TEST(DockdDaemon, ShortLidarGapHoldsTheRobotAndTheDockingContinues) {
 TEST(DockdDaemon, UdpFloodStaysConsistentAndUnknownDockIsRejected) {
   Rig r("flood", true);
   r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
-  const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  to.sin_port = htons(r.udp->bound_port());
+  const int s = r.udp_client(to);
   auto send = [&](const std::string& m) {
     ::sendto(s, m.data(), m.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
   };
@@ -476,11 +540,8 @@ TEST(DockdDaemon, UdpFloodStaysConsistentAndUnknownDockIsRejected) {
 TEST(DockdDaemon, RefusalFloodIsLoggedAtTheCapAndTheRestCounted) {
   Rig r("refusals", true, 1.2, true);
   r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
-  const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  to.sin_port = htons(r.udp->bound_port());
+  const int s = r.udp_client(to);
   const std::uint32_t before = r.daemon->counters().commands_rejected;
   char buf[2048];
   int seq = 1;
@@ -510,17 +571,57 @@ TEST(DockdDaemon, RefusalFloodIsLoggedAtTheCapAndTheRestCounted) {
   STRCMP_CONTAINS("\"of\":\"refusals\"", held.c_str());
 }
 
+TEST(DockdDaemon, EveryQueuedOrRefusedUdpCommandIsAnsweredOnce) {
+  // More task commands per tick than the queue holds: the queued ones are answered with their result when the core
+  // takes them, the rest at once with busy; a stop that finds the queue full takes the newest entry's place. Each
+  // request gets exactly one reply, whatever order the refusals and the queue's answers come in.
+  Rig r("answers", true);
+  r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
+  sockaddr_in to{};
+  const int s = r.udp_client(to);
+  std::vector<int> replies(2000, 0);
+  char buf[2048];
+  auto drain = [&]() {
+    for (ssize_t n; (n = ::recv(s, buf, sizeof buf - 1, MSG_DONTWAIT)) > 0;) {
+      buf[n] = '\0';
+      const char* at = std::strstr(buf, "\"seq\":");
+      if (at != nullptr) ++replies[static_cast<std::size_t>(std::strtol(at + 6, nullptr, 10))];
+    }
+  };
+  int seq = 1;
+  for (int t = 0; t < 40; ++t) {
+    for (int k = 0; k < 30; ++k) {  // docks and tests, one stop in every ten
+      const char* cmd = k % 10 == 9 ? "stop" : (k % 2 == 0 ? "dock" : "test");
+      const std::string m = std::string("{\"cmd\":\"") + cmd + "\",\"seq\":" + std::to_string(seq++) + "}";
+      ::sendto(s, m.data(), m.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+    }
+    r.tick();
+    drain();
+  }
+  for (int t = 0; t < 20; ++t) {
+    r.tick();
+    drain();
+  }
+  ::close(s);
+  int none = 0, twice = 0;
+  for (int q = 1; q < seq; ++q) {
+    if (replies[static_cast<std::size_t>(q)] == 0) ++none;
+    if (replies[static_cast<std::size_t>(q)] > 1) ++twice;
+  }
+  // A stop that displaced a queued command leaves that command unanswered (documented): at most one per stop.
+  CHECK(none <= (seq - 1) / 10);
+  CHECK_EQUAL(0, twice);
+  CHECK(r.daemon->counters().queue_overflows > 0);
+}
+
 TEST(DockdDaemon, TeachStoresTargetUsedByLaterDockings) {
   Rig r("teach", true);
   // Dock first, so the robot sits on the charger (as if placed there by hand).
   r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0);
   r.host.command(1, 3);
   CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
-  const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  to.sin_port = htons(r.udp->bound_port());
+  const int s = r.udp_client(to);
   const std::string m = "{\"cmd\":\"teach\",\"dock_id\":3,\"scans\":8,\"seq\":5}";
   ::sendto(s, m.data(), m.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
   char buf[2048];

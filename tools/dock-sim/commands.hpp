@@ -20,5 +20,7 @@ void register_soak(CLI::App& app);
 void register_features(CLI::App& app);
 /// `dock-sim params`: the parameter table as Markdown; regenerate or check the docs' key tables (params.cpp).
 void register_params(CLI::App& app);
+/// `dock-sim replay`: a dockd loop record through a fresh core, every tick compared (replay.cpp).
+void register_replay(CLI::App& app);
 
 }  // namespace docksim_cli

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   docksim_cli::register_soak(app);
   docksim_cli::register_features(app);
   docksim_cli::register_params(app);
+  docksim_cli::register_replay(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

@@ -1,13 +1,14 @@
 # A whole docking session on vcan0: chassis-sim (robot base + LD06 on a pty), dockd, candump.
 # Run 1 is commanded with a CAN host command frame (cansend), run 2 with dockctl; both must reach charging
 # confirmed (FINISH_TASKING) and undock. Then SIGTERM: dockd exits 0 leaving zero on the bus. dock-decode must read the
-# candump log with zero counter/checksum errors, and the status frames must show the expected state sequence.
+# candump log with zero counter/checksum errors, and the status frames must show the expected state sequence. dockd
+# records every call into its core (--record-loop); dock-sim replay must reproduce every tick of the session.
 make_dockd_config
 start_candump
 bg chassis chassis-sim-run --can vcan0 --lidar-pty /tmp/dockcore-lidar --start 1.2,10,5 --truth "$OUT/truth.jsonl" \
    --seed 3 "$SRC/tools/scenarios/default.toml"
 wait_for 10 test -e /tmp/dockcore-lidar
-bg dockd "$BUILD/app/dockd" --config "$OUT/dockd.toml"
+bg dockd "$BUILD/app/dockd" --config "$OUT/dockd.toml" --record-loop
 check dockd_up wait_for 20 dockd_ready
 
 # Run 1: CAN host command (dock at dock 0, sequence 1).
@@ -48,3 +49,8 @@ echo "INFO state sequence: $states"
 check state_sequence_two_sessions grep -qE '^0 1 (2 )?3 5 4 7 0 1 (2 )?3 5 4 7 0$' <<< "$states"
 check last_wheel_command_zero test "$(/usr/bin/python3 "$SRC/tests/hil/analyze.py" last-wheels "$OUT/decode.json")" = "0 0"
 grep -E "^errors|^malformed|^summary" "$OUT/decode.txt" | sed 's/^/INFO /'
+# The session's core calls through a fresh core: every tick's output bit for bit.
+replay_rc=0
+"$BUILD/tools/dock-sim" replay "$OUT/record/loop.rec" > "$OUT/replay.txt" 2>&1 || replay_rc=$?
+sed 's/^/INFO /' "$OUT/replay.txt"
+check loop_record_replays_bit_for_bit test "$replay_rc" -eq 0
