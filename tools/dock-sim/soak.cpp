@@ -118,7 +118,7 @@ class SoakWorld {
         world_(docksim::scenario_world(sc, true)),
         geom_(docksim::core_drive_geometry(sc.chassis.geometry)),
         target_world_(sc.dock_pose.transform(sc.camera.target_in_dock)) {
-    core_ = std::make_unique<dockcore::Dockcore>(ctl);  // ~330 KiB: heap, not stack
+    core_ = std::make_unique<dockcore::Dockcore>(ctl);  // ~334 KiB: heap, not stack
     configured_ = core_->configure(sc.profile, docksim::core_config(sc));
     docksim::DockPlacement dp;
     dp.pose_world = sc.dock_pose;

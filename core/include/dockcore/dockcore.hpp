@@ -39,7 +39,7 @@
 ///   test, and the lidar's scan stays the obstacle check's input: the tag replaces the lidar's dock detection, not
 ///   its safety role.
 /// No heap. DockcoreN<N> holds the estimator's buffers and the scan copy for N beams (docs/architecture.md: about
-/// 90 KiB with double at 720 beams, 370 KiB at kMaxScanPoints): keep it static or a member, never on a small stack.
+/// 81 KiB with double at 720 beams, 334 KiB at kMaxScanPoints): keep it static or a member, never on a small stack.
 
 #include <cstdint>
 
