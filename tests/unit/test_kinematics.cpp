@@ -6,36 +6,19 @@
 #include "dockcore/control/kinematics.hpp"
 #include "docksim/chassis.hpp"
 
+#include "drive_geometries.hpp"
 #include "real_tolerance.hpp"
 
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
+using dockcore_test::diff_geom;
+using dockcore_test::mec_geom;
+using dockcore_test::tw;
 
 namespace {
 
 const double kTol = std::is_same<Real, float>::value ? 1e-4 : 1e-12;
-
-DriveGeometry diff_geom() {
-  DriveGeometry g;
-  g.kind = DriveKind::kDifferential;
-  g.wheel_radius_m = static_cast<Real>(0.05);
-  g.wheel_base_m = static_cast<Real>(0.30);
-  return g;
-}
-
-DriveGeometry mec_geom() {
-  DriveGeometry g;
-  g.kind = DriveKind::kMecanum;
-  g.wheel_radius_m = static_cast<Real>(0.04);
-  g.lx_m = static_cast<Real>(0.2);
-  g.ly_m = static_cast<Real>(0.15);
-  return g;
-}
-
-Twist2 tw(double vx, double vy, double wz) {
-  return Twist2{static_cast<Real>(vx), static_cast<Real>(vy), static_cast<Real>(wz)};
-}
 
 }  // namespace
 

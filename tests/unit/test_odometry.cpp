@@ -7,26 +7,21 @@
 #include "dockcore/control/kinematics.hpp"
 #include "dockcore/control/odometry.hpp"
 
+#include "drive_geometries.hpp"
 #include "real_tolerance.hpp"
 
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
+using dockcore_test::diff_geom;
+using dockcore_test::mec_geom;
 
 namespace {
 
 const double kTol = std::is_same<Real, float>::value ? 2e-5 : 1e-9;
 
-DriveGeometry diff_geom() {
-  DriveGeometry g;
-  g.kind = DriveKind::kDifferential;
-  g.wheel_radius_m = static_cast<Real>(0.05);
-  g.wheel_base_m = static_cast<Real>(0.30);
-  return g;
-}
-
 WheelSpeeds wheels_for(const DriveGeometry& g, double vx, double vy, double wz) {
-  return twist_to_wheels(g, Twist2{static_cast<Real>(vx), static_cast<Real>(vy), static_cast<Real>(wz)});
+  return twist_to_wheels(g, dockcore_test::tw(vx, vy, wz));
 }
 
 /// Feeds `n` feedbacks of the same wheel speeds every `period_us`, starting at `t0_us`.
@@ -65,9 +60,7 @@ TEST(Odometry, StraightAndArcFromWheelSpeeds) {
 }
 
 TEST(Odometry, MecanumSideways) {
-  DriveGeometry g;
-  g.kind = DriveKind::kMecanum;
-  g.wheel_radius_m = static_cast<Real>(0.04);
+  const DriveGeometry g = mec_geom();
   Odometry o;
   feed(o, g, wheels_for(g, 0, 0.1, 0), 500000, 10000, 101);  // 1 s left at 0.1 m/s
   REAL_EQUAL(0.0, o.pose().x_m, kTol);
