@@ -161,6 +161,58 @@ TEST(SimRun, OneSecondOcclusionIsRecovered) {
   CHECK(back);
 }
 
+// A base that reports only its wheel speeds (as the CAN wheel feedback does): the core integrates them with the
+// geometry the robot believes (2 % radius and base errors, 1 % left/right radius difference), as dockd does.
+TEST(SimRun, OdometryFromWheelSpeedsDocksAsDockdWould) {
+  docksim::Scenario sc = default_scenario();
+  sc.odometry_source = docksim::OdometrySource::kWheels;
+  sc.chassis.noise.odom_radius_error = 0.02;
+  sc.chassis.noise.odom_radius_diff = 0.01;
+  sc.chassis.noise.odom_base_error = 0.02;
+  const docksim::StartPose start = docksim::start_from(sc, 1.5, 15 * kDeg, -10 * kDeg);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 5, opt);
+  check_docked(r);
+  CHECK(r.outcome.faults.empty());
+  // The same start with the chassis's own odometry docks too; the two runs differ (another odometry).
+  sc.odometry_source = docksim::OdometrySource::kChassis;
+  const docksim::SimRun c = docksim::run_docking(sc, "smooth", 5, opt);
+  check_docked(c);
+  CHECK(c.outcome.time_to_charging_s != r.outcome.time_to_charging_s || c.outcome.lateral_m != r.outcome.lateral_m);
+}
+
+// A lidar dropout longer than lidar_stale_ms + fault_after_ms: the core holds the robot, faults 185, and once scans
+// have been fresh for resume_after_ms issues the dock command again (its resume policy, as in dockd); it docks.
+TEST(SimRun, ALongLidarDropoutFaultsAndIsResumed) {
+  docksim::Scenario sc = default_scenario();
+  docksim::ScenarioEvent drop;
+  drop.t_s = 3.0;
+  drop.kind = docksim::EventKind::kLidarDropout;
+  drop.duration_s = 2.0;
+  sc.events.push_back(drop);
+  const docksim::StartPose start = docksim::start_from(sc, 1.5, 10 * kDeg, 0);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 5, opt);
+  check_docked(r);
+  const double fault_at = 3.0 + 0.2 + 1.0;  // hold after lidar_stale_ms past the last turn, fault after fault_after_ms
+  CHECK(has_fault(r, 185, fault_at - 0.15, fault_at + 0.15));
+  bool resumed = false;
+  for (const auto& e : r.timeline) {
+    if (e.kind == docksim::TimelineKind::kHost && e.text.rfind("resume:", 0) == 0) {
+      resumed = true;
+      CHECK(e.t_s >= 5.0 + 0.5 && e.t_s <= 5.0 + 0.5 + 0.2);  // fresh scans for resume_after_ms after the dropout
+    }
+  }
+  CHECK(resumed);
+  // A dropout shorter than the fault: held, not faulted.
+  sc.events.back().duration_s = 0.6;
+  const docksim::SimRun h = docksim::run_docking(sc, "smooth", 5, opt);
+  check_docked(h);
+  CHECK(h.outcome.faults.empty());
+}
+
 // dockd stalled (a starved machine): no scan read, no tick, the motors keep the last command until the chassis'
 // command timeout. The robot travels blind for exactly the timeout, then stands; the run resumes afterwards.
 TEST(SimRun, HostStallHoldsTheLastCommandUntilTheChassisTimeout) {

@@ -176,7 +176,7 @@ class SoakWorld {
     const docksim::ChassisState& cs = chassis_.state();
     {
       AllocScope scope;
-      core_->on_odometry(cs.odom_pose, docksim::measured_twist(geom_, cs), now_us);
+      docksim::feed_chassis(*core_, sc_, cs, now_us);
     }
 
     if (t + 1e-9 >= next_scan_t_) {

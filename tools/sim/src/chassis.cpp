@@ -78,8 +78,6 @@ double geometry_k(const DriveGeometry& g) {
   return g.kind == DriveKind::kMecanum ? g.lx_m + g.ly_m : g.wheel_base_m;
 }
 
-bool is_left_wheel(DriveKind kind, std::size_t i) { return kind == DriveKind::kMecanum ? (i % 2 == 0) : (i == 0); }
-
 }  // namespace
 
 WheelRadps body_twist_to_wheel_radps(const DriveGeometry& g, const BodyTwist& twist) {

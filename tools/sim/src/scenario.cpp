@@ -275,7 +275,11 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
            [&](const toml::node& n) { o.encoder_cpr = static_cast<std::int32_t>(p.integer(n, 1, 1 << 24)); }},
           {"radius_error", p.num(&o.odom_radius_error, -0.5, 0.5)},
           {"radius_diff", p.num(&o.odom_radius_diff, -0.5, 0.5)},
-          {"base_error", p.num(&o.odom_base_error, -0.5, 0.5)}};
+          {"base_error", p.num(&o.odom_base_error, -0.5, 0.5)},
+          {"source", [&](const toml::node& n) {
+             sc.odometry_source =
+                 p.choice(n, {"chassis", "wheels"}) == "wheels" ? OdometrySource::kWheels : OdometrySource::kChassis;
+           }}};
     }));
     return h;
   };

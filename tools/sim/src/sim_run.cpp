@@ -169,17 +169,49 @@ dockcore::DriveGeometry core_drive_geometry(const DriveGeometry& g) {
   return c;
 }
 
+namespace {
+
+/// The geometry the robot believes it has: the chassis's odometry radius and base errors applied.
+DriveGeometry believed_geometry(const ChassisParams& c) {
+  DriveGeometry g = c.geometry;
+  g.wheel_radius_m *= 1.0 + c.noise.odom_radius_error;
+  g.wheel_base_m *= 1.0 + c.noise.odom_base_error;
+  g.lx_m *= 1.0 + c.noise.odom_base_error;
+  g.ly_m *= 1.0 + c.noise.odom_base_error;
+  return g;
+}
+
+}  // namespace
+
 dockcore::DockcoreConfig core_config(const Scenario& sc) {
   dockcore::DockcoreConfig cfg;
   cfg.estimator = sc.estimator;
   cfg.task = sc.task;
   cfg.footprint = sc.safety;
   cfg.lidar_mount = sc.lidar_mount;
-  cfg.drive = core_drive_geometry(sc.chassis.geometry);
+  cfg.drive = core_drive_geometry(sc.odometry_source == OdometrySource::kWheels ? believed_geometry(sc.chassis)
+                                                                                : sc.chassis.geometry);
   cfg.limits = sc.limits;
   cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
   cfg.watchdog = sc.watchdog;
   return cfg;
+}
+
+void feed_chassis(dockcore::DockcoreBase& core, const Scenario& sc, const ChassisState& reported,
+                  std::uint64_t now_us) {
+  if (sc.odometry_source == OdometrySource::kChassis) {
+    core.on_odometry(reported.odom_pose, measured_twist(core.config().drive, reported), now_us);
+    return;
+  }
+  const NoiseParams& n = sc.chassis.noise;
+  dockcore::WheelSpeeds w;
+  w.count = reported.wheel_count;
+  for (std::size_t i = 0; i < w.count; ++i) {
+    const double side = is_left_wheel(sc.chassis.geometry.kind, i) ? 0.5 : -0.5;
+    const double scale = (1.0 + n.odom_radius_error + side * n.odom_radius_diff) / (1.0 + n.odom_radius_error);
+    w.radps[i] = static_cast<Real>(reported.wheel_measured_radps[i] * scale);
+  }
+  core.on_wheels(w, now_us);
 }
 
 dockcore::Twist2 measured_twist(const dockcore::DriveGeometry& g, const ChassisState& reported) {
@@ -320,7 +352,6 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   CameraSim camera(camera_sim_params(sc), mix64(seed ^ 0x43414dull), frame_camera.get());
   const Vec2 target_world = sc.dock_pose.transform(sc.camera.target_in_dock);
 
-  const dockcore::DriveGeometry geom = core_drive_geometry(sc.chassis.geometry);
   const double dt = sc.chassis.dt_s;
 
   // World state driven by events.
@@ -454,7 +485,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       reported = cs;
       // The chassis firmware's odometry, as its feedback reaches the host (a stalled host reads none): the core
       // places each scan and tag frame by it, as in dockd.
-      if (!host_stalled) core->on_odometry(reported.odom_pose, measured_twist(geom, reported), now_us);
+      if (!host_stalled) feed_chassis(*core, sc, reported, now_us);
     }
 
     // 2. Lidar: capture at the model's rate from the true lidar pose, deliver after the scan latency.

@@ -48,6 +48,10 @@ struct DriveGeometry {
 
 /// Number of driven wheels for a kind: 2 or 4. O(1).
 inline std::size_t wheel_count(DriveKind k) { return k == DriveKind::kMecanum ? 4 : 2; }
+/// Whether wheel `i` (the order above) is on the left side. O(1).
+inline bool is_left_wheel(DriveKind kind, std::size_t i) {
+  return kind == DriveKind::kMecanum ? (i % 2 == 0) : (i == 0);
+}
 
 /// Body velocity in the body frame.
 struct BodyTwist {

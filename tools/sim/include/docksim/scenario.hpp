@@ -161,6 +161,12 @@ struct HostSpec {
   double redock_delay_s = 1.0;   ///< Wait this long in FAULT before re-sending (cancel, then dock).
 };
 
+/// What the host hears from the chassis ([robot.odometry] source).
+enum class OdometrySource : std::uint8_t {
+  kChassis = 0,  ///< The chassis firmware integrates its encoders and reports the pose (DockcoreBase::on_odometry).
+  kWheels = 1,   ///< Only the measured wheel speeds, integrated by the core as dockd does (DockcoreBase::on_wheels).
+};
+
 /// Everything one docking simulation needs.
 struct Scenario {
   std::string name;    ///< Scenario name (default: the file name without .toml).
@@ -171,6 +177,7 @@ struct Scenario {
 
   // Robot.
   ChassisParams chassis{};             ///< Drive geometry, motors, noise, footprint (pads), contacts, battery.
+  OdometrySource odometry_source = OdometrySource::kChassis;
   dockcore::DriveLimits limits{};      ///< Kinematics saturation and acceleration limits.
   dockcore::FootprintParams safety{};  ///< Obstacle check (derived from the footprint plus check areas).
   Pose2 lidar_mount{};                 ///< Lidar in the robot frame.

@@ -44,8 +44,13 @@ std::uint64_t trial_seed(std::uint64_t base, std::uint64_t index);
 dockcore::DriveGeometry core_drive_geometry(const DriveGeometry& g);
 /// The core's configuration for a scenario: estimator, task, footprint, lidar mount, drive geometry and limits,
 /// watchdog, and the control period (the simulator ticks every 4 chassis steps). The camera's tag fusion is the
-/// caller's (tag_fusion_params). O(1).
+/// caller's (tag_fusion_params). With odometry from wheel speeds the drive geometry is the one the robot believes
+/// (the chassis's radius and base errors applied), as a user would configure a robot whose dimensions are off. O(1).
 dockcore::DockcoreConfig core_config(const Scenario& sc);
+/// Hands the chassis's feedback at `now_us` to the core as the scenario's odometry source says: the chassis
+/// firmware's pose and the measured twist, or the measured wheel speeds (each scaled by its own believed radius
+/// over the common one, so a left/right radius difference reaches the core's odometry). O(1).
+void feed_chassis(dockcore::DockcoreBase& core, const Scenario& sc, const ChassisState& reported, std::uint64_t now_us);
 /// The body twist of the chassis's reported (measured) wheel speeds under dockcore's drive geometry `g`: what a host
 /// hands the core with the chassis's odometry pose (DockcoreBase::on_odometry). O(1).
 dockcore::Twist2 measured_twist(const dockcore::DriveGeometry& g, const ChassisState& reported);
