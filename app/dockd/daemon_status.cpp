@@ -1,0 +1,153 @@
+// dockd: the status — the JSON object every status reply and stream carries, and its publication on CAN and UDP.
+#include "daemon.hpp"
+#include "daemon_internal.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+
+namespace dockd {
+
+using namespace detail;  // the shared helpers (daemon_internal.hpp)
+
+using dockcore::FaultCode;
+using dockcore::HostCommandType;
+using dockcore::Pose2;
+using dockcore::Real;
+using dockcore::TaskState;
+using dockcore::drivers::HostErrorCode;
+using dockcore::drivers::HostRequest;
+using dockcore::drivers::HostRequestKind;
+
+void Daemon::publish_status(std::uint64_t now_us) {
+  const dockcore::TaskStatus& s = last_out_.status;
+  if (io_.can_host != nullptr) {
+    dockcore::hal::StatusMessage m;
+    m.task_state = static_cast<std::uint8_t>(s.state);
+    m.align_phase = s.phase;
+    // The watchdogs' codes are reported even while idle (the task manager faults only in active states).
+    m.fault_code = static_cast<std::uint16_t>(s.fault != FaultCode::kNone ? s.fault
+                                              : chassis_stale()           ? FaultCode::kChassisStale
+                                              : lidar_stale()             ? FaultCode::kLidarStale
+                                                                          : FaultCode::kNone);
+    m.retries = s.retries;
+    m.last_result = static_cast<std::uint8_t>(s.last_command);
+    m.dock_valid = s.dock_valid;
+    m.dock_in_robot = s.dock_pose;
+    m.stamp_us = now_us;
+    io_.can_host->send_status(m);
+  }
+  if (io_.udp_host != nullptr && io_.udp_host->subscriber_count() > 0) {
+    char buf[dockcore::drivers::kMaxHostReply];
+    const std::size_t n = status_json(buf, sizeof buf, now_us);
+    if (n > 0) io_.udp_host->publish(buf, n, now_us);
+  }
+  ++counters_.status_sent;
+}
+
+std::uint32_t Daemon::commands_rejected_total() const {
+  std::uint32_t n = counters_.commands_rejected;
+  if (io_.udp_host != nullptr) {
+    // Requests the UDP link refused before dockd saw them (it answered them itself): still host commands refused.
+    const auto& u = io_.udp_host->counters();
+    n += u.malformed + u.unknown_command + u.bad_field + u.too_long;
+  }
+  return n;
+}
+
+std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_us) const {
+  dockcore::drivers::JsonWriter w(buf, size);
+  status_fields(w, now_us);
+  return w.finish();
+}
+
+void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_us) const {
+  const dockcore::TaskStatus& s = last_out_.status;
+  const FaultCode watchdog_fault = chassis_stale() ? FaultCode::kChassisStale
+                                   : lidar_stale() ? FaultCode::kLidarStale
+                                                   : FaultCode::kNone;
+  const dockcore::hal::LidarCounters& lc = io_.lidar->counters();
+  const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
+  // The latest scan's detection decision: its evidence and each cue (for a miss, the best refused candidate's).
+  const dockcore::DockEstimate& e = core_->last_estimate();
+  double cues[dockcore::kEvidenceCueCount];
+  for (std::size_t i = 0; i < dockcore::kEvidenceCueCount; ++i) cues[i] = static_cast<double>(e.evidence.cue_nats[i]);
+  w.str("type", "status")
+      .uint("stamp_us", now_us)
+      .str("state", dockcore::to_string(s.state))
+      .uint("state_code", static_cast<unsigned>(s.state))
+      .uint("phase", s.phase)
+      .str("phase_name", s.state == TaskState::kAlign ? controller_->phase_name(s.phase) : "")
+      .uint("fault", static_cast<unsigned>(s.fault))
+      .str("fault_name", dockcore::to_string(s.fault))
+      .uint("watchdog_fault", static_cast<unsigned>(watchdog_fault))
+      .uint("retries", s.retries)
+      .uint("dock_id", s.dock_id)
+      .boolean("dock_valid", s.dock_valid)
+      .real("dock_x_m", static_cast<double>(s.dock_pose.x_m), 4)
+      .real("dock_y_m", static_cast<double>(s.dock_pose.y_m), 4)
+      .real("dock_yaw_deg", deg(s.dock_pose.yaw_rad), 2)
+      .str("last_command", dockcore::to_string(s.last_command))
+      .str("last_result", to_string_result(s.last_result))
+      .boolean("charge_enable", s.charge_enable)
+      .boolean("contact", fb_.charging_contact)
+      .real("charge_current_a", static_cast<double>(fb_.battery_current_a), 2)
+      .real("battery_v", static_cast<double>(fb_.battery_voltage_v), 2)
+      .real("soc", static_cast<double>(fb_.soc), 3)
+      .boolean("estop", fb_.estop)
+      .boolean("lidar_stale", lidar_stale())
+      .boolean("chassis_stale", chassis_stale())
+      .real("odom_x_m", static_cast<double>(odom_pose().x_m), 4)
+      .real("odom_y_m", static_cast<double>(odom_pose().y_m), 4)
+      .real("odom_yaw_deg", deg(odom_pose().yaw_rad), 2)
+      .real("cmd_vx_mps", static_cast<double>(core_->drive_cmd().vx_mps), 3)
+      .real("cmd_wz_radps", static_cast<double>(core_->drive_cmd().wz_radps), 3)
+      .boolean("teaching", teach_.active)
+      .boolean("taught", state_.find(s.dock_id) != nullptr)
+      .uint("ticks", stats_.ticks)
+      .uint("tick_worst_us", stats_.worst_period_us)
+      .uint("tick_overruns", stats_.overruns)
+      .uint("tick_work_worst_us", stats_.worst_work_us)
+      .uint("scans", counters_.scans)
+      .uint("detections", counters_.detections)
+      .uint("lidar_crc_errors", lc.crc_errors)
+      .uint("lidar_resyncs", lc.resyncs)
+      .uint("lidar_dropped_bytes", lc.dropped_bytes)
+      .uint("lidar_foreign_datagrams", lc.foreign_datagrams)
+      .uint("lidar_reconnects", lc.reconnects)
+      .uint("lidar_late_scans", core_->inputs().late_scans())
+      .uint("can_bad_frames", cc.bad_frames)
+      .uint("can_send_failures", cc.send_failures)
+      .uint("commands", counters_.commands)
+      .uint("commands_rejected", commands_rejected_total())
+      .uint("resumes", counters_.resumes)
+      .uint("can_host_rejected", io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u)
+      .uint("udp_not_allowed", io_.udp_host != nullptr ? io_.udp_host->counters().not_allowed : 0u)
+      .uint("config_reloads", counters_.config_reloads)
+      .uint("config_reloads_rejected", counters_.config_reloads_rejected)
+      .boolean("config_reload_pending", pending_cfg_ != nullptr)
+      .boolean("det_found", e.found)
+      .real("det_evidence_nats", static_cast<double>(e.evidence.total_nats), 1)
+      .reals("det_cues_nats", cues, dockcore::kEvidenceCueCount, 1)
+      .str("det_reject", e.found ? "none" : dockcore::to_string(e.reject))
+      .real("dock_evidence_nats", static_cast<double>(core_->filter().evidence_nats()), 1)
+      .boolean("dock_confirmed", core_->filter().confirmed());
+  // The optional groups go in only when they fit (the status must stay one datagram); each is dropped whole.
+  const auto optional = [&w](auto&& write) {
+    const std::size_t m = w.mark();
+    write();
+    if (!w.ok()) w.rollback(m);
+  };
+  // The tag fusion's counters (docs/camera.md, "Status").
+  if (io_.tags != nullptr) {
+    optional([&] {
+      w.uint("tag_fused", counters_.tags[0]).uints("tag_refused", counters_.tags + 1, dockcore::kTagStatusCount - 1);
+    });
+  }
+  // The stall watchdog's flag only, as for the lidar: the count is in the watchdog event.
+  if (io_.camera_frames != nullptr) optional([&] { w.boolean("camera_stalled", camera_stalled_); });
+  // The own camera's fields.
+  if (io_.camera_status != nullptr) optional([&] { io_.camera_status(io_.camera_status_ctx, w); });
+}
+
+}  // namespace dockd
