@@ -346,16 +346,18 @@ ReplayResult replay_loop_record(const std::string& path) {
       case LoopRecordKind::kScan: {
         ScanHeader sh;
         if (!read_as(p, 0, &sh)) return fail("scan record too short");
-        const std::size_t n = static_cast<std::size_t>(sh.count) * sizeof(Real);
+        if (sh.count > len / sizeof(Real)) return fail("scan record with more beams than bytes");
+        const std::size_t count = static_cast<std::size_t>(sh.count);
+        const std::size_t n = count * sizeof(Real);
         const bool with_intensities = len == sizeof sh + 2 * n;
         if (len != sizeof sh + n && !with_intensities) return fail("scan record of the wrong size");
-        ranges.resize(sh.count);
-        intensities.assign(sh.count, 0);
+        ranges.resize(count);
+        intensities.assign(count, 0);
         if (n > 0) std::memcpy(ranges.data(), p.data() + sizeof sh, n);
         if (with_intensities && n > 0) std::memcpy(intensities.data(), p.data() + sizeof sh + n, n);
         ScanView v{ranges.data(),
                    with_intensities ? intensities.data() : nullptr,
-                   static_cast<std::size_t>(sh.count),
+                   count,
                    sh.angle_min_rad,
                    sh.angle_increment_rad,
                    sh.view_stamp_us};
