@@ -10,7 +10,8 @@ bool Odometry::add_wheels(const DriveGeometry& geometry, const WheelSpeeds& meas
   if (valid_ && stamp_us > stamp_us_) {
     const std::uint64_t gap = stamp_us - stamp_us_;
     const Real dt = static_cast<Real>(gap < kMaxGapUs ? gap : 0u) * static_cast<Real>(1e-6);
-    const Real vx = (twist_.vx_mps + tw.vx_mps) / 2, vy = (twist_.vy_mps + tw.vy_mps) / 2;
+    const Real vx = (twist_.vx_mps + tw.vx_mps) / 2;
+    const Real vy = (twist_.vy_mps + tw.vy_mps) / 2;
     const Real wz = (twist_.wz_radps + tw.wz_radps) / 2;
     const Real yaw_mid = pose_.yaw_rad + wz * dt / 2;
     pose_.x_m += (vx * std::cos(yaw_mid) - vy * std::sin(yaw_mid)) * dt;

@@ -4,7 +4,9 @@ namespace dockcore {
 
 void InputWatch::reset() {
   const WatchdogParams p = p_;
-  const std::uint32_t late = late_scans_, lidar = lidar_trips_, chassis = chassis_trips_;
+  const std::uint32_t late = late_scans_;
+  const std::uint32_t lidar = lidar_trips_;
+  const std::uint32_t chassis = chassis_trips_;
   *this = InputWatch{};
   p_ = p;
   late_scans_ = late;
