@@ -11,17 +11,6 @@
 
 namespace dockd {
 
-using namespace detail;  // the shared helpers (daemon_internal.hpp)
-
-using dockcore::FaultCode;
-using dockcore::HostCommandType;
-using dockcore::Pose2;
-using dockcore::Real;
-using dockcore::TaskState;
-using dockcore::drivers::HostErrorCode;
-using dockcore::drivers::HostRequest;
-using dockcore::drivers::HostRequestKind;
-
 const char* to_string_result(dockcore::TaskResult r) {
   switch (r) {
     case dockcore::TaskResult::kNone:
@@ -41,10 +30,7 @@ const char* to_string_result(dockcore::TaskResult r) {
 Daemon::Daemon(const DockdConfig& config, const DaemonIo& io)
     : cfg_(config),
       io_(io),
-      seed000_(config.seed000),
-      seed004_(config.seed004),
-      seed003_(config.seed003),
-      smooth_(config.smooth),
+      controllers_(config.seed000, config.seed004, config.seed003, config.smooth),
       teach_storage_(std::make_unique<Teach>()),
       teach_(*teach_storage_) {
   build_core();
@@ -61,18 +47,9 @@ dockcore::drivers::LoopController Daemon::loop_controller() const {
 }
 
 void Daemon::build_core() {
-  seed000_ = dockcore::Seed000Controller(cfg_.seed000);
-  seed004_ = dockcore::Seed004Controller(cfg_.seed004);
-  seed003_ = dockcore::Seed003Controller(cfg_.seed003);
-  smooth_ = dockcore::SmoothController(cfg_.smooth);
-  if (cfg_.controller == "seed000")
-    controller_ = &seed000_;
-  else if (cfg_.controller == "seed004")
-    controller_ = &seed004_;
-  else if (cfg_.controller == "seed003")
-    controller_ = &seed003_;
-  else
-    controller_ = &smooth_;
+  controllers_ = dockcore::ControllerSet(cfg_.seed000, cfg_.seed004, cfg_.seed003, cfg_.smooth);
+  controller_ = controllers_.by_name(cfg_.controller.c_str());
+  if (controller_ == nullptr) controller_ = &controllers_.smooth;  // the config validates the name
   core_ = std::make_unique<dockcore::Dockcore>(*controller_);
   core_cfg_ = dockcore::DockcoreConfig{};
   core_cfg_.estimator = cfg_.estimator;

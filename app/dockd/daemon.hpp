@@ -272,11 +272,8 @@ class Daemon {
 
   DockdConfig cfg_;
   DaemonIo io_;
-  dockcore::Seed000Controller seed000_;
-  dockcore::Seed004Controller seed004_;
-  dockcore::Seed003Controller seed003_;
-  dockcore::SmoothController smooth_;
-  dockcore::DockingController* controller_ = nullptr;
+  dockcore::ControllerSet controllers_;
+  dockcore::DockingController* controller_ = nullptr;  ///< The configured one of controllers_.
   std::unique_ptr<dockcore::Dockcore> core_;
   std::unique_ptr<Teach> teach_storage_;
   Teach& teach_;

@@ -9,17 +9,6 @@
 
 namespace dockd {
 
-using namespace detail;  // the shared helpers (daemon_internal.hpp)
-
-using dockcore::FaultCode;
-using dockcore::HostCommandType;
-using dockcore::Pose2;
-using dockcore::Real;
-using dockcore::TaskState;
-using dockcore::drivers::HostErrorCode;
-using dockcore::drivers::HostRequest;
-using dockcore::drivers::HostRequestKind;
-
 std::uint32_t Daemon::hold_reply(const HostRequest& r) {
   // A free slot always exists: at most the queue's capacity of requests wait, plus the one being submitted.
   for (UdpReply& slot : replies_) {

@@ -1,5 +1,6 @@
 #pragma once
-// Helpers the daemon's source files share (daemon.cpp and daemon_*.cpp: one job each). Not part of dockd's interface.
+// Helpers and names the daemon's source files share (daemon.cpp and daemon_*.cpp: one job each). Not part of dockd's
+// interface.
 #include <cstdint>
 
 #include "daemon.hpp"
@@ -32,3 +33,18 @@ inline bool idle_state(dockcore::TaskState s) {
 }
 
 }  // namespace dockd::detail
+
+namespace dockd {
+
+// Every daemon source file uses these names unqualified.
+using namespace detail;
+using dockcore::FaultCode;
+using dockcore::HostCommandType;
+using dockcore::Pose2;
+using dockcore::Real;
+using dockcore::TaskState;
+using dockcore::drivers::HostErrorCode;
+using dockcore::drivers::HostRequest;
+using dockcore::drivers::HostRequestKind;
+
+}  // namespace dockd

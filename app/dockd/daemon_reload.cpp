@@ -8,17 +8,6 @@
 
 namespace dockd {
 
-using namespace detail;  // the shared helpers (daemon_internal.hpp)
-
-using dockcore::FaultCode;
-using dockcore::HostCommandType;
-using dockcore::Pose2;
-using dockcore::Real;
-using dockcore::TaskState;
-using dockcore::drivers::HostErrorCode;
-using dockcore::drivers::HostRequest;
-using dockcore::drivers::HostRequestKind;
-
 void Daemon::log_reload(std::uint64_t now_us, const char* result, const std::string& message, LogLevel level) {
   EventLine e(now_us, "config_reload");
   e.w.str("result", result).str_cut("message", message.c_str(), 1024);

@@ -8,17 +8,6 @@
 
 namespace dockd {
 
-using namespace detail;  // the shared helpers (daemon_internal.hpp)
-
-using dockcore::FaultCode;
-using dockcore::HostCommandType;
-using dockcore::Pose2;
-using dockcore::Real;
-using dockcore::TaskState;
-using dockcore::drivers::HostErrorCode;
-using dockcore::drivers::HostRequest;
-using dockcore::drivers::HostRequestKind;
-
 void Daemon::publish_status(std::uint64_t now_us) {
   const dockcore::TaskStatus& s = last_out_.status;
   if (io_.can_host != nullptr) {

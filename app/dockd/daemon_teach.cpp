@@ -8,17 +8,6 @@
 
 namespace dockd {
 
-using namespace detail;  // the shared helpers (daemon_internal.hpp)
-
-using dockcore::FaultCode;
-using dockcore::HostCommandType;
-using dockcore::Pose2;
-using dockcore::Real;
-using dockcore::TaskState;
-using dockcore::drivers::HostErrorCode;
-using dockcore::drivers::HostRequest;
-using dockcore::drivers::HostRequestKind;
-
 void Daemon::start_teach(const HostRequest& r, std::uint64_t now_us) {
   const std::uint16_t id = r.has_dock_id ? r.dock_id : cfg_.default_dock_id;
   if (cfg_.find_dock(id) == nullptr) {

@@ -24,8 +24,7 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
 
 void DockcoreBase::take_inputs(const DockcoreBase& from) {
   odometry_ = from.odometry_;
-  watch_ = from.watch_;
-  watch_.configure(config_.watchdog);
+  watch_ = from.watch_;  // configure() sets this core's thresholds
   queue_ = from.queue_;
   have_scan_ = from.have_scan_;
   last_scan_us_ = from.last_scan_us_;

@@ -43,6 +43,10 @@ struct ScanHeader {
   Real angle_increment_rad = 0;
 };
 
+// The largest record, a full scan, fits the buffer allocated at open(): nothing is allocated while recording.
+static_assert(kRecordHeader + sizeof(ScanHeader) + 2 * kMaxScanPoints * sizeof(Real) <= kBufferBytes,
+              "a kMaxScanPoints scan must fit the loop record's buffer");
+
 struct StampedWheels {
   WheelSpeeds wheels{};
   std::uint64_t stamp_us = 0;
@@ -134,7 +138,10 @@ void LoopRecordWriter::put(LoopRecordKind kind, const void* a, std::size_t na, c
     return;
   }
   if (len_ + kRecordHeader + n > buf_.size()) flush();
-  if (kRecordHeader + n > buf_.size()) buf_.resize(kRecordHeader + n);  // a scan larger than the buffer (once)
+  if (kRecordHeader + n > buf_.size()) {  // cannot happen for scans up to kMaxScanPoints (static_assert above)
+    ++write_errors_;
+    return;
+  }
   unsigned char* p = buf_.data() + len_;
   p[0] = static_cast<unsigned char>(kind);
   const std::uint32_t len = static_cast<std::uint32_t>(n);
@@ -226,21 +233,10 @@ void LoopRecordWriter::take_inputs() {
 
 namespace {
 
-/// The controllers of one core, built from a configure record's parameters.
+/// A core and its controllers, built from a configure record's parameters.
 struct ReplayCore {
-  explicit ReplayCore(const LoopController& c)
-      : seed000(c.seed000), seed004(c.seed004), seed003(c.seed003), smooth(c.smooth) {
-    const std::string name(c.name, strnlen(c.name, sizeof c.name));
-    DockingController* ctl = &smooth;
-    if (name == "seed000") ctl = &seed000;
-    if (name == "seed004") ctl = &seed004;
-    if (name == "seed003") ctl = &seed003;
-    core = std::make_unique<Dockcore>(*ctl);
-  }
-  Seed000Controller seed000;
-  Seed004Controller seed004;
-  Seed003Controller seed003;
-  SmoothController smooth;
+  explicit ReplayCore(const LoopController& c) : controllers(c.seed000, c.seed004, c.seed003, c.smooth) {}
+  ControllerSet controllers;
   std::unique_ptr<Dockcore> core;
 };
 
@@ -319,6 +315,10 @@ ReplayResult replay_loop_record(const std::string& path) {
         read_as(p, sizeof ctl + sizeof profile, &config);
         if (!rc || rebuild) {
           auto next = std::make_unique<ReplayCore>(ctl);
+          const std::string name(ctl.name, strnlen(ctl.name, sizeof ctl.name));
+          DockingController* const driven = next->controllers.by_name(name.c_str());
+          if (driven == nullptr) return fail("unknown controller '" + name + "'");
+          next->core = std::make_unique<Dockcore>(*driven);
           if (rc) next->core->take_inputs(*rc->core);
           rc = std::move(next);
           rebuild = false;

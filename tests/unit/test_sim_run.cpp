@@ -25,15 +25,20 @@ docksim::Scenario default_scenario() {
   return docksim::load_scenario_file(f + "/tools/scenarios/default.toml");
 }
 
+// Appends a timed event of `kind` lasting `duration_s` to the scenario's timeline.
+void add_event(docksim::Scenario& sc, docksim::EventKind kind, double t_s, double duration_s) {
+  docksim::ScenarioEvent ev;
+  ev.t_s = t_s;
+  ev.kind = kind;
+  ev.duration_s = duration_s;
+  sc.events.push_back(ev);
+}
+
 // The default scenario with a base command timeout and one host_stall event.
 docksim::Scenario host_stall_scenario(double command_timeout_s, double t_s, double duration_s) {
   docksim::Scenario sc = default_scenario();
   sc.chassis.motor.command_timeout_s = command_timeout_s;
-  docksim::ScenarioEvent ev;
-  ev.t_s = t_s;
-  ev.kind = docksim::EventKind::kHostStall;
-  ev.duration_s = duration_s;
-  sc.events.push_back(ev);
+  add_event(sc, docksim::EventKind::kHostStall, t_s, duration_s);
   return sc;
 }
 
@@ -140,11 +145,7 @@ TEST(SimRun, PushThenHostRedockRecovers) {
 
 TEST(SimRun, OneSecondOcclusionIsRecovered) {
   docksim::Scenario sc = default_scenario();
-  docksim::ScenarioEvent occ;
-  occ.t_s = 2.0;
-  occ.kind = docksim::EventKind::kOccludeDock;
-  occ.duration_s = 1.0;
-  sc.events.push_back(occ);
+  add_event(sc, docksim::EventKind::kOccludeDock, 2.0, 1.0);
   const docksim::StartPose start = docksim::start_from(sc, 1.5, 10 * kDeg, 0);
   docksim::SimOptions opt;
   opt.start = &start;
@@ -186,11 +187,7 @@ TEST(SimRun, OdometryFromWheelSpeedsDocksAsDockdWould) {
 // have been fresh for resume_after_ms issues the dock command again (its resume policy, as in dockd); it docks.
 TEST(SimRun, ALongLidarDropoutFaultsAndIsResumed) {
   docksim::Scenario sc = default_scenario();
-  docksim::ScenarioEvent drop;
-  drop.t_s = 3.0;
-  drop.kind = docksim::EventKind::kLidarDropout;
-  drop.duration_s = 2.0;
-  sc.events.push_back(drop);
+  add_event(sc, docksim::EventKind::kLidarDropout, 3.0, 2.0);
   const docksim::StartPose start = docksim::start_from(sc, 1.5, 10 * kDeg, 0);
   docksim::SimOptions opt;
   opt.start = &start;

@@ -1,6 +1,7 @@
 #include "dockcore/control/controllers.hpp"
 
 #include <cmath>
+#include <cstring>
 
 namespace dockcore {
 namespace {
@@ -513,6 +514,14 @@ ControlOutput SmoothController::step(const ControlInput& in) {
   o.cmd.vx_mps = p_.backwards ? -v : v;
   o.cmd.wz_radps = w;
   return o;
+}
+
+DockingController* ControllerSet::by_name(const char* name) {
+  DockingController* const all[] = {&seed000, &seed004, &seed003, &smooth};
+  for (DockingController* c : all) {
+    if (std::strcmp(c->name(), name) == 0) return c;
+  }
+  return nullptr;
 }
 
 }  // namespace dockcore

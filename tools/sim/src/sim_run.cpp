@@ -120,21 +120,6 @@ double clearance(const std::vector<P>& poly, bool is_disc, P disc_c, double disc
   return best;
 }
 
-struct Controllers {
-  explicit Controllers(const Scenario& sc) : s000(sc.seed000), s004(sc.seed004), s003(sc.seed003), smooth(sc.smooth) {}
-  dockcore::Seed000Controller s000;
-  dockcore::Seed004Controller s004;
-  dockcore::Seed003Controller s003;
-  dockcore::SmoothController smooth;
-  dockcore::DockingController* get(const std::string& name) {
-    if (name == "seed000") return &s000;
-    if (name == "seed004") return &s004;
-    if (name == "seed003") return &s003;
-    if (name == "smooth") return &smooth;
-    return nullptr;
-  }
-};
-
 std::string fault_text(int code) {
   return "fault " + std::to_string(code) + " " + dockcore::to_string(static_cast<dockcore::FaultCode>(code));
 }
@@ -321,8 +306,8 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   run.start = opt.start != nullptr ? *opt.start : draw_start(sc, seed);
   SimOutcome& out = run.outcome;
 
-  auto ctrls = std::make_unique<Controllers>(sc);
-  dockcore::DockingController* ctl = ctrls->get(controller);
+  auto ctrls = std::make_unique<dockcore::ControllerSet>(sc.seed000, sc.seed004, sc.seed003, sc.smooth);
+  dockcore::DockingController* ctl = ctrls->by_name(controller.c_str());
   if (ctl == nullptr) throw ScenarioError("unknown controller '" + controller + "'");
 
   // Dockcore is large (estimator buffers, a scan copy): heap, not stack.

@@ -290,4 +290,17 @@ class SmoothController final : public DockingController {
   Real stall_s_ = 0;
 };
 
+/// The four controllers, each with its parameters; a host drives one of them by name (dockd's `[controller] name`,
+/// a scenario's controller, a loop record's). The object owns them, so pointers from by_name() live as long as it.
+struct ControllerSet {
+  ControllerSet(const Seed000Params& p000, const Seed004Params& p004, const Seed003Params& p003, const SmoothParams& ps)
+      : seed000(p000), seed004(p004), seed003(p003), smooth(ps) {}
+  Seed000Controller seed000;
+  Seed004Controller seed004;
+  Seed003Controller seed003;
+  SmoothController smooth;
+  /// The controller called `name` ("seed000", "seed004", "seed003", "smooth"); nullptr for any other. O(1).
+  DockingController* by_name(const char* name);
+};
+
 }  // namespace dockcore
