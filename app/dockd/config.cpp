@@ -172,7 +172,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   // The core structs' keys, with their bounds, come from the parameter table (the same as dock-sim's scenarios).
   namespace params = dockcore::params;
   const params::ParamTargets targets{&c.drive,   &c.limits,  &c.footprint, &c.task,       &c.estimator, &c.seed000,
-                                     &c.seed004, &c.seed003, &c.smooth,    &c.tag_fusion, &c.watchdog};
+                                     &c.seed004, &c.seed003, &c.smooth,    &c.tag_fusion, &c.watchdog,  &c.deadband};
   auto table_keys = [&](const std::string& table, Handlers h) {
     params::add_params(p, h, table, targets, params::kDockd);
     return h;
@@ -233,6 +233,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
         {"pad_side", [&](const toml::node& n) { pad_side = p.choice(n, {"front", "rear"}); }},
     });
     h.emplace_back("limits", params::param_sub(p, "robot.limits", targets, params::kDockd));
+    h.emplace_back("deadband", params::param_sub(p, "robot.deadband", targets, params::kDockd));
     h.emplace_back("footprint", p.sub("robot.footprint.", [&]() {
       return table_keys("robot.footprint", Handlers{
           {"self_sectors_deg", [&](const toml::node& n) { self_sectors(p, n, c.footprint); }},

@@ -14,6 +14,7 @@
 #include "dockcore/control/controllers.hpp"
 #include "dockcore/control/kinematics.hpp"
 #include "dockcore/control/safety.hpp"
+#include "dockcore/control/wheel_deadband.hpp"
 #include "dockcore/drivers/can_link.hpp"
 #include "dockcore/drivers/lidar_driver.hpp"
 #include "dockcore/drivers/udp_camera.hpp"
@@ -117,6 +118,7 @@ struct DockdConfig {
 
   // [watchdog]
   dockcore::WatchdogParams watchdog{};         ///< [watchdog]: the core's input watch (the parameter table).
+  dockcore::WheelDeadbandParams deadband{};    ///< [robot.deadband]: the drive's wheel deadband (the parameter table).
   std::uint32_t systemd_watchdog_divider = 2;  ///< WATCHDOG=1 every WatchdogSec / this.
 
   // [state]

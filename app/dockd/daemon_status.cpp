@@ -61,6 +61,15 @@ void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_u
   const dockcore::DockEstimate& e = core_->last_estimate();
   double cues[dockcore::kEvidenceCueCount];
   for (std::size_t i = 0; i < dockcore::kEvidenceCueCount; ++i) cues[i] = static_cast<double>(e.evidence.cue_nats[i]);
+  // The wheel deadband the output shaping applies, per wheel, forward and backward.
+  const dockcore::WheelDeadband& db = core_->deadband();
+  const std::size_t wheels = dockcore::drive_wheel_count(core_->config().drive.kind);
+  double db_fwd[dockcore::kMaxDriveWheels];
+  double db_rev[dockcore::kMaxDriveWheels];
+  for (std::size_t i = 0; i < wheels; ++i) {
+    db_fwd[i] = static_cast<double>(db.floor_radps(i, false));
+    db_rev[i] = static_cast<double>(db.floor_radps(i, true));
+  }
   w.str("type", "status")
       .uint("stamp_us", now_us)
       .str("state", dockcore::to_string(s.state))
@@ -91,6 +100,9 @@ void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_u
       .real("odom_yaw_deg", deg(odom_pose().yaw_rad), 2)
       .real("cmd_vx_mps", static_cast<double>(core_->drive_cmd().vx_mps), 3)
       .real("cmd_wz_radps", static_cast<double>(core_->drive_cmd().wz_radps), 3)
+      .reals("deadband_fwd_radps", db_fwd, wheels, 2)
+      .reals("deadband_rev_radps", db_rev, wheels, 2)
+      .uint("deadband_raises", db.raises())
       .boolean("teaching", teach_.active)
       .boolean("taught", state_.find(s.dock_id) != nullptr)
       .uint("ticks", stats_.ticks)

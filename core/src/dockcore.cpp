@@ -1,5 +1,7 @@
 #include "dockcore/dockcore.hpp"
 
+#include <cmath>
+
 namespace dockcore {
 
 bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& config) {
@@ -19,6 +21,9 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
   last_estimate_ = DockEstimate{};
   prev_state_ = TaskState::kNotTasking;
   prev_drive_cmd_ = Twist2{};
+  sent_drive_cmd_ = Twist2{};
+  sent_wheels_ = WheelSpeeds{};
+  deadband_.configure(config.deadband);
   return estimator_.configure(profile, config.estimator);
 }
 
@@ -212,6 +217,7 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
   pending_count_ = 0;
 
   static_cast<TaskOutput&>(out) = tasks_.tick(t);
+  observe_drive(in, before, t);
   shape(watch_.hold(), &out);
   // A new dock task: forget the old dock (the robot may have been carried since), so the push test and the
   // controller start from this task's own detections. A resumed one keeps the pre-outage estimate for the push test.
@@ -274,6 +280,19 @@ void DockcoreBase::resume_policy(TaskState before, bool have_cmd, const QueuedCo
   out->resumes = resumes_;
 }
 
+void DockcoreBase::observe_drive(const TickInput& in, TaskState state, const TaskInput& t) {
+  // A stall may be the drive's deadband only while the robot moves freely: not on the contacts, not with stale
+  // feedback, not in a state that stands still, and not with its edge at the dock's face (pressing a misaligned dock
+  // is no deadband).
+  const bool moving_state = state == TaskState::kReachTaskingPoint || state == TaskState::kAlign ||
+                            state == TaskState::kRetry || state == TaskState::kUndocking;
+  const Real edge_m = config_.footprint.shape == FootprintShape::kCircular ? config_.footprint.radius_m
+                                                                           : config_.footprint.half_length_m;
+  const bool at_dock = t.dock.valid && std::fabs(t.dock.pose.x_m) - edge_m < kDeadbandDockClearanceM;
+  const bool learn = moving_state && !in.contact && !watch_.hold() && !at_dock;
+  deadband_.observe(sent_wheels_, twist_to_wheels(config_.drive, odometry_.twist()), in.now_us, learn);
+}
+
 void DockcoreBase::shape(bool hold, TickOutput* out) {
   Twist2 c{};
   const Twist2& want = out->cmd;
@@ -283,8 +302,14 @@ void DockcoreBase::shape(bool hold, TickOutput* out) {
     c = limit_acceleration(config_.limits, prev_drive_cmd_, c, config_.control_period_s);
   }
   prev_drive_cmd_ = c;
+  // Raised above the wheels' deadband as a whole: the path keeps its curvature and is driven faster, not left
+  // unexecuted (the limiter keeps ramping the command the controller asked for).
+  const Real s = deadband_.scale(config_.drive, config_.limits, c);
+  c = Twist2{c.vx_mps * s, c.vy_mps * s, c.wz_radps * s};
   out->drive_cmd = c;
   out->wheels = twist_to_wheels(config_.drive, c);
+  sent_drive_cmd_ = c;
+  sent_wheels_ = out->wheels;
 }
 
 }  // namespace dockcore

@@ -183,6 +183,32 @@ TEST(SimRun, OdometryFromWheelSpeedsDocksAsDockdWould) {
   CHECK(c.outcome.time_to_charging_s != r.outcome.time_to_charging_s || c.outcome.lateral_m != r.outcome.lateral_m);
 }
 
+// A heavy base whose wheels do not turn below 0.8 rad/s, more than the 0.6 rad/s the creep asks for, with a long
+// command latency and a slow motor: the core learns the deadband from the wheel speeds the chassis reports and the
+// creep reaches the contacts, on both odometry paths. Not adapting (and not told), the robot stops short.
+TEST(SimRun, AHeavyBaseWithAWideDeadbandDocksOnceTheCoreHasLearnedIt) {
+  docksim::Scenario sc = default_scenario();
+  sc.chassis.motor.deadband_radps = 0.8;
+  sc.chassis.motor.latency_steps = 12;  // 60 ms
+  sc.chassis.motor.time_constant_s = 0.2;
+  const docksim::StartPose start = docksim::start_from(sc, 1.5, 15 * kDeg, -10 * kDeg);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  for (const docksim::OdometrySource src : {docksim::OdometrySource::kChassis, docksim::OdometrySource::kWheels}) {
+    sc.odometry_source = src;
+    const docksim::SimRun r = docksim::run_docking(sc, "smooth", 5, opt);
+    check_docked(r);
+    CHECK(r.outcome.faults.empty());
+  }
+  sc.odometry_source = docksim::OdometrySource::kChassis;
+  sc.deadband.adapt = false;
+  const docksim::SimRun stuck = docksim::run_docking(sc, "smooth", 5, opt);
+  CHECK(!stuck.outcome.charging_confirmed);
+  // Told the deadband instead, it docks without learning.
+  sc.deadband.known_radps = 0.8;
+  check_docked(docksim::run_docking(sc, "smooth", 5, opt));
+}
+
 // A lidar dropout longer than lidar_stale_ms + fault_after_ms: the core holds the robot, faults 185, and once scans
 // have been fresh for resume_after_ms issues the dock command again (its resume policy, as in dockd); it docks.
 TEST(SimRun, ALongLidarDropoutFaultsAndIsResumed) {

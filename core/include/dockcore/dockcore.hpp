@@ -47,6 +47,7 @@
 #include "dockcore/control/kinematics.hpp"
 #include "dockcore/control/odometry.hpp"
 #include "dockcore/control/safety.hpp"
+#include "dockcore/control/wheel_deadband.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
@@ -71,6 +72,7 @@ struct DockcoreConfig {
   /// The control tick's nominal period, s: the acceleration limit's step. > 0.
   Real control_period_s = static_cast<Real>(0.02);
   WatchdogParams watchdog{};  ///< When scans and chassis feedback count as stale.
+  WheelDeadbandParams deadband{};  ///< The drive's wheel deadband: known, and learned while docking (WheelDeadband).
   /// A resumed dock command (the resume policy's) keeps the dock estimate from before the outage as the push test's
   /// reference when its last detection is at most this old at the resume (s). Wheel odometry runs through a lidar
   /// outage, so the old estimate carried by odometry still says where the dock must be; beyond this, odometry drift
@@ -180,9 +182,15 @@ class DockcoreBase {
   const DockcoreConfig& config() const { return config_; }
   /// The host sent the drive a zero command outside tick() (shutdown, a stop of its own): the next tick's
   /// acceleration limit starts from rest. O(1).
-  void note_drive_stopped() { prev_drive_cmd_ = Twist2{}; }
+  void note_drive_stopped() {
+    prev_drive_cmd_ = Twist2{};
+    sent_drive_cmd_ = Twist2{};
+    sent_wheels_ = WheelSpeeds{};
+  }
   /// drive_cmd of the last tick. O(1).
-  const Twist2& drive_cmd() const { return prev_drive_cmd_; }
+  const Twist2& drive_cmd() const { return sent_drive_cmd_; }
+  /// The wheel deadband the output shaping applies: its floors and how often they grew. O(1).
+  const WheelDeadband& deadband() const { return deadband_; }
   /// Detections that did not fit into one tick's list (more than kMaxDetectionsPerTick scans between two ticks).
   std::uint32_t detections_dropped() const { return pending_dropped_; }
 
@@ -198,6 +206,11 @@ class DockcoreBase {
  private:
   /// Fills out->drive_cmd and out->wheels from out->cmd (file comment). O(1).
   void shape(bool hold, TickOutput* out);
+  /// Hands the deadband the last command and the measured wheel speeds; `state` is the task's state that command was
+  /// given in, `t` this tick's task input (the dock estimate). O(wheels).
+  void observe_drive(const TickInput& in, TaskState state, const TaskInput& t);
+  /// The robot's edge closer than this to the dock's face: a stall there may be the dock holding it, m.
+  static constexpr Real kDeadbandDockClearanceM = static_cast<Real>(0.01);
   /// The resume policy's bookkeeping after the task manager's tick: what the taken command started or stopped, and
   /// which fault left a command to resume (file comment). O(1).
   void resume_policy(TaskState before, bool have_cmd, const QueuedCommand& cmd, TickOutput* out);
@@ -230,7 +243,10 @@ class DockcoreBase {
   bool have_tag_ = false;
   std::uint64_t last_tag_us_ = 0;  ///< Newest tag frame past the id and order checks.
   TaskState prev_state_ = TaskState::kNotTasking;
-  Twist2 prev_drive_cmd_{};  ///< drive_cmd of the previous tick: the acceleration limit's start.
+  Twist2 prev_drive_cmd_{};    ///< The previous tick's command before the deadband: the acceleration limit's start.
+  Twist2 sent_drive_cmd_{};    ///< drive_cmd of the previous tick (after the deadband).
+  WheelSpeeds sent_wheels_{};  ///< wheels of the previous tick: what the measured wheel speeds are compared with.
+  WheelDeadband deadband_{};
   bool filter_confirmed_ = false;  ///< The filter fused a detection since its last (re)initialisation.
   /// The confirmed estimate from before the filter's most recent restart (this task), for a resumed command.
   bool restart_ref_set_ = false;

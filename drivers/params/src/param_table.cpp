@@ -251,6 +251,16 @@ const ParamSpec kTable[] = {
     DC_INT("watchdog", "max_resumes", "–", 0, 20, kBoth, watchdog, max_resumes,
            "Resumes per task; then the fault stays."),
 
+    // [robot.deadband]: WheelDeadbandParams, the output shaping's wheel deadband (docs/architecture.md).
+    DC_REAL("robot.deadband", "known_radps", "rad/s", 0, 20, kBoth, deadband, known_radps,
+            "Wheel deadband the drive is known to have: slower commands are scaled up to it (0: none known)."),
+    DC_BOOL("robot.deadband", "adapt", kBoth, deadband, adapt,
+            "Learn a larger deadband per wheel and direction from commanded versus measured wheel speeds."),
+    DC_REAL("robot.deadband", "max_radps", "rad/s", 0, 20, kBoth, deadband, max_radps,
+            "Largest deadband learned: bounds how fast the slowest creep can become."),
+    DC_INT("robot.deadband", "stall_ms", "ms", 50, 10000, kBoth, deadband, stall_ms,
+           "A wheel turning at under a quarter of its command this long has stalled: its deadband grows by 25 %."),
+
     // [task]: TaskParams (docs/task-manager.md).
     DC_REAL("task", "detect_wait_s", "s", 0, 60, kBoth, task, detect_wait_s,
             "Stand still this long for a detection before swinging."),
@@ -530,8 +540,9 @@ std::string markdown_table(const std::string& table, ParamUse use) {
   SmoothParams smooth;
   TagFusionParams tag_fusion;
   WatchdogParams watchdog;
+  WheelDeadbandParams deadband;
   const ParamTargets defaults{&drive,   &limits,  &footprint, &task,       &estimator, &seed000,
-                              &seed004, &seed003, &smooth,    &tag_fusion, &watchdog};
+                              &seed004, &seed003, &smooth,    &tag_fusion, &watchdog,  &deadband};
   apply_defaults(defaults, use);
   std::ostringstream out;
   bool any = false;

@@ -186,7 +186,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   // obstacle footprint's body is derived from the chassis below.
   namespace params = dockcore::params;
   const params::ParamTargets targets{nullptr,     &sc.limits,  &sc.safety, &sc.task,       &sc.estimator, &sc.seed000,
-                                     &sc.seed004, &sc.seed003, &sc.smooth, &sc.tag_fusion, &sc.watchdog};
+                                     &sc.seed004, &sc.seed003, &sc.smooth, &sc.tag_fusion, &sc.watchdog,  &sc.deadband};
   params::apply_defaults(targets, params::kScenario);
   auto table_keys = [&](const std::string& table, Handlers h) {
     params::add_params(p, h, table, targets, params::kScenario);
@@ -205,6 +205,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
     h.emplace_back("lx_m", params::bounded_by(p, "robot", "half_wheelbase_m", &c.geometry.lx_m));
     h.emplace_back("ly_m", params::bounded_by(p, "robot", "half_track_m", &c.geometry.ly_m));
     h.emplace_back("limits", params::param_sub(p, "robot.limits", targets, params::kScenario));
+    h.emplace_back("deadband", params::param_sub(p, "robot.deadband", targets, params::kScenario));
     h.emplace_back("footprint", p.sub("robot.footprint.", [&]() {
       FootprintParams& f = c.footprint;
       // The table's keys (shape, check area, margins) plus the chassis outline the obstacle check's body comes from.

@@ -179,6 +179,7 @@ dockcore::DockcoreConfig core_config(const Scenario& sc) {
   cfg.limits = sc.limits;
   cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
   cfg.watchdog = sc.watchdog;
+  cfg.deadband = sc.deadband;
   return cfg;
 }
 

@@ -15,6 +15,7 @@
 #include "dockcore/control/controllers.hpp"
 #include "dockcore/control/kinematics.hpp"
 #include "dockcore/control/safety.hpp"
+#include "dockcore/control/wheel_deadband.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_profile.hpp"
@@ -185,6 +186,7 @@ struct Scenario {
   DockTagSpec dock_tag{};
   dockcore::TagFusionParams tag_fusion{};  ///< [camera.fusion]: the tag covariance model (the parameter table).
   dockcore::WatchdogParams watchdog{};     ///< [watchdog]: the core's input watch (the parameter table).
+  dockcore::WheelDeadbandParams deadband{};  ///< [robot.deadband]: what dockcore knows and learns of the deadband.
 
   // Lidar.
   LidarModel lidar{};

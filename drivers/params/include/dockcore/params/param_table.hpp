@@ -14,6 +14,7 @@
 #include "dockcore/control/controllers.hpp"
 #include "dockcore/control/kinematics.hpp"
 #include "dockcore/control/safety.hpp"
+#include "dockcore/control/wheel_deadband.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
 #include "dockcore/task/input_watch.hpp"
@@ -50,6 +51,7 @@ struct ParamTargets {
   SmoothParams* smooth = nullptr;
   TagFusionParams* tag_fusion = nullptr;  ///< dockd only: [camera.fusion].
   WatchdogParams* watchdog = nullptr;
+  WheelDeadbandParams* deadband = nullptr;
 };
 
 /// One parameter.

@@ -1,0 +1,75 @@
+#pragma once
+/// @file WheelDeadband: keeps slow commands moving on a drive whose wheels do not turn below some speed (PWM drives
+/// that do not overcome static friction, stiction, a heavy base). Part of the core's output shaping
+/// (docs/architecture.md, "The control tick").
+///
+/// Each wheel and direction has a floor, rad/s: the slowest command it is known to execute. A command whose turning
+/// wheels sit below their floors is scaled up as a whole, so the path's curvature is kept and the robot still moves
+/// along it, faster. The floors start at the configured deadband and, when adapting, grow from what the drive does:
+/// a wheel commanded at or above its floor that keeps turning at under a quarter of the command for `stall_ms` is
+/// stalled, and its floor becomes 1.25 × the smallest command of that stall, never more than `max_radps`. The caller
+/// judges when a stall may be the drive's (not the dock or an obstacle holding the robot). No heap; O(wheels) per call.
+
+#include <cstdint>
+
+#include "dockcore/control/kinematics.hpp"
+#include "dockcore/geometry.hpp"
+
+namespace dockcore {
+
+/// How dockcore treats the drive's wheel deadband ([robot.deadband] in dockd's config and scenarios).
+struct WheelDeadbandParams {
+  /// Deadband the drive is known to have, rad/s (0: none known): the starting floor of every wheel and direction.
+  Real known_radps = 0;
+  /// Learn larger floors per wheel and direction from commanded versus measured wheel speeds.
+  bool adapt = true;
+  /// Largest floor learned, rad/s: bounds how fast the slowest creep can become (floor × wheel radius).
+  Real max_radps = static_cast<Real>(1.5);
+  /// How long a wheel must be stalled before its floor grows, ms. Longer than the drive's latency plus its motors'
+  /// rise time, so a drive that is only slow to follow is not taken for a stalled one.
+  std::uint16_t stall_ms = 500;
+};
+
+class WheelDeadband {
+ public:
+  /// A measured wheel speed under this share of the command counts as not following it.
+  static constexpr Real kStallShare = static_cast<Real>(0.25);
+  /// A stalled wheel's floor becomes this times the smallest command of the stall.
+  static constexpr Real kGrowth = static_cast<Real>(1.25);
+  /// Wheels turning slower than this share of the fastest one are meant to stand nearly still (a pivot): they are
+  /// left in the deadband rather than speeding the whole command up without bound.
+  static constexpr Real kPivotShare = static_cast<Real>(0.25);
+
+  /// Takes the parameters and forgets what was learned: every floor is known_radps (clamped to max_radps when
+  /// adapting, to [0, ∞) always). O(wheels).
+  void configure(const WheelDeadbandParams& params);
+
+  /// The factor s >= 1 by which `twist` must be scaled so that every wheel of twist_to_wheels(geometry, twist) that
+  /// turns at kPivotShare of the fastest one or more reaches its floor, limited so that no wheel exceeds
+  /// limits.max_wheel_radps (when set). 1 for a zero twist or when no floor binds. O(wheels).
+  Real scale(const DriveGeometry& geometry, const DriveLimits& limits, const Twist2& twist) const;
+
+  /// One control tick's observation, at `now_us`: the wheel speeds the drive was last commanded and those it
+  /// measured since (same order and count). `learn` false (the robot may be held by the dock, an obstacle, a
+  /// push; the feedback is stale) ends any stall in progress without learning. O(wheels).
+  void observe(const WheelSpeeds& commanded, const WheelSpeeds& measured, std::uint64_t now_us, bool learn);
+
+  /// The floor of `wheel` (< kMaxDriveWheels) for forward (`reverse` false) or backward rotation, rad/s. O(1).
+  Real floor_radps(std::size_t wheel, bool reverse) const { return floor_radps_[wheel][reverse ? 1 : 0]; }
+  /// Times a floor grew since configure(). O(1).
+  std::uint32_t raises() const { return raises_; }
+
+ private:
+  struct Stall {
+    bool active = false;
+    bool reverse = false;
+    std::uint64_t since_us = 0;
+    Real min_command_radps = 0;
+  };
+  WheelDeadbandParams params_{};
+  Real floor_radps_[kMaxDriveWheels][2] = {};
+  Stall stall_[kMaxDriveWheels] = {};
+  std::uint32_t raises_ = 0;
+};
+
+}  // namespace dockcore

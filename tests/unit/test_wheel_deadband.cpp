@@ -1,0 +1,141 @@
+// core wheel deadband: scaling a command above the floors while keeping its curvature, the pivot and wheel-limit
+// caps, and learning a floor from a stalled wheel (per wheel and direction, bounded, never while told not to).
+#include <cmath>
+#include <cstdint>
+
+#include "dockcore/control/kinematics.hpp"
+#include "dockcore/control/wheel_deadband.hpp"
+
+#include <CppUTest/TestHarness.h>
+
+using namespace dockcore;
+
+namespace {
+
+constexpr std::uint64_t kMs = 1000;
+constexpr double kTol = 1e-5;
+
+DriveGeometry diff_drive() {
+  DriveGeometry g;
+  g.kind = DriveKind::kDifferential;
+  g.wheel_radius_m = static_cast<Real>(0.05);
+  g.wheel_base_m = static_cast<Real>(0.30);
+  return g;
+}
+
+WheelSpeeds wheels(Real left, Real right) {
+  WheelSpeeds w;
+  w.count = 2;
+  w.radps[0] = left;
+  w.radps[1] = right;
+  return w;
+}
+
+/// Feeds `commanded` and `measured` every 20 ms from `t0_us` for `duration_ms`; returns the time after the last.
+std::uint64_t hold(WheelDeadband& d, const WheelSpeeds& commanded, const WheelSpeeds& measured, std::uint64_t t0_us,
+                   std::uint64_t duration_ms, bool learn = true) {
+  std::uint64_t t = t0_us;
+  for (; t <= t0_us + duration_ms * kMs; t += 20 * kMs) d.observe(commanded, measured, t, learn);
+  return t;
+}
+
+}  // namespace
+
+TEST_GROUP(WheelDeadband){};
+
+TEST(WheelDeadband, NoFloorLeavesEveryCommandAlone) {
+  WheelDeadband d;
+  d.configure(WheelDeadbandParams{});
+  const Twist2 creep{static_cast<Real>(0.01), 0, static_cast<Real>(0.02)};
+  DOUBLES_EQUAL(1.0, static_cast<double>(d.scale(diff_drive(), DriveLimits{}, creep)), kTol);
+  DOUBLES_EQUAL(1.0, static_cast<double>(d.scale(diff_drive(), DriveLimits{}, Twist2{})), kTol);
+}
+
+TEST(WheelDeadband, AKnownFloorScalesTheWholeCommandAndKeepsItsCurvature) {
+  WheelDeadbandParams p;
+  p.known_radps = static_cast<Real>(0.8);
+  WheelDeadband d;
+  d.configure(p);
+  const DriveGeometry g = diff_drive();
+  // 0.03 m/s on a 3 1/m curve: wheels 0.33 and 0.87 rad/s; the inner one must reach 0.8.
+  const Twist2 c{static_cast<Real>(0.03), 0, static_cast<Real>(0.09)};
+  const Real s = d.scale(g, DriveLimits{}, c);
+  const WheelSpeeds w = twist_to_wheels(g, Twist2{c.vx_mps * s, 0, c.wz_radps * s});
+  DOUBLES_EQUAL(0.8, static_cast<double>(w.radps[0]), kTol);
+  CHECK(w.radps[1] > static_cast<Real>(0.8));
+  DOUBLES_EQUAL(static_cast<double>(c.wz_radps / c.vx_mps), static_cast<double>((c.wz_radps * s) / (c.vx_mps * s)),
+                kTol);
+  // Fast enough already: untouched.
+  DOUBLES_EQUAL(1.0, static_cast<double>(d.scale(g, DriveLimits{}, Twist2{static_cast<Real>(0.2), 0, 0})), kTol);
+  // Backwards: the reverse floors apply.
+  const Real back = d.scale(g, DriveLimits{}, Twist2{static_cast<Real>(-0.02), 0, 0});
+  DOUBLES_EQUAL(0.8 / 0.4, static_cast<double>(back), kTol);
+}
+
+TEST(WheelDeadband, APivotingWheelStaysInTheDeadbandAndTheWheelLimitCapsTheScale) {
+  WheelDeadbandParams p;
+  p.known_radps = static_cast<Real>(0.8);
+  WheelDeadband d;
+  d.configure(p);
+  const DriveGeometry g = diff_drive();
+  // Nearly a pivot about the left wheel: only the right wheel sets the scale.
+  const Twist2 pivot{static_cast<Real>(0.01), 0, static_cast<Real>(0.0625)};  // wheels ≈ 0.0125 and 0.3875 rad/s
+  const Real s = d.scale(g, DriveLimits{}, pivot);
+  const WheelSpeeds w = twist_to_wheels(g, Twist2{pivot.vx_mps * s, 0, pivot.wz_radps * s});
+  DOUBLES_EQUAL(0.8, static_cast<double>(w.radps[1]), kTol);
+  CHECK(std::fabs(w.radps[0]) < static_cast<Real>(0.8));
+  DriveLimits lim;
+  lim.max_wheel_radps = static_cast<Real>(0.5);
+  const Real capped = d.scale(g, lim, Twist2{static_cast<Real>(0.01), 0, 0});  // wheels 0.2 rad/s
+  DOUBLES_EQUAL(2.5, static_cast<double>(capped), kTol);
+}
+
+TEST(WheelDeadband, AStalledWheelRaisesItsOwnFloorForItsOwnDirectionOnly) {
+  WheelDeadband d;
+  d.configure(WheelDeadbandParams{});
+  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  // The left wheel stands, the right one follows.
+  const std::uint64_t t = hold(d, cmd, wheels(0, static_cast<Real>(0.58)), 0, 480);
+  DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(0, false)), kTol);  // not yet stall_ms
+  hold(d, cmd, wheels(0, static_cast<Real>(0.58)), t, 40);
+  DOUBLES_EQUAL(0.75, static_cast<double>(d.floor_radps(0, false)), kTol);  // 1.25 × 0.6
+  DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(0, true)), kTol);
+  DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(1, false)), kTol);
+  LONGS_EQUAL(1, d.raises());
+}
+
+TEST(WheelDeadband, AWheelSlowToFollowOrToldNotToLearnIsNoStall) {
+  WheelDeadband d;
+  d.configure(WheelDeadbandParams{});
+  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  // Standing for 300 ms (latency and motor lag), then following: the stall never lasts stall_ms.
+  std::uint64_t t = hold(d, cmd, wheels(0, 0), 0, 300);
+  t = hold(d, cmd, wheels(static_cast<Real>(0.5), static_cast<Real>(0.5)), t, 2000);
+  // Held by something the caller knows of (the dock, an obstacle): nothing is learned however long.
+  hold(d, cmd, wheels(0, 0), t, 5000, false);
+  LONGS_EQUAL(0, d.raises());
+  DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(0, false)), kTol);
+}
+
+TEST(WheelDeadband, FloorsGrowStepByStepUpToTheBoundAndConfigureForgetsThem) {
+  WheelDeadbandParams p;
+  p.max_radps = static_cast<Real>(1.0);
+  WheelDeadband d;
+  d.configure(p);
+  const DriveGeometry g = diff_drive();
+  const Twist2 creep{static_cast<Real>(-0.03), 0, 0};  // backing in: 0.6 rad/s on both wheels, backwards
+  std::uint64_t t = 0;
+  for (int k = 0; k < 10; ++k) {
+    const Real s = d.scale(g, DriveLimits{}, creep);
+    const WheelSpeeds sent = twist_to_wheels(g, Twist2{creep.vx_mps * s, 0, 0});
+    t = hold(d, sent, wheels(0, 0), t, 520);  // a drive that never moves
+  }
+  DOUBLES_EQUAL(1.0, static_cast<double>(d.floor_radps(0, true)), kTol);
+  DOUBLES_EQUAL(1.0, static_cast<double>(d.floor_radps(1, true)), kTol);
+  DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(0, false)), kTol);
+  // 0.6 → 0.75 → 0.9375 → 1.0 (bound) on each wheel, then no more.
+  LONGS_EQUAL(6, d.raises());
+  d.configure(p);
+  DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(0, true)), kTol);
+  LONGS_EQUAL(0, d.raises());
+}
