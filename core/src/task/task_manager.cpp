@@ -63,6 +63,7 @@ bool is_zero(const Twist2& t) { return t.vx_mps == 0 && t.vy_mps == 0 && t.wz_ra
 void TaskManager::configure(const TaskParams& params, const FootprintParams& footprint, const DockProfile& profile) {
   params_ = params;
   obstacles_.configure(footprint, &profile);
+  edge_m_ = footprint.shape == FootprintShape::kCircular ? footprint.radius_m : footprint.half_length_m;
   state_ = TaskState::kNotTasking;
   fault_ = FaultCode::kNone;
   faulted_in_ = TaskState::kNotTasking;
@@ -79,7 +80,13 @@ Real TaskManager::since_s(std::uint64_t t_us, const TaskInput& in) {
 }
 
 bool TaskManager::dock_fresh(const TaskInput& in) const {
-  return in.dock.valid && since_s(in.dock.stamp_us, in) <= params_.target_lost_after_s;
+  if (!in.dock.valid) return false;
+  const Real age_s = since_s(in.dock.stamp_us, in);
+  if (age_s <= params_.target_lost_after_s) return true;
+  // The last stretch: odometry carries a confirmed estimate over a few centimetres with sub-millimetre error, while
+  // the lidar may see only the dock's face from there.
+  return state_ == TaskState::kAlign && in.dock.confirmed && age_s <= params_.blind_finish_max_s &&
+         std::fabs(in.dock.pose.x_m) - edge_m_ <= params_.blind_finish_m;
 }
 
 void TaskManager::enter(TaskState s, const TaskInput& in) {

@@ -88,6 +88,11 @@ struct TaskParams {
   // Target loss (ALIGN).
   Real target_lost_after_s = static_cast<Real>(0.5);  ///< Estimate older than this: stop and wait.
   Real target_lost_timeout_s = static_cast<Real>(5.0);///< Lost this long: fault 181.
+  /// The last stretch: with the robot's edge (footprint half-length or radius) this close to the dock's face, a
+  /// confirmed estimate carried by odometry stays current for up to blind_finish_max_s, m (0: off). A lidar near the
+  /// robot's front comes too close to see more than the dock's flat face, which fixes no lateral position.
+  Real blind_finish_m = static_cast<Real>(0.10);
+  Real blind_finish_max_s = static_cast<Real>(10.0);  ///< Longest the last stretch runs on odometry alone, s.
   // Pose deviation (ALIGN) and obstacle handling.
   DeviationParams deviation{};
   MotionGateParams gate{};
@@ -250,6 +255,7 @@ class TaskManager {
   Twist2 want_{};              // the state's wanted twist for this tick; emit() decides what leaves
   bool hold_ = false;          // a stop condition of the running state (target lost)
   bool have_prev_tick_ = false;
+  Real edge_m_ = 0;  // robot centre to the footprint's edge (half-length or radius): where the pads meet the dock.
   std::uint64_t prev_tick_us_ = 0;
   std::uint64_t state_since_us_ = 0;
   std::uint64_t task_since_us_ = 0;
