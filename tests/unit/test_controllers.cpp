@@ -41,6 +41,49 @@ TEST(Controllers, NamesAndPhaseNames) {
   DOUBLES_EQUAL(0.4, b.params().distance_kp, 1e-7);
 }
 
+TEST(Controllers, EveryPhaseHasItsName) {
+  const Seed000Controller a;
+  const Seed004Controller b;
+  const Seed003Controller c;
+  const SmoothController d;
+  const char* seed000[] = {"ROTATE", "DRIVE", "DOCKED"};
+  for (std::uint8_t i = 0; i < 3; ++i) STRCMP_EQUAL(seed000[i], a.phase_name(i));
+  STRCMP_EQUAL("DOCKED", a.phase_name(static_cast<std::uint8_t>(Seed000Phase::kDocked)));
+  STRCMP_EQUAL("UNKNOWN", a.phase_name(3));
+  STRCMP_EQUAL("FINAL_APPROACH", b.phase_name(static_cast<std::uint8_t>(Seed004Phase::kFinalApproach)));
+  STRCMP_EQUAL("DOCKED", b.phase_name(static_cast<std::uint8_t>(Seed004Phase::kDocked)));
+  STRCMP_EQUAL("UNKNOWN", b.phase_name(11));
+  const char* seed003[] = {"STAGE1", "STAGE2", "SEED_SUCCESS", "FINAL_APPROACH", "DOCKED"};
+  for (std::uint8_t i = 0; i < 5; ++i) STRCMP_EQUAL(seed003[i], c.phase_name(i));
+  STRCMP_EQUAL("DOCKED", c.phase_name(static_cast<std::uint8_t>(Seed003Phase::kDocked)));
+  STRCMP_EQUAL("UNKNOWN", c.phase_name(5));
+  const char* smooth[] = {"APPROACH", "SLOWDOWN", "CREEP", "DOCKED", "LINEUP"};
+  for (std::uint8_t i = 0; i < 5; ++i) STRCMP_EQUAL(smooth[i], d.phase_name(i));
+  STRCMP_EQUAL("DOCKED", d.phase_name(static_cast<std::uint8_t>(SmoothPhase::kDocked)));
+  STRCMP_EQUAL("UNKNOWN", d.phase_name(5));
+}
+
+TEST(Controllers, SetPicksEachControllerByNameWithItsParameters) {
+  Seed000Params p000;
+  p000.forward_speed_mps = static_cast<Real>(0.15);
+  Seed004Params p004;
+  p004.angle_kp = static_cast<Real>(0.7);
+  Seed003Params p003;
+  p003.holonomic = true;
+  SmoothParams ps;
+  ps.v_max_mps = static_cast<Real>(0.2);
+  ControllerSet set(p000, p004, p003, ps);
+  POINTERS_EQUAL(&set.seed000, set.by_name("seed000"));
+  POINTERS_EQUAL(&set.seed004, set.by_name("seed004"));
+  POINTERS_EQUAL(&set.seed003, set.by_name("seed003"));
+  POINTERS_EQUAL(&set.smooth, set.by_name("smooth"));
+  for (const char* other : {"", "Smooth", "seed00", "smooth ", "seed005"}) POINTERS_EQUAL(nullptr, set.by_name(other));
+  DOUBLES_EQUAL(0.15, set.seed000.params().forward_speed_mps, 1e-7);
+  DOUBLES_EQUAL(0.7, set.seed004.params().angle_kp, 1e-7);
+  CHECK(set.seed003.params().holonomic);
+  DOUBLES_EQUAL(0.2, set.smooth.params().v_max_mps, 1e-7);
+}
+
 TEST(Controllers, GracefulCurvatureSigns) {
   // Target dead ahead with the same heading: straight.
   DOUBLES_EQUAL(0.0, SmoothController::graceful_curvature(1, 0, 0, 3, 2), 1e-12);
@@ -129,6 +172,52 @@ TEST(Controllers, LostTargetGivesZeroTwist) {
   const ControlOutput oc = c.step(in);
   CHECK(oc.status == ControlStatus::kLost);
   DOUBLES_EQUAL(0.0, oc.cmd.wz_radps, 0.0);
+}
+
+TEST(Controllers, SmoothStallPastTheContactPlaneFailsUntilReset) {
+  // Pads 1 cm past the contact plane (stall_press_m 0), no contact: running for the first 1.8 s, failed with a zero
+  // twist by 2.2 s (stall_timeout_s 2), and failed even once the pads are back out, until reset().
+  SmoothController d;
+  ControlInput in;
+  in.dt_s = static_cast<Real>(kCtlDt);
+  in.dock_valid = true;
+  Pose2 robot;
+  robot.x_m = static_cast<Real>(kPadReach - 0.01);
+  robot.yaw_rad = static_cast<Real>(kPiD);
+  in.dock_in_robot = robot.inverse();
+  for (int k = 0; k < 90; ++k) CHECK(d.step(in).status == ControlStatus::kRunning);
+  ControlOutput o;
+  for (int k = 0; k < 20; ++k) o = d.step(in);
+  CHECK(o.status == ControlStatus::kFailed);
+  DOUBLES_EQUAL(0.0, o.cmd.vx_mps, 0.0);
+  DOUBLES_EQUAL(0.0, o.cmd.wz_radps, 0.0);
+  robot.x_m = static_cast<Real>(kPadReach + 0.20);
+  in.dock_in_robot = robot.inverse();
+  CHECK(d.step(in).status == ControlStatus::kFailed);
+  d.reset();
+  CHECK(d.step(in).status == ControlStatus::kRunning);
+}
+
+TEST(Controllers, SmoothSaturatedTurnKeepsTheMinimumTurnSpeed) {
+  // Pads 5 cm from the plane, 10 cm off the axis (no LINEUP) and turned 1 rad the wrong way: the curvature is so
+  // tight that ω hits w_max_radps and the speed that keeps the curvature falls below min_turn_speed_mps (set above the
+  // creep speed here), which is commanded instead.
+  SmoothParams p;
+  p.min_turn_speed_mps = static_cast<Real>(0.04);
+  SmoothController d(p);
+  ControlInput in;
+  in.dt_s = static_cast<Real>(kCtlDt);
+  in.dock_valid = true;
+  Pose2 robot;
+  robot.x_m = static_cast<Real>(kPadReach + 0.05);
+  robot.y_m = static_cast<Real>(0.10);
+  robot.yaw_rad = static_cast<Real>(wrapd(kPiD - 1.0));
+  in.dock_in_robot = robot.inverse();
+  const ControlOutput o = d.step(in);
+  CHECK(o.status == ControlStatus::kRunning);
+  CHECK(o.phase != static_cast<std::uint8_t>(SmoothPhase::kLineup));
+  DOUBLES_EQUAL(p.w_max_radps, std::fabs(o.cmd.wz_radps), 0.0);
+  DOUBLES_EQUAL(p.min_turn_speed_mps, o.cmd.vx_mps, 0.0);
 }
 
 TEST(Controllers, ContactMeansArrivedAndZero) {

@@ -56,6 +56,45 @@ TEST(DockPoseEstimator, HintOnEmptyScanIsStillNoPoints) {
   CHECK_EQUAL(0u, g_est.counters().candidates);
 }
 
+TEST(DockPoseEstimator, ScatteredReturnsAreNoCandidates) {
+  // Isolated returns, one every 10th beam at ranges that jump about: points, but no line a profile could match.
+  g_est.configure(profile("plate-v"), EstimatorParams{});
+  g_scan.reset(450, -kPi, deg_to_rad(0.8), 0);
+  for (std::size_t i = 0; i < 450; i += 10) {
+    g_scan.ranges_m[i] = static_cast<Real>(1.0 + 0.7 * static_cast<double>(i % 3));
+  }
+  const DockEstimate e = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_FALSE(e.found);
+  CHECK_EQUAL(static_cast<int>(EstimateStatus::kNoCandidates), static_cast<int>(e.status));
+}
+
+TEST(DockPoseEstimator, CovarianceAboveTheLimitIsRefusedAsUncertain) {
+  // A plate-v 1 m ahead, its returns cast on core's own placed profile (no noise, no wall): found with the default
+  // limit on the position 1-σ, refused as uncertain (and counted) when the limit is far below the range noise.
+  const DockProfile prof = profile("plate-v");
+  static PlacedProfile pp;
+  const Pose2 dock = dockcore_test::pose(1.0, 0.05, kPi - 0.1);
+  pp.place(prof, dock);
+  g_scan.reset(450, -kPi, deg_to_rad(0.8), 0);
+  for (std::size_t i = 0; i < 450; ++i) {
+    const Real a = g_scan.view().angle_rad(i);
+    Real r = 0;
+    std::size_t seg = 0;
+    if (pp.raycast(Vec2(std::cos(a), std::sin(a)), &r, &seg)) g_scan.ranges_m[i] = r;
+  }
+  g_est.configure(prof, EstimatorParams{});
+  const DockEstimate ok = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_TRUE(ok.found);
+  EstimatorParams tight;
+  tight.max_sigma_m = static_cast<Real>(1e-6);
+  g_est.configure(prof, tight);
+  const DockEstimate e = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_FALSE(e.found);
+  CHECK_EQUAL(static_cast<int>(EstimateStatus::kNotVerified), static_cast<int>(e.status));
+  CHECK_EQUAL(static_cast<int>(RejectReason::kUncertain), static_cast<int>(e.reject));
+  CHECK_EQUAL(1u, g_est.counters().rejected_by[static_cast<std::size_t>(RejectReason::kUncertain)]);
+}
+
 namespace {
 
 // The plain formulas the fast PlacedProfile queries must agree with: a division per segment, no precomputation.
