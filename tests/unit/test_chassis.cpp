@@ -4,11 +4,14 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <type_traits>
 
+#include "dockcore/control/kinematics.hpp"
 #include "dockcore/geometry.hpp"
 #include "docksim/battery.hpp"
 #include "docksim/chassis.hpp"
 
+#include "drive_geometries.hpp"
 #include "real_tolerance.hpp"
 
 #include <CppUTest/TestHarness.h>
@@ -133,6 +136,35 @@ TEST(ChassisKinematics, HelpersMatchHandFormulas) {
   REAL_EQUAL(0.2, t.vx_mps, 1e-12);
   REAL_EQUAL(0.1, t.vy_mps, 1e-12);
   REAL_EQUAL(0.5, t.wz_radps, 1e-12);
+}
+
+// The chassis' wheel kinematics against core's (dockcore::twist_to_wheels / wheels_to_twist) on the geometries of
+// core's kinematics suite: both directions agree for differential and mecanum drives.
+TEST(ChassisKinematics, MatchesCoreKinematics) {
+  using dockcore_test::diff_geom;
+  using dockcore_test::mec_geom;
+  using dockcore_test::tw;
+  const double tol = std::is_same<dockcore::Real, float>::value ? 1e-4 : 1e-12;
+  const double cases[][3] = {{0.2, 0, 0.5}, {-0.1, 0.05, -1.2}, {0, -0.2, 0.3}, {0.31, 0.12, 0}};
+  for (int kind = 0; kind < 2; ++kind) {
+    const dockcore::DriveGeometry g = kind == 0 ? diff_geom() : mec_geom();
+    DriveGeometry sg;
+    sg.kind = kind == 0 ? DriveKind::kDifferential : DriveKind::kMecanum;
+    sg.wheel_radius_m = static_cast<double>(g.wheel_radius_m);
+    sg.wheel_base_m = static_cast<double>(g.wheel_base_m);
+    sg.lx_m = static_cast<double>(g.lx_m);
+    sg.ly_m = static_cast<double>(g.ly_m);
+    for (const auto& c : cases) {
+      const dockcore::WheelSpeeds w = dockcore::twist_to_wheels(g, tw(c[0], c[1], c[2]));
+      const WheelRadps s = body_twist_to_wheel_radps(sg, BodyTwist{c[0], c[1], c[2]});
+      for (std::size_t i = 0; i < kMaxWheels; ++i) REAL_EQUAL(s[i], static_cast<double>(w.radps[i]), tol);
+      const BodyTwist sb = wheel_radps_to_body_twist(sg, s);
+      const dockcore::Twist2 b = dockcore::wheels_to_twist(g, w);
+      REAL_EQUAL(sb.vx_mps, b.vx_mps, tol);
+      REAL_EQUAL(sb.vy_mps, b.vy_mps, tol);
+      REAL_EQUAL(sb.wz_radps, b.wz_radps, tol);
+    }
+  }
 }
 
 TEST(ChassisKinematics, DiffStraightLineFromRotatedStart) {

@@ -190,3 +190,41 @@ TEST(Profile, MountKindNamesRoundTripAndOthersAreRefused) {
   CHECK_FALSE(parse_mount_kind("wall", nullptr));
   STRCMP_EQUAL("unknown", to_string(static_cast<DockMountKind>(7)));
 }
+
+TEST(Profile, MountingBoundsAreChecked) {
+  const DockMounting def;
+  CHECK(mounting_valid(def));
+  for (const DockMountKind k : {DockMountKind::kUnknown, DockMountKind::kWall, DockMountKind::kFreeStanding}) {
+    DockMounting m;
+    m.kind = k;
+    CHECK(mounting_valid(m));
+  }
+  DockMounting m;
+  m.kind = static_cast<DockMountKind>(7);
+  CHECK_FALSE(mounting_valid(m));
+  // The gap range: ordered, within [0, kMaxWallGapM], finite; equal ends and the largest gap are allowed.
+  const Real inf = std::numeric_limits<Real>::infinity();
+  const Real nan = std::numeric_limits<Real>::quiet_NaN();
+  const Real ok[][2] = {{0, 0}, {static_cast<Real>(0.05), static_cast<Real>(0.05)}, {0, kMaxWallGapM}};
+  for (const auto& r : ok) {
+    m = DockMounting{};
+    m.kind = DockMountKind::kWall;
+    m.wall_gap_min_m = r[0];
+    m.wall_gap_max_m = r[1];
+    CHECK(mounting_valid(m));
+  }
+  const Real bad[][2] = {{static_cast<Real>(-0.01), static_cast<Real>(0.05)},
+                         {static_cast<Real>(0.06), static_cast<Real>(0.05)},
+                         {0, kMaxWallGapM + static_cast<Real>(0.01)},
+                         {nan, static_cast<Real>(0.05)},
+                         {0, nan},
+                         {0, inf},
+                         {-inf, 0}};
+  for (const auto& r : bad) {
+    m = DockMounting{};
+    m.kind = DockMountKind::kWall;
+    m.wall_gap_min_m = r[0];
+    m.wall_gap_max_m = r[1];
+    CHECK_FALSE(mounting_valid(m));
+  }
+}

@@ -1,10 +1,9 @@
-// core kinematics: wheel speeds from hand formulas, round trips, curvature-preserving saturation, acceleration limiter,
-// and agreement with the simulated chassis' own kinematics (docksim::body_twist_to_wheel_radps).
+// core kinematics: wheel speeds from hand formulas, round trips, curvature-preserving saturation, acceleration limiter.
+// That the simulated chassis' own kinematics agree with these is test_chassis' ChassisKinematics.MatchesCoreKinematics.
 #include <cmath>
 #include <type_traits>
 
 #include "dockcore/control/kinematics.hpp"
-#include "docksim/chassis.hpp"
 
 #include "drive_geometries.hpp"
 #include "real_tolerance.hpp"
@@ -56,29 +55,6 @@ TEST(Kinematics, MecanumHandNumbersAndRoundTrip) {
   REAL_EQUAL(0.13, b.vx_mps, kTol);
   REAL_EQUAL(-0.07, b.vy_mps, kTol);
   REAL_EQUAL(0.41, b.wz_radps, kTol);
-}
-
-TEST(Kinematics, MatchesSimulatedChassis) {
-  const double cases[][3] = {{0.2, 0, 0.5}, {-0.1, 0.05, -1.2}, {0, -0.2, 0.3}, {0.31, 0.12, 0}};
-  for (int kind = 0; kind < 2; ++kind) {
-    const DriveGeometry g = kind == 0 ? diff_geom() : mec_geom();
-    docksim::DriveGeometry sg;
-    sg.kind = kind == 0 ? docksim::DriveKind::kDifferential : docksim::DriveKind::kMecanum;
-    sg.wheel_radius_m = static_cast<double>(g.wheel_radius_m);
-    sg.wheel_base_m = static_cast<double>(g.wheel_base_m);
-    sg.lx_m = static_cast<double>(g.lx_m);
-    sg.ly_m = static_cast<double>(g.ly_m);
-    for (const auto& c : cases) {
-      const WheelSpeeds w = twist_to_wheels(g, tw(c[0], c[1], c[2]));
-      const docksim::WheelRadps s = docksim::body_twist_to_wheel_radps(sg, docksim::BodyTwist{c[0], c[1], c[2]});
-      for (std::size_t i = 0; i < docksim::kMaxWheels; ++i) REAL_EQUAL(s[i], static_cast<double>(w.radps[i]), kTol);
-      const docksim::BodyTwist sb = docksim::wheel_radps_to_body_twist(sg, s);
-      const Twist2 b = wheels_to_twist(g, w);
-      REAL_EQUAL(sb.vx_mps, b.vx_mps, kTol);
-      REAL_EQUAL(sb.vy_mps, b.vy_mps, kTol);
-      REAL_EQUAL(sb.wz_radps, b.wz_radps, kTol);
-    }
-  }
 }
 
 TEST(Kinematics, SaturationKeepsCurvature) {

@@ -1,11 +1,15 @@
 // core odometry: integration of measured wheel speeds (straight, arc, mecanum sideways), the feedback stamp rules
-// (repeats, gaps, clock steps), a base's own pose, and the history that places a scan at its own stamp.
+// (repeats, gaps, clock steps), a base's own pose, the history that places a scan at its own stamp, and Dockcore's
+// wheel feedback into it.
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
 
+#include "dockcore/control/controllers.hpp"
 #include "dockcore/control/kinematics.hpp"
 #include "dockcore/control/odometry.hpp"
+#include "dockcore/dockcore.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 
 #include "drive_geometries.hpp"
 #include "real_tolerance.hpp"
@@ -128,4 +132,31 @@ TEST(Odometry, HistoryPlacesAStampAtTheNewestPoseNotAfterIt) {
   o.reset();
   CHECK_FALSE(o.valid());
   REAL_EQUAL(0.0, o.pose_at(2000000).x_m, 0.0);
+}
+
+TEST(Odometry, DockcoreIntegratesWheelFeedbackWithItsConfiguredDrive) {
+  // Dockcore::on_wheels is Odometry::add_wheels with DockcoreConfig::drive: the same feedback gives the same pose, bit
+  // for bit, under the same stamp rules.
+  static SmoothController ctl;
+  static DockcoreN<720> core(ctl);
+  DockProfile prof;
+  CHECK(builtin_profile("plate-v", prof) == ProfileError::kOk);
+  DockcoreConfig cfg;
+  cfg.drive = mec_geom();
+  CHECK(core.configure(prof, cfg));
+  const DriveGeometry g = mec_geom();
+  Odometry o;
+  const WheelSpeeds w = wheels_for(g, 0.1, 0.05, 0.3);
+  CHECK_FALSE(core.on_wheels(w, 0));
+  for (int i = 0; i < 20; ++i) {
+    const std::uint64_t t = 1000000 + static_cast<std::uint64_t>(i) * 20000;
+    CHECK(core.on_wheels(w, t));
+    CHECK(o.add_wheels(g, w, t));
+  }
+  CHECK_FALSE(core.on_wheels(w, 1000000 + 19 * 20000));  // a repeated stamp is no new feedback
+  CHECK(core.odometry().valid());
+  CHECK(core.odometry().pose().x_m == o.pose().x_m && core.odometry().pose().y_m == o.pose().y_m &&
+        core.odometry().pose().yaw_rad == o.pose().yaw_rad);
+  LONGS_EQUAL(static_cast<long>(o.stamp_us()), static_cast<long>(core.odometry().stamp_us()));
+  REAL_EQUAL(0.05, core.odometry().twist().vy_mps, kTol);  // sideways: the mecanum geometry was used
 }

@@ -1199,6 +1199,9 @@ TEST(Dockcore, DriveCommandIsSaturatedRateLimitedAndZeroedAtOnce) {
     LONGS_EQUAL(2, static_cast<long>(o.wheels.count));
     REAL_EQUAL(w.radps[0], o.wheels.radps[0], 0);
     REAL_EQUAL(w.radps[1], o.wheels.radps[1], 0);
+    // drive_cmd() reports the last tick's shaped command.
+    CHECK(f.core->drive_cmd().vx_mps == o.drive_cmd.vx_mps && f.core->drive_cmd().vy_mps == o.drive_cmd.vy_mps &&
+          f.core->drive_cmd().wz_radps == o.drive_cmd.wz_radps);
     prev = o.drive_cmd;
   }
   CHECK(moved);
