@@ -209,6 +209,19 @@ TEST(SimRun, AHeavyBaseWithAWideDeadbandDocksOnceTheCoreHasLearnedIt) {
   check_docked(docksim::run_docking(sc, "smooth", 5, opt));
 }
 
+// A lidar mounted 12 cm ahead of the centre, 3 cm to the left and turned 5° (mount configured): near the dock it
+// sees only the flat face, and the last centimetres run on the odometry-carried estimate. It docks, with no fault.
+TEST(SimRun, ALidarMountedAheadAndTurnedDocks) {
+  docksim::Scenario sc = default_scenario();
+  sc.lidar_mount = dockcore_test::pose(0.12, 0.03, 5 * kDeg);
+  const docksim::StartPose start = docksim::start_from(sc, 1.5, -20 * kDeg, 15 * kDeg);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 3, opt);
+  check_docked(r);
+  CHECK(r.outcome.faults.empty());
+}
+
 // A lidar dropout longer than lidar_stale_ms + fault_after_ms: the core holds the robot, faults 185, and once scans
 // have been fresh for resume_after_ms issues the dock command again (its resume policy, as in dockd); it docks.
 TEST(SimRun, ALongLidarDropoutFaultsAndIsResumed) {
