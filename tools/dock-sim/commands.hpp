@@ -14,6 +14,8 @@ void register_scene(CLI::App& app);
 void register_run(CLI::App& app);
 /// `dock-sim montecarlo`: many seeded starts per controller, comparison table (run.cpp).
 void register_montecarlo(CLI::App& app);
+/// `dock-sim certify`: a Monte Carlo over a family of robots, with the reliability it demonstrates (certify.cpp).
+void register_certify(CLI::App& app);
 /// `dock-sim soak`: N consecutive dock -> charge -> undock cycles of one continuous robot (soak.cpp).
 void register_soak(CLI::App& app);
 /// `dock-sim features`: the estimator's decision features of labelled candidates, CSV (features.cpp).

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   docksim_cli::register_perception(app);
   docksim_cli::register_run(app);
   docksim_cli::register_montecarlo(app);
+  docksim_cli::register_certify(app);
   docksim_cli::register_soak(app);
   docksim_cli::register_features(app);
   docksim_cli::register_params(app);

@@ -1,15 +1,12 @@
 // `dock-sim run`: one closed-loop docking of a scenario (timeline, outcome, SVG).
 // `dock-sim montecarlo`: many seeded starts for one or all controllers, the same starts for each; comparison table.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
-#include <mutex>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -21,6 +18,7 @@
 #include "docksim/sim_run.hpp"
 #include "docksim/svg.hpp"
 #include "frame_camera.hpp"
+#include "mc_stats.hpp"
 
 namespace docksim_cli {
 namespace {
@@ -272,59 +270,6 @@ struct McOptions {
   bool camera_render = false;  // --camera-render
 };
 
-double pct(std::vector<double> v, double p) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  // Nearest-rank percentile.
-  const std::size_t n = v.size();
-  std::size_t k = static_cast<std::size_t>(std::ceil(p / 100.0 * static_cast<double>(n)));
-  k = std::min(n, std::max<std::size_t>(1, k));
-  return v[k - 1];
-}
-
-struct Summary {
-  std::string name;
-  int trials = 0, successes = 0;
-  std::vector<double> lat_mm, lon_mm, yaw_deg, time_s, path_m;
-  long reversals = 0, runs_with_reversals = 0, inplace = 0, runs_with_inplace = 0, retries = 0, runs_with_retries = 0;
-  double min_clearance_m = std::numeric_limits<double>::infinity();
-  std::map<int, int> faults;
-  int timeouts = 0;
-  std::vector<double> seed_t, seed_z, seed_x;  // seed003's own success test
-};
-
-Summary summarise(const std::string& name, const std::vector<docksim::SimRun>& runs) {
-  Summary s;
-  s.name = name;
-  for (const auto& r : runs) {
-    const auto& o = r.outcome;
-    ++s.trials;
-    if (o.charging_confirmed) {
-      ++s.successes;
-      s.lat_mm.push_back(std::fabs(o.lateral_m) * 1e3);
-      s.lon_mm.push_back(std::fabs(o.longitudinal_m) * 1e3);
-      s.yaw_deg.push_back(std::fabs(o.yaw_rad) * kRadToDeg);
-      s.time_s.push_back(o.time_to_charging_s);
-    }
-    s.path_m.push_back(o.path_length_m);
-    s.reversals += o.reversals;
-    s.runs_with_reversals += o.reversals > 0;
-    s.inplace += o.inplace_turns_45;
-    s.runs_with_inplace += o.inplace_turns_45 > 0;
-    s.retries += o.retries;
-    s.runs_with_retries += o.retries > 0;
-    s.min_clearance_m = std::min(s.min_clearance_m, o.min_clearance_m);
-    for (const auto& kv : o.faults) s.faults[kv.first] += kv.second;
-    s.timeouts += o.timed_out;
-    if (!std::isnan(o.seed_success_t_s)) {
-      s.seed_t.push_back(o.seed_success_t_s);
-      s.seed_z.push_back(o.seed_success_z_err_m);
-      s.seed_x.push_back(o.seed_success_x_m);
-    }
-  }
-  return s;
-}
-
 std::string triple(const std::vector<double>& v, const char* f) {
   if (v.empty()) return "-";
   return fmt(f, pct(v, 50)) + "/" + fmt(f, pct(v, 95)) + "/" + fmt(f, *std::max_element(v.begin(), v.end()));
@@ -465,8 +410,6 @@ int run_mc(const McOptions& opt) {
   const std::size_t n = static_cast<std::size_t>(opt.trials);
   const std::size_t total = n * ctls.size();
   std::vector<docksim::SimRun> runs(total);
-  std::atomic<std::size_t> next{0}, done{0};
-  std::mutex progress_mutex;
   docksim::SimOptions so;
   std::string camera_error;
   if (!docksim_cli::use_rendered_camera(sc, opt.camera_render, so, camera_error)) {
@@ -476,27 +419,11 @@ int run_mc(const McOptions& opt) {
   so.record_trajectory = !opt.svg.empty();
   so.trajectory_period_s = 0.25;
   so.keep_last_scan = false;
-  auto worker = [&]() {
-    for (;;) {
-      const std::size_t i = next.fetch_add(1);
-      if (i >= total) return;
-      // Trial-major order: every controller gets trial t's seed (same start, same noise streams).
-      const std::size_t ci = i % ctls.size(), t = i / ctls.size();
-      runs[ci * n + t] = docksim::run_docking(sc, ctls[ci], docksim::trial_seed(base, t), so);
-      const std::size_t d = done.fetch_add(1) + 1;
-      if (d % 10 == 0 || d == total) {
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        const int w = 40;
-        const int filled = static_cast<int>(w * d / total);
-        std::fprintf(stderr, "\r[%s%s] %zu/%zu", std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                     std::string(static_cast<std::size_t>(w - filled), '.').c_str(), d, total);
-        if (d == total) std::fprintf(stderr, "\n");
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int j = 0; j < opt.jobs; ++j) pool.emplace_back(worker);
-  for (auto& th : pool) th.join();
+  run_trials(total, opt.jobs, [&](std::size_t i) {
+    // Trial-major order: every controller gets trial t's seed (same start, same noise streams).
+    const std::size_t ci = i % ctls.size(), t = i / ctls.size();
+    runs[ci * n + t] = docksim::run_docking(sc, ctls[ci], docksim::trial_seed(base, t), so);
+  });
 
   std::vector<Summary> sums;
   for (std::size_t ci = 0; ci < ctls.size(); ++ci) {

@@ -1,0 +1,417 @@
+// `dock-sim certify`: a Monte Carlo over a family of robots. Every trial draws its own base, drive, odometry and lidar
+// mounting from documented distributions (kFactors below; docs/scenarios.md, "dock-sim certify") on top of a base
+// scenario, and docks from a start drawn from that scenario's envelope. It prints the success rate with its
+// one-sided 95 % Clopper–Pearson lower bound (the reliability the run demonstrates), the errors at the contacts,
+// every failure with the command that replays it alone, and the success rate by quartile of each factor (where it
+// breaks); --svg draws the last as one strip per factor.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "dockcore/task/faults.hpp"
+#include "dockcore/task/task_manager.hpp"
+#include "docksim/cli_checks.hpp"
+#include "docksim/rng.hpp"
+#include "docksim/scenario.hpp"
+#include "docksim/sim_run.hpp"
+#include "docksim/svg.hpp"
+#include "mc_stats.hpp"
+
+namespace docksim_cli {
+namespace {
+
+using dockcore::Vec2;
+
+/// One randomised property of the robot: the TOML key it sets in the trial's scenario and its range. A discrete
+/// factor (choices non-null) draws one of two choices with probability `p_second` of the second.
+struct Factor {
+  const char* table;
+  const char* key;
+  double lo, hi;
+  const char* unit;
+  const char* what;
+  const char* first = nullptr;
+  const char* second = nullptr;
+  double p_second = 0;
+};
+
+// The family. Ranges follow the bases, drives and mounts robot builders have (docs/scenarios.md lists them); the dock,
+// the room and the start envelope are the base scenario's.
+const Factor kFactors[] = {
+    {"robot", "kinematics", 0, 1, "", "drive: differential or mecanum", "diff", "mecanum", 0.3},
+    {"robot.footprint", "pads", 0, 1, "", "charging pads: front or rear (docking backwards)", "front", "rear", 0.5},
+    {"robot", "wheel_radius_m", 0.04, 0.08, "m", "wheel radius"},
+    {"robot", "wheel_base_m", 0.25, 0.40, "m", "track (differential)"},
+    {"robot", "lx_m", 0.12, 0.20, "m", "half wheelbase (mecanum)"},
+    {"robot", "ly_m", 0.12, 0.20, "m", "half track (mecanum)"},
+    {"robot.motor", "latency_s", 0.0, 0.10, "s", "command latency"},
+    {"robot.motor", "time_constant_s", 0.02, 0.25, "s", "motor time constant"},
+    {"robot.motor", "deadband_radps", 0.0, 1.0, "rad/s", "wheel deadband (not told to dockcore)"},
+    {"robot.odometry", "slip_sigma", 0.0, 0.03, "", "wheel slip, 1 sigma"},
+    {"robot.odometry", "radius_error", -0.03, 0.03, "", "odometry wheel radius error"},
+    {"robot.odometry", "radius_diff", -0.02, 0.02, "", "odometry left/right radius difference"},
+    {"robot.odometry", "base_error", -0.03, 0.03, "", "odometry track error"},
+    {"robot.lidar", "x_m", -0.12, 0.12, "m", "lidar mount x (configured)"},
+    {"robot.lidar", "y_m", -0.05, 0.05, "m", "lidar mount y (configured)"},
+    {"robot.lidar", "yaw_deg", -10.0, 10.0, "deg", "lidar mount yaw (configured)"},
+    {"lidar", "rate_hz", 5.0, 15.0, "Hz", "lidar scan rate"},
+    {"lidar", "latency_s", 0.0, 0.10, "s", "lidar latency"},
+};
+constexpr std::size_t kFactorCount = sizeof(kFactors) / sizeof(kFactors[0]);
+constexpr std::uint64_t kFamilySalt = 0x63657274696679ull;  // the family's own stream, apart from the run's noise
+
+struct CertifyOptions {
+  std::string scenario;
+  std::string controller;
+  int trials = 60;
+  std::uint64_t seed = 0;
+  bool seed_set = false;
+  int jobs = 1;
+  bool json = false;
+  std::string svg;
+  int trial = -1;     // --trial: draw only this trial
+  std::string write;  // --write: the drawn trial's scenario file
+};
+
+/// The table at a dotted path, created when missing.
+toml::table& table_at(toml::table& root, const std::string& dotted) {
+  toml::table* t = &root;
+  std::size_t from = 0;
+  while (from <= dotted.size()) {
+    const std::size_t dot = dotted.find('.', from);
+    const std::string part = dotted.substr(from, dot == std::string::npos ? std::string::npos : dot - from);
+    if (!t->contains(part) || !(*t)[part].is_table()) t->insert_or_assign(part, toml::table{});
+    t = (*t)[part].as_table();
+    if (dot == std::string::npos) break;
+    from = dot + 1;
+  }
+  return *t;
+}
+
+/// Trial `index`'s world: the base scenario with every factor drawn. `values` receives each factor's value (a
+/// discrete factor: 0 or 1; a factor its drive does not have: NaN). Deterministic in (base_seed, index).
+toml::table draw_world(const toml::table& base, std::uint64_t base_seed, std::size_t index,
+                       std::vector<double>* values) {
+  toml::table w = base;
+  docksim::Rng rng(docksim::trial_seed(base_seed ^ kFamilySalt, index));
+  values->assign(kFactorCount, std::nan(""));
+  bool mecanum = false;
+  for (std::size_t i = 0; i < kFactorCount; ++i) {
+    const Factor& f = kFactors[i];
+    const double u = rng.uniform();  // drawn for every factor, used or not: each keeps its own place in the stream
+    const std::string key = f.key;
+    if (f.first != nullptr) {
+      const bool second = u < f.p_second;
+      (*values)[i] = second ? 1 : 0;
+      table_at(w, f.table).insert_or_assign(key, std::string(second ? f.second : f.first));
+      if (key == "kinematics") mecanum = second;
+      continue;
+    }
+    if ((key == "wheel_base_m" && mecanum) || ((key == "lx_m" || key == "ly_m") && !mecanum)) continue;
+    const double v = f.lo + (f.hi - f.lo) * u;
+    (*values)[i] = v;
+    table_at(w, f.table).insert_or_assign(key, v);
+  }
+  return w;
+}
+
+std::string toml_text(const toml::table& t) {
+  std::ostringstream os;
+  os << t << "\n";
+  return os.str();
+}
+
+/// log of the binomial probability of k successes in n trials at success rate p (0 < p < 1).
+double log_binom(int n, int k, double p) {
+  return std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) + k * std::log(p) +
+         (n - k) * std::log1p(-p);
+}
+
+/// One-sided lower confidence bound on the success rate (Clopper–Pearson): the p at which k or more successes in n
+/// have probability alpha. 0 when k is 0. Bisection to 1e-9.
+double clopper_pearson_lower(int n, int k, double alpha) {
+  if (k <= 0) return 0;
+  if (k >= n) return std::pow(alpha, 1.0 / n);
+  double lo = 0, hi = 1;
+  for (int it = 0; it < 80; ++it) {
+    const double p = 0.5 * (lo + hi);
+    double tail = 0;
+    for (int i = k; i <= n; ++i) tail += std::exp(log_binom(n, i, p));
+    (tail > alpha ? hi : lo) = p;
+  }
+  return 0.5 * (lo + hi);
+}
+
+/// Why a run did not confirm charging: its fault's name, "timeout", or the state it ended in.
+std::string cause_of(const docksim::SimRun& r) {
+  const auto& o = r.outcome;
+  if (o.final_state == dockcore::TaskState::kFault && !o.faults.empty()) {
+    int last = o.faults.rbegin()->first;
+    for (const auto& kv : o.faults) last = kv.first;  // codes in order; the run ends on one of them
+    return std::to_string(last) + " " + dockcore::to_string(static_cast<dockcore::FaultCode>(last));
+  }
+  if (o.timed_out) return "timeout";
+  return std::string("ended in ") + dockcore::to_string(o.final_state);
+}
+
+std::string fmt(const char* f, double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+void draw_envelope(const std::string& path, const std::string& title, const std::vector<std::vector<double>>& values,
+                   const std::vector<bool>& ok) {
+  docksim::SvgBounds b;
+  b.add(-0.8, 0.2);
+  b.add(1.05, -static_cast<double>(kFactorCount) * 0.25 - 0.1);
+  docksim::SvgCanvas c(b, 420, 20);
+  c.title(title);
+  for (std::size_t i = 0; i < kFactorCount; ++i) {
+    const Factor& f = kFactors[i];
+    const double y = -static_cast<double>(i) * 0.25;
+    c.line(Vec2(0, y), Vec2(1, y), docksim::SvgStyle::line("#cccccc", 1));
+    const std::string range = f.first != nullptr ? std::string(f.first) + " | " + f.second
+                                                 : fmt("%g", f.lo) + " to " + fmt("%g", f.hi) + " " + f.unit;
+    c.text_px(Vec2(-0.02, y), 0, 4, std::string(f.table) + "." + f.key, 11, "black", docksim::SvgAnchor::kEnd);
+    c.text_px(Vec2(1.02, y), 0, 4, range, 10, "#555555");
+    for (std::size_t t = 0; t < values.size(); ++t) {
+      const double v = values[t][i];
+      if (std::isnan(v)) continue;
+      const double x = f.first != nullptr ? (v > 0.5 ? 0.75 : 0.25) : (v - f.lo) / (f.hi - f.lo);
+      // Successes jittered a little about the line, failures on it and on top, so a failure is never hidden.
+      const double jitter = ok[t] ? 0.06 * (static_cast<double>((t * 7919) % 97) / 96.0 - 0.5) : 0;
+      c.circle(Vec2(x, y + jitter), ok[t] ? 0.008 : 0.014, docksim::SvgStyle::filled(ok[t] ? "#1f77b4" : "#d62728"));
+    }
+  }
+  c.legend("charging confirmed", docksim::SvgStyle::filled("#1f77b4"), docksim::SvgLegendMark::kDot);
+  c.legend("failed", docksim::SvgStyle::filled("#d62728"), docksim::SvgLegendMark::kDot);
+  std::string error;
+  if (!c.write(path, &error)) std::cerr << "dock-sim certify: " << error << "\n";
+}
+
+int run_certify(const CertifyOptions& o) {
+  docksim::Scenario base_sc;
+  toml::table base;
+  try {
+    base_sc = docksim::load_scenario_file(o.scenario);
+    base = toml::parse_file(o.scenario);
+  } catch (const docksim::ScenarioError& e) {
+    std::cerr << "dock-sim certify: " << e.what() << "\n";
+    return 2;
+  } catch (const toml::parse_error& e) {
+    std::cerr << "dock-sim certify: " << o.scenario << ": " << e.description() << "\n";
+    return 2;
+  }
+  const std::string ctl = o.controller.empty() ? base_sc.controller : o.controller;
+  if (!docksim::is_controller_name(ctl)) {
+    std::cerr << "dock-sim certify: unknown controller '" << ctl << "' (seed000, seed004, seed003, smooth)\n";
+    return 2;
+  }
+  if (o.trials < 1 || o.jobs < 1 || (o.trial >= 0 && o.trial >= o.trials)) {
+    std::cerr << "dock-sim certify: --trials and --jobs must be >= 1 and --trial below --trials\n";
+    return 2;
+  }
+  if (!o.write.empty() && o.trial < 0) {
+    std::cerr << "dock-sim certify: --write needs --trial\n";
+    return 2;
+  }
+  const std::uint64_t seed = o.seed_set ? o.seed : base_sc.seed;
+  const std::size_t n = static_cast<std::size_t>(o.trials);
+  auto load = [&](std::size_t t, std::vector<double>* values) {
+    const toml::table w = draw_world(base, seed, t, values);
+    return docksim::parse_scenario_toml(toml_text(w), o.scenario + " (trial " + std::to_string(t) + ")");
+  };
+
+  if (o.trial >= 0) {  // one trial: its world, written for `dock-sim run`
+    std::vector<double> values;
+    const std::size_t t = static_cast<std::size_t>(o.trial);
+    const std::string text = toml_text(draw_world(base, seed, t, &values));
+    if (!o.write.empty()) {
+      std::ofstream out(o.write, std::ios::binary);
+      out << "# dock-sim certify " << o.scenario << " --seed " << seed << ", trial " << t
+          << "; replay: dock-sim run THIS_FILE --seed " << docksim::trial_seed(seed, t) << "\n"
+          << text;
+      if (!out) {
+        std::cerr << "dock-sim certify: cannot write " << o.write << "\n";
+        return 2;
+      }
+    } else {
+      std::cout << text;
+    }
+    std::fprintf(stderr, "trial %zu: dock-sim run FILE --seed %llu --controller %s\n", t,
+                 static_cast<unsigned long long>(docksim::trial_seed(seed, t)), ctl.c_str());
+    return 0;
+  }
+
+  std::vector<docksim::SimRun> runs(n);
+  std::vector<std::vector<double>> values(n);
+  std::vector<std::string> errors(n);
+  docksim::SimOptions so;
+  so.keep_last_scan = false;
+  run_trials(n, o.jobs, [&](std::size_t t) {
+    try {
+      const docksim::Scenario sc = load(t, &values[t]);
+      runs[t] = docksim::run_docking(sc, ctl, docksim::trial_seed(seed, t), so);
+    } catch (const docksim::ScenarioError& e) {
+      errors[t] = e.what();
+    }
+  });
+  for (std::size_t t = 0; t < n; ++t) {
+    if (!errors[t].empty()) {
+      std::cerr << "dock-sim certify: the family drew a scenario the loader refuses: " << errors[t] << "\n";
+      return 2;
+    }
+  }
+  const Summary s = summarise(ctl, runs);
+  std::vector<bool> ok(n);
+  for (std::size_t t = 0; t < n; ++t) ok[t] = runs[t].outcome.charging_confirmed;
+  const double rate = static_cast<double>(s.successes) / static_cast<double>(n);
+  const double lower = clopper_pearson_lower(o.trials, s.successes, 0.05);
+
+  // Success by quartile of each continuous factor (discrete: by choice).
+  struct Bin {
+    int n = 0, ok = 0;
+  };
+  std::vector<std::vector<Bin>> bins(kFactorCount, std::vector<Bin>(4));
+  for (std::size_t i = 0; i < kFactorCount; ++i) {
+    const Factor& f = kFactors[i];
+    for (std::size_t t = 0; t < n; ++t) {
+      const double v = values[t][i];
+      if (std::isnan(v)) continue;
+      const std::size_t q = f.first != nullptr
+                                ? (v > 0.5 ? 1u : 0u)
+                                : std::min<std::size_t>(3, static_cast<std::size_t>(4 * (v - f.lo) / (f.hi - f.lo)));
+      ++bins[i][q].n;
+      bins[i][q].ok += ok[t] ? 1 : 0;
+    }
+  }
+  auto replay = [&](std::size_t t) {
+    return "dock-sim certify " + o.scenario + " --seed " + std::to_string(seed) + " --trial " + std::to_string(t) +
+           " --write trial.toml && dock-sim run trial.toml --seed " + std::to_string(docksim::trial_seed(seed, t)) +
+           " --controller " + ctl;
+  };
+
+  if (o.json) {
+    nlohmann::ordered_json j;
+    j["scenario"] = base_sc.name;
+    j["controller"] = ctl;
+    j["seed"] = seed;
+    j["trials"] = o.trials;
+    j["successes"] = s.successes;
+    j["success_rate"] = rate;
+    j["lower_bound_95"] = lower;
+    auto stats = [](const std::vector<double>& v) {
+      if (v.empty()) return nlohmann::ordered_json();
+      return nlohmann::ordered_json{
+          {"p50", pct(v, 50)}, {"p95", pct(v, 95)}, {"max", *std::max_element(v.begin(), v.end())}};
+    };
+    j["lateral_mm"] = stats(s.lat_mm);
+    j["longitudinal_mm"] = stats(s.lon_mm);
+    j["yaw_deg"] = stats(s.yaw_deg);
+    j["time_to_charging_s"] = stats(s.time_s);
+    j["reversals"] = s.reversals;
+    j["retries"] = s.retries;
+    j["min_clearance_m"] =
+        std::isfinite(s.min_clearance_m) ? nlohmann::ordered_json(s.min_clearance_m) : nlohmann::ordered_json();
+    nlohmann::ordered_json fails = nlohmann::ordered_json::array();
+    for (std::size_t t = 0; t < n; ++t) {
+      if (ok[t]) continue;
+      fails.push_back({{"trial", t}, {"cause", cause_of(runs[t])}, {"replay", replay(t)}});
+    }
+    j["failures"] = fails;
+    nlohmann::ordered_json fac = nlohmann::ordered_json::array();
+    for (std::size_t i = 0; i < kFactorCount; ++i) {
+      nlohmann::ordered_json b = nlohmann::ordered_json::array();
+      for (const Bin& x : bins[i]) b.push_back({{"trials", x.n}, {"successes", x.ok}});
+      fac.push_back({{"factor", std::string(kFactors[i].table) + "." + kFactors[i].key}, {"bins", b}});
+    }
+    j["factors"] = fac;
+    std::cout << j.dump() << "\n";
+  } else {
+    std::printf("certify %s, controller %s: %d trials, each its own robot drawn from the family (base seed %llu)\n",
+                base_sc.name.c_str(), ctl.c_str(), o.trials, static_cast<unsigned long long>(seed));
+    std::printf("charging confirmed  %d / %d = %.1f %%\n", s.successes, o.trials, 100 * rate);
+    std::printf("demonstrated        success rate >= %.2f %% at 95 %% confidence (one-sided Clopper-Pearson)\n",
+                100 * lower);
+    auto triple = [](const std::vector<double>& v, const char* f) {
+      if (v.empty()) return std::string("-");
+      return fmt(f, pct(v, 50)) + " / " + fmt(f, pct(v, 95)) + " / " + fmt(f, *std::max_element(v.begin(), v.end()));
+    };
+    std::printf("at the contacts     lateral %s mm, longitudinal %s mm, yaw %s deg (p50 / p95 / max)\n",
+                triple(s.lat_mm, "%.1f").c_str(), triple(s.lon_mm, "%.1f").c_str(), triple(s.yaw_deg, "%.2f").c_str());
+    std::printf("time to charging    %s s (p50 / p95 / max)\n", triple(s.time_s, "%.1f").c_str());
+    std::printf("reversals           %ld in %ld runs; retries %ld in %ld runs; minimum obstacle clearance %s\n",
+                s.reversals, s.runs_with_reversals, s.retries, s.runs_with_retries,
+                std::isfinite(s.min_clearance_m) ? fmt("%.3f m", s.min_clearance_m).c_str() : "- (no obstacle)");
+    std::printf("\nfailures (each replays alone):\n");
+    int shown = 0;
+    for (std::size_t t = 0; t < n; ++t) {
+      if (ok[t]) continue;
+      std::printf("  trial %-5zu %-24s %s\n", t, cause_of(runs[t]).c_str(), replay(t).c_str());
+      ++shown;
+    }
+    if (shown == 0) std::printf("  none\n");
+    std::printf("\nsuccess by quartile of each factor (discrete: by choice), %% (trials)\n");
+    for (std::size_t i = 0; i < kFactorCount; ++i) {
+      const Factor& f = kFactors[i];
+      std::printf("  %-26s", (std::string(f.table) + "." + f.key).c_str());
+      const std::size_t nb = f.first != nullptr ? 2 : 4;
+      for (std::size_t q = 0; q < nb; ++q) {
+        const Bin& x = bins[i][q];
+        std::printf("  %6s (%3d)", x.n > 0 ? fmt("%.1f", 100.0 * x.ok / x.n).c_str() : "-", x.n);
+      }
+      if (f.first != nullptr) {
+        std::printf("   %s | %s\n", f.first, f.second);
+      } else {
+        std::printf("   %g to %g %s\n", f.lo, f.hi, f.unit);
+      }
+    }
+  }
+  if (!o.svg.empty()) {
+    draw_envelope(
+        o.svg, base_sc.name + " / " + ctl + " / " + std::to_string(n) + " robots: " + fmt("%.1f %% docked", 100 * rate),
+        values, ok);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void register_certify(CLI::App& app) {
+  auto o = std::make_shared<CertifyOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "certify",
+      "Monte Carlo over a family of robots: every trial draws its own drive, odometry, lidar rate and mounting "
+      "(docs/scenarios.md) on the scenario's dock and start envelope; prints the success rate with its one-sided 95 % "
+      "lower bound, errors, every failure with the command that replays it, and success by factor. Exit 0, or 2 for "
+      "bad arguments or a bad scenario file.");
+  sub->add_option("scenario", o->scenario, "Base scenario TOML file (docs/scenarios.md)")->required();
+  sub->add_option("--trials", o->trials, "Robots drawn, one docking each")->capture_default_str();
+  sub->add_option("--controller", o->controller, "seed000, seed004, seed003 or smooth (default: the scenario's)");
+  CLI::Option* seed =
+      sub->add_option("--seed", o->seed, "Base seed (default: the scenario's)")->check(docksim::non_negative_integer());
+  sub->add_option("--jobs", o->jobs, "Worker threads (results do not depend on it)")->capture_default_str();
+  sub->add_flag("--json", o->json, "Print JSON instead of the report");
+  sub->add_option("--svg", o->svg, "Draw success and failure over each factor's range");
+  sub->add_option("--trial", o->trial, "Draw only this trial's robot: print its scenario (or --write it)");
+  sub->add_option("--write", o->write, "With --trial: write the trial's scenario file here");
+  sub->callback([o, seed]() {
+    o->seed_set = seed->count() > 0;
+    const int rc = run_certify(*o);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+}
+
+}  // namespace docksim_cli

@@ -1,0 +1,37 @@
+#pragma once
+// What `dock-sim montecarlo` and `dock-sim certify` share: the per-controller summary of a set of closed-loop runs,
+// the nearest-rank percentile, and the worker pool that runs seeded trials in parallel with a progress bar.
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "docksim/sim_run.hpp"
+
+namespace docksim_cli {
+
+/// Nearest-rank percentile p (0-100) of v; NaN for an empty v. O(n log n).
+double pct(std::vector<double> v, double p);
+
+/// Outcome statistics of a set of runs of one controller. Errors and times are over the runs that confirmed charging.
+struct Summary {
+  std::string name;
+  int trials = 0, successes = 0;
+  std::vector<double> lat_mm, lon_mm, yaw_deg, time_s, path_m;
+  long reversals = 0, runs_with_reversals = 0, inplace = 0, runs_with_inplace = 0, retries = 0, runs_with_retries = 0;
+  double min_clearance_m = std::numeric_limits<double>::infinity();
+  std::map<int, int> faults;
+  int timeouts = 0;
+  std::vector<double> seed_t, seed_z, seed_x;  // seed003's own success test
+};
+
+/// Summarises `runs` under `name`. O(runs).
+Summary summarise(const std::string& name, const std::vector<docksim::SimRun>& runs);
+
+/// Calls run(i) for every i in [0, total) on `jobs` threads (>= 1), drawing a progress bar on stderr labelled
+/// with nothing but the counts. run must be safe to call concurrently for different i.
+void run_trials(std::size_t total, int jobs, const std::function<void(std::size_t)>& run);
+
+}  // namespace docksim_cli
