@@ -30,17 +30,18 @@
 #include "dockcore/hal/clock.hpp"
 #include "dockcore/hal/host_link.hpp"
 #include "dockcore/hal/lidar.hpp"
-#include "session_record.hpp"
+#include "dockcore/hal/log_sink.hpp"
 #include "state_file.hpp"
 
 namespace dockd {
 
-/// What the daemon talks to. lidar, chassis and clock are required; the rest may be null.
+/// What the daemon talks to, all HAL interfaces. lidar, chassis and clock are required; the rest may be null.
 struct DaemonIo {
   dockcore::hal::LidarSource* lidar = nullptr;
   dockcore::hal::ChassisLink* chassis = nullptr;
-  dockcore::hal::HostLink* can_host = nullptr;              ///< CAN host command / status frames.
-  dockcore::drivers::UdpHostLink* udp_host = nullptr;       ///< JSON requests and the status stream.
+  /// CAN host command / status frames; its host_commands_rejected() (replays, out-of-order) is in the status.
+  dockcore::hal::HostLink* can_host = nullptr;
+  dockcore::hal::HostRequestLink* udp_host = nullptr;       ///< JSON requests and the status stream.
   dockcore::hal::CameraTargetSource* camera = nullptr;      ///< The UDP camera datagram (external detectors).
   dockcore::hal::CameraTargetSource* camera_own = nullptr;  ///< dockd's own capture + detector (docs/camera.md).
   /// dockd's own detector's tag poses, fused into the dock filter (docs/camera.md, "Fusion"); null: no fusion.
@@ -52,9 +53,7 @@ struct DaemonIo {
   void (*camera_status)(const void* ctx, dockcore::drivers::JsonWriter& w) = nullptr;
   const void* camera_status_ctx = nullptr;
   const dockcore::hal::Clock* clock = nullptr;
-  RotatingLog* event_log = nullptr;  ///< JSON-lines event log (may be closed).
-  /// Optional: the CAN link behind can_host, for its host_commands_rejected() (replays, out-of-order) in the status.
-  const dockcore::drivers::CanLink* can_link = nullptr;
+  dockcore::hal::LogSink* event_log = nullptr;  ///< JSON-lines event log.
   /// Also print events at or above this level to stderr (journal). kError..kDebug.
   LogLevel stderr_level = LogLevel::kInfo;
 };

@@ -38,8 +38,7 @@ std::uint32_t Daemon::commands_rejected_total() const {
   std::uint32_t n = counters_.commands_rejected;
   if (io_.udp_host != nullptr) {
     // Requests the UDP link refused before dockd saw them (it answered them itself): still host commands refused.
-    const auto& u = io_.udp_host->counters();
-    n += u.malformed + u.unknown_command + u.bad_field + u.too_long;
+    n += io_.udp_host->counters().refused();
   }
   return n;
 }
@@ -122,7 +121,7 @@ void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_u
       .uint("commands", counters_.commands)
       .uint("commands_rejected", commands_rejected_total())
       .uint("resumes", counters_.resumes)
-      .uint("can_host_rejected", io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u)
+      .uint("can_host_rejected", io_.can_host != nullptr ? io_.can_host->host_commands_rejected() : 0u)
       .uint("udp_not_allowed", io_.udp_host != nullptr ? io_.udp_host->counters().not_allowed : 0u)
       .uint("config_reloads", counters_.config_reloads)
       .uint("config_reloads_rejected", counters_.config_reloads_rejected)
