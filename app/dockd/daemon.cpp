@@ -32,7 +32,8 @@ Daemon::Daemon(const DockdConfig& config, const DaemonIo& io)
       io_(io),
       controllers_(config.seed000, config.seed004, config.seed003, config.smooth),
       teach_storage_(std::make_unique<Teach>()),
-      teach_(*teach_storage_) {
+      teach_(*teach_storage_),
+      host_(io.udp_host, io.can_host, *this, counters_) {
   build_core();
 }
 
@@ -166,6 +167,18 @@ void Daemon::log_event(EventLine& e, LogLevel level) {
   }
 }
 
+dockcore::SubmitResult Daemon::submit(HostCommandType type, std::uint16_t dock_id, std::uint32_t token,
+                                      std::uint32_t& displaced) {
+  dockcore::QueuedCommand c;
+  c.command = dockcore::HostCommand{type, dock_id};
+  c.token = token;
+  dockcore::QueuedCommand replaced;
+  if (loop_record_) loop_record_->submit(c);
+  const dockcore::SubmitResult res = core_->submit(c, &replaced);
+  displaced = res == dockcore::SubmitResult::kReplacedNewest ? replaced.token : 0u;
+  return res;
+}
+
 void Daemon::send_wheels(const dockcore::hal::WheelCommand& w) {
   last_wheels_ = w;
   if (!io_.chassis->send_wheels(w)) ++counters_.wheel_send_failures;
@@ -257,7 +270,7 @@ void Daemon::on_chassis_readable(std::uint64_t now_us) {
   poll_chassis(now_us);
 }
 void Daemon::on_host_readable(std::uint64_t now_us) {
-  poll_hosts(now_us);
+  host_.poll(now_us);
 }
 void Daemon::on_camera_readable(std::uint64_t now_us) {
   poll_camera(now_us);
@@ -330,8 +343,8 @@ void Daemon::on_tick(std::uint64_t now_us) {
   poll_chassis(now_us);
   poll_lidar(now_us);
   poll_camera(now_us);
-  poll_hosts(now_us);
-  report_held_events(now_us);
+  host_.poll(now_us);
+  host_.report_held_events(now_us);
   watchdogs(now_us);
   teach_progress(now_us);
   if (pending_cfg_ != nullptr && reload_can_apply()) {
@@ -379,42 +392,7 @@ void Daemon::on_tick(std::uint64_t now_us) {
     e.w.str("reason", "max resumes reached");
     log_event(e, LogLevel::kWarn);
   }
-  if (out.command_taken) {
-    ++counters_.commands;
-    const HostCommandType type = out.command.command.type;
-    const std::uint16_t dock_id = out.command.command.dock_id;
-    const bool accepted = out.command_result == dockcore::CommandResult::kAccepted ||
-                          out.command_result == dockcore::CommandResult::kAlreadyDocked;
-    const UdpReply* udp = take_reply(out.command.token);
-    const TaskState after = out.status.state;
-    if (!accepted) ++counters_.commands_rejected;
-    if (udp != nullptr) {
-      if (accepted) {
-        char buf[256];
-        dockcore::drivers::JsonWriter reply(buf, sizeof buf);
-        reply.boolean("ok", true)
-            .str("cmd", to_string(udp->request.kind))
-            .uint("seq", udp->request.seq)
-            .str("result", dockcore::to_string(out.command_result))
-            .uint("dock_id", dock_id)
-            .str("state", dockcore::to_string(after));
-        reply_json(udp->request, buf, reply.finish());
-      } else {
-        char msg[128];
-        std::snprintf(msg, sizeof msg, "task manager: %s (state %s)", dockcore::to_string(out.command_result),
-                      dockcore::to_string(before));
-        reply_error(udp->request, HostErrorCode::kRejected, msg);
-      }
-    }
-    if (accepted || refusal_log_.admit(now_us)) {
-      EventLine e(now_us, "command_result");
-      e.w.str("source", out.command.resume ? "resume" : (udp != nullptr ? "udp" : "can"))
-          .uint("command", static_cast<unsigned>(type))
-          .uint("dock_id", dock_id)
-          .str("result", dockcore::to_string(out.command_result));
-      log_event(e, accepted ? LogLevel::kInfo : LogLevel::kWarn);
-    }
-  }
+  if (out.command_taken) host_.command_taken(out, before, now_us);
 
   // Motion: Dockcore's shaped wheel speeds (zero while stale input holds the robot).
   dockcore::hal::WheelCommand wc;

@@ -20,27 +20,30 @@
 #include <string>
 
 #include "config.hpp"
+#include "counters.hpp"
 #include "dockcore/control/controllers.hpp"
 #include "dockcore/dockcore.hpp"
 #include "dockcore/drivers/json_writer.hpp"
 #include "dockcore/drivers/loop_record.hpp"
-#include "dockcore/drivers/udp_host_link.hpp"
 #include "dockcore/hal/camera.hpp"
 #include "dockcore/hal/chassis.hpp"
 #include "dockcore/hal/clock.hpp"
 #include "dockcore/hal/host_link.hpp"
 #include "dockcore/hal/lidar.hpp"
-#include "session_record.hpp"
+#include "dockcore/hal/log_sink.hpp"
+#include "events.hpp"
+#include "host_protocol.hpp"
 #include "state_file.hpp"
 
 namespace dockd {
 
-/// What the daemon talks to. lidar, chassis and clock are required; the rest may be null.
+/// What the daemon talks to, all HAL interfaces. lidar, chassis and clock are required; the rest may be null.
 struct DaemonIo {
   dockcore::hal::LidarSource* lidar = nullptr;
   dockcore::hal::ChassisLink* chassis = nullptr;
-  dockcore::hal::HostLink* can_host = nullptr;              ///< CAN host command / status frames.
-  dockcore::drivers::UdpHostLink* udp_host = nullptr;       ///< JSON requests and the status stream.
+  /// CAN host command / status frames; its host_commands_rejected() (replays, out-of-order) is in the status.
+  dockcore::hal::HostLink* can_host = nullptr;
+  dockcore::hal::HostRequestLink* udp_host = nullptr;       ///< JSON requests and the status stream.
   dockcore::hal::CameraTargetSource* camera = nullptr;      ///< The UDP camera datagram (external detectors).
   dockcore::hal::CameraTargetSource* camera_own = nullptr;  ///< dockd's own capture + detector (docs/camera.md).
   /// dockd's own detector's tag poses, fused into the dock filter (docs/camera.md, "Fusion"); null: no fusion.
@@ -52,9 +55,7 @@ struct DaemonIo {
   void (*camera_status)(const void* ctx, dockcore::drivers::JsonWriter& w) = nullptr;
   const void* camera_status_ctx = nullptr;
   const dockcore::hal::Clock* clock = nullptr;
-  RotatingLog* event_log = nullptr;  ///< JSON-lines event log (may be closed).
-  /// Optional: the CAN link behind can_host, for its host_commands_rejected() (replays, out-of-order) in the status.
-  const dockcore::drivers::CanLink* can_link = nullptr;
+  dockcore::hal::LogSink* event_log = nullptr;  ///< JSON-lines event log.
   /// Also print events at or above this level to stderr (journal). kError..kDebug.
   LogLevel stderr_level = LogLevel::kInfo;
 };
@@ -68,75 +69,6 @@ struct TickStats {
   std::uint64_t worst_work_us = 0;    ///< Longest time spent inside on_tick (clock before and after).
 };
 
-/// At most kPerWindow events of one kind per kWindowUs reach the record and stderr; the rest are held back and
-/// counted. A host flooding refused requests would otherwise make every request a write(2) or two (on flash, wear
-/// too) and starve the control loop; the request counters still count every one. Cost: O(1), no allocation.
-class EventRateLimit {
- public:
-  static constexpr std::uint32_t kPerWindow = 20;
-  static constexpr std::uint64_t kWindowUs = 1000000;
-  /// True when an event at now_us (monotonic, µs) may be logged; false: it is held back and counted.
-  bool admit(std::uint64_t now_us) {
-    roll(now_us);
-    if (logged_ < kPerWindow) {
-      ++logged_;
-      return true;
-    }
-    ++held_;
-    return false;
-  }
-  /// Events held back in windows that have ended by now_us, each reported once (0 while the window runs).
-  std::uint32_t take_held(std::uint64_t now_us) {
-    roll(now_us);
-    const std::uint32_t n = ready_;
-    ready_ = 0;
-    return n;
-  }
-
- private:
-  void roll(std::uint64_t now_us) {
-    if (now_us - window_start_us_ < kWindowUs) return;  // windows start at 0 or at the first event after one ended
-    window_start_us_ = now_us;
-    logged_ = 0;
-    ready_ += held_;
-    held_ = 0;
-  }
-  std::uint64_t window_start_us_ = 0;
-  std::uint32_t logged_ = 0;
-  std::uint32_t held_ = 0;   ///< In the running window.
-  std::uint32_t ready_ = 0;  ///< From ended windows, not yet reported.
-};
-
-/// One event line being written: {"t_us":…,"event":"name", then the fields added to `w`}; Daemon::log_event
-/// finishes and writes it. 1.5 KiB on the stack.
-struct EventLine {
-  EventLine(std::uint64_t t_us, const char* name) : w(buf, sizeof buf) { w.uint("t_us", t_us).str("event", name); }
-  EventLine(const EventLine&) = delete;
-  EventLine& operator=(const EventLine&) = delete;
-  char buf[1536];
-  dockcore::drivers::JsonWriter w;
-};
-
-/// Counters the daemon itself keeps (the drivers keep theirs).
-struct DaemonCounters {
-  std::uint32_t commands = 0;  ///< Task commands handed to the task manager.
-  /// By the task manager or dockd (unknown dock id, queue full), from CAN or UDP; the status field adds the UDP
-  /// link's own refusals (commands_rejected_total()).
-  std::uint32_t commands_rejected = 0;
-  std::uint32_t queue_overflows = 0;
-  std::uint32_t scans = 0;
-  std::uint32_t detections = 0;
-  std::uint32_t camera_stalls = 0;  ///< Times the own camera went [camera.device] stall_ms without a frame.
-  std::uint32_t resumes = 0;
-  std::uint32_t wheel_send_failures = 0;
-  std::uint32_t status_sent = 0;
-  std::uint32_t config_reloads = 0;           ///< Reloads applied.
-  std::uint32_t config_reloads_rejected = 0;  ///< Reloads refused (invalid file, restart-only key changed).
-  std::uint32_t events_too_long = 0;          ///< Event lines that did not fit EventLine and were not written.
-  /// Tag poses handed to the core, by what became of them (index: dockcore::TagStatus; kFused = fused).
-  std::uint32_t tags[dockcore::kTagStatusCount] = {};
-};
-
 /// What a config reload request came to (docs/dockd.md, "Config reload").
 enum class ReloadResult : std::uint8_t {
   kApplied = 0,   ///< In effect now (the task was idle).
@@ -144,7 +76,9 @@ enum class ReloadResult : std::uint8_t {
   kRejected = 2,  ///< Invalid or changes a restart-only key: nothing changed; the message says why.
 };
 
-class Daemon {
+/// The daemon: the wiring of the inputs into the core, the tick, teach, reload and the status. The host protocol is
+/// its HostProtocol member, which asks the daemon for what a request needs through HostActions.
+class Daemon final : private HostActions {
  public:
   /// `config` is copied. Call start() before anything else.
   Daemon(const DockdConfig& config, const DaemonIo& io);
@@ -171,7 +105,7 @@ class Daemon {
   void log_shutdown(std::uint64_t now_us, const char* reason);
   /// Finishes `e` and writes it to the event log (and stderr at `level` or above); one that did not fit is counted
   /// in counters().events_too_long instead.
-  void log_event(EventLine& e, LogLevel level = LogLevel::kInfo);
+  void log_event(EventLine& e, LogLevel level = LogLevel::kInfo) override;
 
   /// SIGHUP: reads `path` like --check-config (parse + validation), applies `adjust` (the command-line overrides)
   /// and hands the result to request_reload(). A file that does not parse or validate is rejected with its
@@ -184,7 +118,7 @@ class Daemon {
   /// the first idle tick (a newer request replaces a pending one). Never changes a running motion. Allocates.
   ReloadResult request_reload(const DockdConfig& next, std::uint64_t now_us, std::string& message);
   bool reload_pending() const { return pending_cfg_ != nullptr; }
-  const DockdConfig& config() const { return cfg_; }
+  const DockdConfig& config() const override { return cfg_; }
 
   // Introspection (tests, status).
   dockcore::TaskState state() const;
@@ -204,25 +138,18 @@ class Daemon {
   const StateData& state_data() const { return state_; }
   bool teaching() const { return teach_.active; }
   /// The profile currently configured (after any taught/configured target correction) and its dock id.
-  std::uint16_t active_dock_id() const { return active_dock_; }
+  std::uint16_t active_dock_id() const override { return active_dock_; }
   /// Current status as one JSON object (no newline). Returns the length (0 when it does not fit). O(1).
   std::size_t status_json(char* buf, std::size_t size, std::uint64_t now_us) const;
   /// The status's fields, written into `w` (status_json and the status reply); optional groups (tag fusion, camera)
   /// only when they fit.
-  void status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_us) const;
+  void status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_us) const override;
   /// Every host command refused, whatever refused it: dockd and the task manager (counters().commands_rejected)
   /// plus the UDP link's parse refusals (malformed, unknown command, bad field, too long). The status field
   /// `commands_rejected`. O(1).
-  std::uint32_t commands_rejected_total() const;
+  std::uint32_t commands_rejected_total() const { return host_.commands_rejected_total(); }
 
  private:
-  /// A UDP request whose command waits in the core's queue: answered when the core takes the command.
-  struct UdpReply {
-    std::uint32_t token = 0;  ///< 0: free.
-    dockcore::drivers::HostRequest request{};
-  };
-  /// More than the core's queue holds plus the request being submitted: a waiting request always keeps its slot.
-  static constexpr std::size_t kReplySlots = dockcore::CommandQueue::kCapacity + 2;
   struct Teach {
     bool active = false;
     std::uint16_t dock_id = 0;
@@ -231,32 +158,23 @@ class Daemon {
     double sx = 0, sy = 0, sc = 0, ss = 0;  // sums of x, y, cos yaw, sin yaw
     dockcore::Pose2 samples[1000];
     std::uint64_t deadline_us = 0;
-    dockcore::drivers::HostRequest request{};
+    dockcore::hal::HostRequest request{};
   };
 
   void poll_chassis(std::uint64_t now_us);
   void poll_lidar(std::uint64_t now_us);
   void poll_camera(std::uint64_t now_us);
-  void poll_hosts(std::uint64_t now_us);
-  void handle_udp_request(const dockcore::drivers::HostRequest& r, std::uint64_t now_us);
-  /// Logs how many refusal events refusal_log_ held back, once their window has ended.
-  void report_held_events(std::uint64_t now_us);
-  /// Keeps `r` in a free slot for its answer; returns its token. O(kReplySlots).
-  std::uint32_t hold_reply(const dockcore::drivers::HostRequest& r);
-  /// The request held under `token` (nullptr for 0 or one no longer held), released. O(kReplySlots).
-  const UdpReply* take_reply(std::uint32_t token);
-  /// Queues a command in the core (counted as an overflow unless queued; a refused or displaced request's reply slot
-  /// is released). O(1).
-  dockcore::SubmitResult submit(dockcore::HostCommandType type, std::uint16_t dock_id, std::uint32_t token);
-  void reply_error(const dockcore::drivers::HostRequest& r, dockcore::drivers::HostErrorCode code, const char* msg);
-  void reply_json(const dockcore::drivers::HostRequest& r, const char* json, std::size_t len);
+  // HostActions: what the host protocol asks of the daemon.
+  dockcore::SubmitResult submit(dockcore::HostCommandType type, std::uint16_t dock_id, std::uint32_t token,
+                                std::uint32_t& displaced) override;
+  void start_teach(const dockcore::hal::HostRequest& r, std::uint64_t now_us) override;
+  void cancel_teach(std::uint64_t now_us) override;
   /// Configures Dockcore for `dock_id` (profile corrected by its taught / configured target). Resets the task
   /// manager: only while idle.
   bool configure_core(std::uint16_t dock_id, bool raw_profile);
   void watchdogs(std::uint64_t now_us);
   /// The own camera's stall watchdog (part of watchdogs): sets camera_stalled_, counts and logs its changes.
   void camera_watchdog(std::uint64_t now_us);
-  void start_teach(const dockcore::drivers::HostRequest& r, std::uint64_t now_us);
   void teach_sample(const dockcore::DockEstimate& e);
   void teach_progress(std::uint64_t now_us);
   void finish_teach(bool ok, const char* why, std::uint64_t now_us);
@@ -288,10 +206,6 @@ class Daemon {
   // Camera.
   dockcore::CameraTarget camera_{};
 
-  // UDP requests waiting for their command's result.
-  UdpReply replies_[kReplySlots];
-  std::uint32_t next_token_ = 0;
-
   // Watchdogs and resume.
   bool camera_stalled_ = false, prev_camera_stalled_ = false;
   std::uint64_t camera_watch_from_us_ = 0;  ///< First watchdog tick: a camera that never delivers stalls from here.
@@ -313,7 +227,7 @@ class Daemon {
   TickStats stats_{};
   std::uint64_t prev_tick_us_ = 0;
   DaemonCounters counters_{};
-  EventRateLimit refusal_log_{};  ///< command_rejected and refused command_result events (one per refused request).
+  HostProtocol host_;  ///< The host links: requests, replies, the status on both links.
   bool shutdown_logged_ = false;
   std::unique_ptr<DockdConfig> pending_cfg_;  ///< A validated reload waiting for an idle task.
   /// [record] loop: every call into the core, for dock-sim replay (null when off).

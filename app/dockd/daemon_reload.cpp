@@ -57,7 +57,7 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
   std::unique_ptr<DockdConfig> next = std::move(pending_cfg_);
   std::string err;
   // The only step that can still refuse: done first, so a refusal leaves everything as it was.
-  if (io_.udp_host != nullptr && !io_.udp_host->set_allowlist(next->host.allowlist, err)) {
+  if (!host_.set_allowlist(next->host.allowlist, err)) {
     ++counters_.config_reloads_rejected;
     message = next->source + ": config reload rejected: " + err + " (the running configuration stays)";
     log_reload(now_us, "rejected", message, LogLevel::kError);
@@ -77,7 +77,7 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
     core_->take_inputs(*previous);
     if (loop_record_) loop_record_->take_inputs();
     configure_core(cfg_.default_dock_id, false);
-    if (io_.udp_host != nullptr) io_.udp_host->set_allowlist(cfg_.host.allowlist, err);
+    host_.set_allowlist(cfg_.host.allowlist, err);
     ++counters_.config_reloads_rejected;
     message = next->source +
               ": config reload rejected: dock profile refused by the estimator (the running "

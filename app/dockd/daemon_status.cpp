@@ -10,38 +10,20 @@ namespace dockd {
 
 void Daemon::publish_status(std::uint64_t now_us) {
   const dockcore::TaskStatus& s = last_out_.status;
-  if (io_.can_host != nullptr) {
-    dockcore::hal::StatusMessage m;
-    m.task_state = static_cast<std::uint8_t>(s.state);
-    m.align_phase = s.phase;
-    // The watchdogs' codes are reported even while idle (the task manager faults only in active states).
-    m.fault_code = static_cast<std::uint16_t>(s.fault != FaultCode::kNone ? s.fault
-                                              : chassis_stale()           ? FaultCode::kChassisStale
-                                              : lidar_stale()             ? FaultCode::kLidarStale
-                                                                          : FaultCode::kNone);
-    m.retries = s.retries;
-    m.last_result = static_cast<std::uint8_t>(s.last_command);
-    m.dock_valid = s.dock_valid;
-    m.dock_in_robot = s.dock_pose;
-    m.stamp_us = now_us;
-    io_.can_host->send_status(m);
-  }
-  if (io_.udp_host != nullptr && io_.udp_host->subscriber_count() > 0) {
-    char buf[dockcore::drivers::kMaxHostReply];
-    const std::size_t n = status_json(buf, sizeof buf, now_us);
-    if (n > 0) io_.udp_host->publish(buf, n, now_us);
-  }
-  ++counters_.status_sent;
-}
-
-std::uint32_t Daemon::commands_rejected_total() const {
-  std::uint32_t n = counters_.commands_rejected;
-  if (io_.udp_host != nullptr) {
-    // Requests the UDP link refused before dockd saw them (it answered them itself): still host commands refused.
-    const auto& u = io_.udp_host->counters();
-    n += u.malformed + u.unknown_command + u.bad_field + u.too_long;
-  }
-  return n;
+  dockcore::hal::StatusMessage m;
+  m.task_state = static_cast<std::uint8_t>(s.state);
+  m.align_phase = s.phase;
+  // The watchdogs' codes are reported even while idle (the task manager faults only in active states).
+  m.fault_code = static_cast<std::uint16_t>(s.fault != FaultCode::kNone ? s.fault
+                                            : chassis_stale()           ? FaultCode::kChassisStale
+                                            : lidar_stale()             ? FaultCode::kLidarStale
+                                                                        : FaultCode::kNone);
+  m.retries = s.retries;
+  m.last_result = static_cast<std::uint8_t>(s.last_command);
+  m.dock_valid = s.dock_valid;
+  m.dock_in_robot = s.dock_pose;
+  m.stamp_us = now_us;
+  host_.publish_status(m, now_us);
 }
 
 std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_us) const {
@@ -122,8 +104,8 @@ void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_u
       .uint("commands", counters_.commands)
       .uint("commands_rejected", commands_rejected_total())
       .uint("resumes", counters_.resumes)
-      .uint("can_host_rejected", io_.can_link != nullptr ? io_.can_link->host_commands_rejected() : 0u)
-      .uint("udp_not_allowed", io_.udp_host != nullptr ? io_.udp_host->counters().not_allowed : 0u)
+      .uint("can_host_rejected", host_.can_rejected())
+      .uint("udp_not_allowed", host_.udp_not_allowed())
       .uint("config_reloads", counters_.config_reloads)
       .uint("config_reloads_rejected", counters_.config_reloads_rejected)
       .boolean("config_reload_pending", pending_cfg_ != nullptr)

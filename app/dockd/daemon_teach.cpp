@@ -13,29 +13,29 @@ void Daemon::start_teach(const HostRequest& r, std::uint64_t now_us) {
   if (cfg_.find_dock(id) == nullptr) {
     char msg[96];
     std::snprintf(msg, sizeof msg, "dock id %u is not in the dock database", id);
-    reply_error(r, HostErrorCode::kUnknownDockId, msg);
+    host_.reply_error(r, HostErrorCode::kUnknownDockId, msg);
     return;
   }
   if (teach_.active) {
-    reply_error(r, HostErrorCode::kBusy, "a teach is already running");
+    host_.reply_error(r, HostErrorCode::kBusy, "a teach is already running");
     return;
   }
   const TaskState s = state();
   if (!(s == TaskState::kNotTasking || s == TaskState::kFinishTasking || s == TaskState::kFault)) {
-    reply_error(r, HostErrorCode::kTeachFailed, "teach needs an idle robot (stop the running task first)");
+    host_.reply_error(r, HostErrorCode::kTeachFailed, "teach needs an idle robot (stop the running task first)");
     return;
   }
   if (chassis_stale() || !fb_.charging_contact) {
-    reply_error(r, HostErrorCode::kTeachFailed, "teach needs the robot on the charger: contacts are not closed");
+    host_.reply_error(r, HostErrorCode::kTeachFailed, "teach needs the robot on the charger: contacts are not closed");
     return;
   }
   if (lidar_stale()) {
-    reply_error(r, HostErrorCode::kTeachFailed, "teach needs the lidar: no fresh scans");
+    host_.reply_error(r, HostErrorCode::kTeachFailed, "teach needs the lidar: no fresh scans");
     return;
   }
   // Detections against the dock's own profile, without any earlier correction (that is what is being measured).
   if (!configure_core(id, true)) {
-    reply_error(r, HostErrorCode::kTeachFailed, "dock profile refused");
+    host_.reply_error(r, HostErrorCode::kTeachFailed, "dock profile refused");
     return;
   }
   teach_.active = true;
@@ -65,7 +65,7 @@ void Daemon::finish_teach(bool ok, const char* why, std::uint64_t now_us) {
   teach_.active = false;
   if (!ok) {
     configure_core(active_dock_, false);
-    reply_error(r, HostErrorCode::kTeachFailed, why);
+    host_.reply_error(r, HostErrorCode::kTeachFailed, why);
     return;
   }
   const double n = teach_.have;
@@ -87,7 +87,7 @@ void Daemon::finish_teach(bool ok, const char* why, std::uint64_t now_us) {
     configure_core(id, false);
     char msg[128];
     std::snprintf(msg, sizeof msg, "detections spread %.1f mm (> 20 mm): robot moving or dock ambiguous", spread * 1e3);
-    reply_error(r, HostErrorCode::kTeachFailed, msg);
+    host_.reply_error(r, HostErrorCode::kTeachFailed, msg);
     return;
   }
   StateData next = state_;
@@ -95,7 +95,7 @@ void Daemon::finish_teach(bool ok, const char* why, std::uint64_t now_us) {
   std::string err;
   if (!save_state(cfg_.state_file, next, err)) {
     configure_core(id, false);
-    reply_error(r, HostErrorCode::kTeachFailed, ("state file: " + err).c_str());
+    host_.reply_error(r, HostErrorCode::kTeachFailed, ("state file: " + err).c_str());
     return;
   }
   state_ = next;
@@ -119,10 +119,14 @@ void Daemon::finish_teach(bool ok, const char* why, std::uint64_t now_us) {
       .real("offset_x_mm", static_cast<double>(t.target.x_m - nom.x_m) * 1e3, 1)
       .real("offset_y_mm", static_cast<double>(t.target.y_m - nom.y_m) * 1e3, 1)
       .real("offset_yaw_deg", deg(dockcore::wrap_angle(t.target.yaw_rad - nom.yaw_rad)), 3);
-  reply_json(r, buf, reply.finish());
+  host_.reply(r, buf, reply.finish());
   EventLine e(now_us, "teach_done");
   e.w.fields(target.body(), target.body_len());
   log_event(e);
+}
+
+void Daemon::cancel_teach(std::uint64_t now_us) {
+  if (teach_.active) finish_teach(false, "cancelled by stop", now_us);
 }
 
 void Daemon::teach_progress(std::uint64_t now_us) {

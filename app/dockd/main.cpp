@@ -385,7 +385,6 @@ int main(int argc, char** argv) {
 #endif
   io.clock = &clock;
   io.event_log = &event_log;
-  io.can_link = can.get();
   io.stderr_level = cfg.log_level;
   auto daemon = std::make_unique<dockd::Daemon>(cfg, io);
   if (!daemon->start(err)) {

@@ -9,11 +9,12 @@
 #include <string>
 
 #include "dockcore/hal/can_bus.hpp"
+#include "dockcore/hal/log_sink.hpp"
 
 namespace dockd {
 
 /// One append-only log file with size rotation.
-class RotatingLog {
+class RotatingLog final : public dockcore::hal::LogSink {
  public:
   RotatingLog() = default;
   ~RotatingLog();
@@ -26,7 +27,7 @@ class RotatingLog {
   bool is_open() const { return fd_ >= 0; }
   /// Appends one line (must end in '\n'); rotates first when it would exceed max_bytes. False on a write error
   /// (counted). O(len) plus a rotation's renames.
-  bool write_line(const char* line, std::size_t len);
+  bool write_line(const char* line, std::size_t len) override;
   std::uint32_t write_errors() const { return write_errors_; }
   std::uint32_t rotations() const { return rotations_; }
   const std::string& path() const { return path_; }

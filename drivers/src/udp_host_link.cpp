@@ -16,20 +16,6 @@
 
 namespace dockcore::drivers {
 
-const char* to_string(HostRequestKind k) {
-  switch (k) {
-    case HostRequestKind::kDock: return "dock";
-    case HostRequestKind::kStop: return "stop";
-    case HostRequestKind::kUndock: return "undock";
-    case HostRequestKind::kTest: return "test";
-    case HostRequestKind::kStatus: return "status";
-    case HostRequestKind::kTeach: return "teach";
-    case HostRequestKind::kSubscribe: return "subscribe";
-    case HostRequestKind::kUnsubscribe: return "unsubscribe";
-  }
-  return "?";
-}
-
 const char* to_string(HostErrorCode e) {
   switch (e) {
     case HostErrorCode::kNone: return "none";
@@ -288,6 +274,7 @@ class UdpHostLinkImpl final : public UdpHostLink {
   }
 
   // hal::HostLink.
+  std::uint32_t host_commands_rejected() const override { return c_.refused(); }
   bool poll_command(hal::HostCommandMessage& out) override {
     HostRequest r;
     while (poll_request(r, last_now_us_)) {

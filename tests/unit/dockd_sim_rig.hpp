@@ -96,6 +96,7 @@ struct FakeHost final : dockcore::hal::HostLink {
     return true;
   }
   int fd() const override { return -1; }
+  std::uint32_t host_commands_rejected() const override { return 0; }
 };
 
 /// dockd's config for the scenario's robot (drive, limits, footprint, lidar mount, estimator, task, smooth

@@ -64,7 +64,8 @@ struct CanLinkOptions {
 
 /// Chassis link and host link over one bus. poll() drains the bus: chassis frames update the feedback, host command
 /// frames go to a bounded queue (overflow counted) that poll_command() empties; bad frames (length, checksum,
-/// counter, unknown id in a filtered range) are counted in counters().bad_frames and change nothing else.
+/// counter, unknown id in a filtered range) are counted in counters().bad_frames and change nothing else. Host command
+/// frames dropped (queue full, replayed or out-of-order sequence) are counted in host_commands_rejected().
 class CanLink : public hal::ChassisLink, public hal::HostLink {
  public:
   virtual ~CanLink() = default;
@@ -72,8 +73,6 @@ class CanLink : public hal::ChassisLink, public hal::HostLink {
   virtual void service(std::uint64_t now_us) = 0;
   /// Standard ids this link wants to receive (for the SocketCAN filter). Pointer valid for the link's lifetime.
   virtual const std::uint32_t* rx_ids(std::size_t& count) const = 0;
-  /// Host command frames dropped: queue full, replayed or out-of-order sequence.
-  virtual std::uint32_t host_commands_rejected() const = 0;
 };
 
 /// The ids a link with `options` receives, without constructing one (the bus is opened first, then the link).

@@ -1,11 +1,11 @@
 #pragma once
-/// @file The host's UDP link to dockd (hal::HostLink): one JSON object per datagram, bound to 127.0.0.1 by default;
-/// peers other than 127.0.0.1 only when they are on an explicit allowlist (others are dropped and counted). Requests: dock, undock,
-/// stop/cancel, test, status, teach, subscribe, unsubscribe (docs/dockd.md, "Host UDP protocol"). Malformed JSON, an
-/// unknown command or a bad field gets an error reply with a code and a message and changes nothing else; every
-/// refusal is counted. Datagrams are bounded (kMaxHostDatagram bytes; longer ones are refused as too_long).
-/// Subscribers get the status stream; their number is bounded and each subscription expires unless renewed.
-/// Heap only at open; polling, replies and the stream use fixed buffers.
+/// @file The host's UDP link to dockd (hal::HostRequestLink, hal::HostLink): one JSON object per datagram, bound to
+/// 127.0.0.1 by default; peers other than 127.0.0.1 only when they are on an explicit allowlist (others are dropped and
+/// counted). Requests: dock, undock, stop/cancel, test, status, teach, subscribe, unsubscribe (docs/dockd.md, "Host UDP
+/// protocol"). Malformed JSON, an unknown command or a bad field gets an error reply with a code and a message and
+/// changes nothing else; every refusal is counted. Datagrams are bounded (kMaxHostDatagram bytes; longer ones are
+/// refused as too_long). Subscribers get the status stream; their number is bounded and each subscription expires
+/// unless renewed. Heap only at open; polling, replies and the stream use fixed buffers.
 
 #include <cstddef>
 #include <cstdint>
@@ -24,20 +24,9 @@ constexpr std::size_t kMaxHostAllowlist = 64;
 /// Largest reply / status datagram dockd sends, bytes.
 constexpr std::size_t kMaxHostReply = 1400;
 
-/// Request kinds. 1-4 are the task manager's HostCommandType codes; 10+ are answered by dockd itself.
-enum class HostRequestKind : std::uint8_t {
-  kDock = 1,
-  kStop = 2,       ///< "stop" or "cancel".
-  kUndock = 3,
-  kTest = 4,       ///< Recognition only (test mode).
-  kStatus = 10,    ///< One status reply.
-  kTeach = 11,     ///< Teach the docked-pose target of a dock (robot placed on the charger by hand).
-  kSubscribe = 12, ///< Handled by the link: the peer receives the status stream until it expires.
-  kUnsubscribe = 13,
-};
-
-/// Stable wire name ("dock", "stop", ...). Never null.
-const char* to_string(HostRequestKind k);
+/// The request vocabulary is the HAL's (hal::HostRequestLink); these names keep the driver's spelling.
+using HostRequestKind = hal::HostRequestKind;
+using hal::to_string;
 
 /// Error codes in replies ("code" field). Stable numbers: hosts log them.
 enum class HostErrorCode : std::uint16_t {
@@ -56,23 +45,8 @@ enum class HostErrorCode : std::uint16_t {
 /// Stable snake_case name ("malformed", ...). Never null.
 const char* to_string(HostErrorCode e);
 
-/// An IPv4 peer, network byte order (as in sockaddr_in).
-struct HostPeer {
-  std::uint32_t addr_be = 0;
-  std::uint16_t port_be = 0;
-};
-
-/// One parsed request.
-struct HostRequest {
-  HostRequestKind kind = HostRequestKind::kStatus;
-  bool has_dock_id = false;
-  std::uint16_t dock_id = 0;   ///< 0..65535 on the wire; dockd's database decides which exist.
-  bool has_seq = false;
-  std::uint32_t seq = 0;       ///< Echoed in the reply; 0..2^32-1.
-  std::uint16_t scans = 0;     ///< teach: scans to average (0 = dockd's default).
-  HostPeer peer{};             ///< Who sent it (replies go there).
-  std::uint64_t stamp_us = 0;  ///< Receive time, CLOCK_MONOTONIC µs.
-};
+using HostPeer = hal::HostPeer;
+using HostRequest = hal::HostRequest;
 
 /// Parses one request datagram (no I/O). On error `out` is untouched except for seq (echoed when it could be read)
 /// and `detail` (static text naming the offending field or reason). Fields: cmd (string, required), seq (integer
@@ -95,46 +69,19 @@ struct UdpHostLinkOptions {
   std::uint32_t subscription_ms = 10000;   ///< A subscription lasts this long unless renewed.
 };
 
-struct UdpHostCounters {
-  std::uint32_t datagrams = 0;           ///< Received from allowed peers.
-  std::uint32_t requests = 0;            ///< Parsed and handed on (or handled: subscribe).
-  std::uint32_t malformed = 0;
-  std::uint32_t unknown_command = 0;
-  std::uint32_t bad_field = 0;
-  std::uint32_t too_long = 0;
-  std::uint32_t not_allowed = 0;         ///< Datagrams from peers outside loopback + allowlist: dropped, no reply.
-  std::uint32_t replies = 0;
-  std::uint32_t send_failures = 0;
-  std::uint32_t stream_sent = 0;         ///< Status datagrams sent to subscribers.
-  std::uint32_t subscribers_rejected = 0;///< Subscribe refused: table full.
-  std::uint32_t subscriptions_expired = 0;
-  std::uint32_t rejected_later = 0;      ///< Counted by the consumer: unknown dock id, task manager refusals.
-};
+using UdpHostCounters = hal::HostRequestCounters;
 
-/// The UDP host link. poll_request() is what dockd uses (it answers every request itself, after the task manager
-/// has ruled). The hal::HostLink side serves simpler consumers: poll_command() returns dock/stop/undock/test and
-/// acknowledges them as queued, answers status with the last send_status() content and refuses teach.
-class UdpHostLink : public hal::HostLink {
+/// The UDP host link. As a hal::HostRequestLink it is what dockd uses (dockd answers every request itself, after the
+/// task manager has ruled); poll_request() reads at most 64 datagrams per call. The hal::HostLink side serves
+/// simpler consumers: poll_command() returns dock/stop/undock/test and acknowledges them as queued, answers status
+/// with the last send_status() content and refuses teach; its host_commands_rejected() are the parse refusals.
+/// set_allowlist() refuses a list with a malformed entry, with more than kMaxHostAllowlist entries, or an empty one
+/// while the link is bound to a non-loopback address.
+class UdpHostLink : public hal::HostLink, public hal::HostRequestLink {
  public:
   virtual ~UdpHostLink() = default;
-  /// Next request that needs the consumer, non-blocking; false when none is pending. Handles subscribe /
-  /// unsubscribe and refuses malformed input itself (reply + counter). Reads at most 64 datagrams per call so a
-  /// flood cannot stall the caller. `now_us`: CLOCK_MONOTONIC µs (stamps, subscription expiry).
-  virtual bool poll_request(HostRequest& out, std::uint64_t now_us) = 0;
-  /// Sends `json` (one object, no newline; a newline is appended) to `peer`. False when it could not be sent.
-  virtual bool reply(const HostPeer& peer, const char* json, std::size_t len) = 0;
-  /// Sends `json` to every live subscriber and drops expired ones. O(subscribers).
-  virtual void publish(const char* json, std::size_t len, std::uint64_t now_us) = 0;
-  virtual std::size_t subscriber_count() const = 0;
-  virtual const UdpHostCounters& counters() const = 0;
-  /// For refusals decided by the consumer (kept with the link's own counters in status output).
-  virtual void count_rejected() = 0;
   /// The bound port (useful with port 0).
   virtual std::uint16_t bound_port() const = 0;
-  /// Replaces the allowlist (dockd's config reload). The whole list is checked first: false + message in `error`
-  /// and the old list kept when an entry is malformed, when there are more than kMaxHostAllowlist entries, or when
-  /// the link is bound to a non-loopback address and the new list is empty. Allocates; not for the tick.
-  virtual bool set_allowlist(const std::vector<std::string>& allowlist, std::string& error) = 0;
 };
 
 /// Opens the socket. nullptr + message in `error` for a bad address, a bad allowlist entry, a non-loopback bind
