@@ -38,6 +38,7 @@
 #include "docksim/rng.hpp"
 #include "docksim/scenario.hpp"
 #include "docksim/sim_run.hpp"
+#include "mc_stats.hpp"
 
 namespace docksim_cli {
 namespace {
@@ -251,15 +252,6 @@ class SoakWorld {
   dockcore::TickOutput last_{};
   double odom_err_m_ = 0;
 };
-
-double pct(std::vector<double> v, double p) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  std::size_t k = static_cast<std::size_t>(std::ceil(p / 100.0 * static_cast<double>(n)));
-  k = std::min(n, std::max<std::size_t>(1, k));
-  return v[k - 1];
-}
 
 double mean(const std::vector<double>& v) {
   if (v.empty()) return std::nan("");
