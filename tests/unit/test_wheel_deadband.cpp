@@ -139,3 +139,19 @@ TEST(WheelDeadband, FloorsGrowStepByStepUpToTheBoundAndConfigureForgetsThem) {
   DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(0, true)), kTol);
   LONGS_EQUAL(0, d.raises());
 }
+
+TEST(WheelDeadband, ACommandAtItsFloorUpToRoundingStillStalls) {
+  WheelDeadbandParams p;
+  p.known_radps = static_cast<Real>(0.75);
+  WheelDeadband d;
+  d.configure(p);
+  // What scale() sends meets the floor only up to rounding: a hair below it is still a command at the floor.
+  const Real at_floor = static_cast<Real>(0.75) * (1 - static_cast<Real>(1e-5));
+  hold(d, wheels(at_floor, at_floor), wheels(0, 0), 0, 520);
+  DOUBLES_EQUAL(0.9375, static_cast<double>(d.floor_radps(0, false)), 1e-4);
+  // Clearly below the floor is no stall of that floor: such a command is one scale() never sends.
+  WheelDeadband e;
+  e.configure(p);
+  hold(e, wheels(static_cast<Real>(0.5), static_cast<Real>(0.5)), wheels(0, 0), 0, 520);
+  LONGS_EQUAL(0, e.raises());
+}

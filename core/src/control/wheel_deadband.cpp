@@ -42,7 +42,8 @@ void WheelDeadband::observe(const WheelSpeeds& commanded, const WheelSpeeds& mea
     const bool reverse = c < 0;
     // Along the command: a wheel turning the wrong way follows it even less than one standing still.
     const Real along = i < n ? (reverse ? -measured.radps[i] : measured.radps[i]) : 0;
-    const bool stalled = learn && params_.adapt && a > 0 && a >= floor_radps_[i][reverse ? 1 : 0] &&
+    // A command scale() raised to the floor equals it only up to rounding: a part in a thousand below still counts.
+    const bool stalled = learn && params_.adapt && a > 0 && a >= kAtFloor * floor_radps_[i][reverse ? 1 : 0] &&
                          along < kStallShare * a && floor_radps_[i][reverse ? 1 : 0] < params_.max_radps;
     if (!stalled) {
       s.active = false;

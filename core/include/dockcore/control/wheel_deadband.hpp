@@ -36,6 +36,8 @@ class WheelDeadband {
   static constexpr Real kStallShare = static_cast<Real>(0.25);
   /// A stalled wheel's floor becomes this times the smallest command of the stall.
   static constexpr Real kGrowth = static_cast<Real>(1.25);
+  /// A command at least this share of its floor counts as at the floor (scale() meets the floor up to rounding).
+  static constexpr Real kAtFloor = static_cast<Real>(0.999);
   /// Wheels turning slower than this share of the fastest one are meant to stand nearly still (a pivot): they are
   /// left in the deadband rather than speeding the whole command up without bound.
   static constexpr Real kPivotShare = static_cast<Real>(0.25);
