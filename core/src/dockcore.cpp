@@ -284,12 +284,9 @@ void DockcoreBase::observe_drive(const TickInput& in, TaskState state, const Tas
   // A stall may be the drive's deadband only while the robot moves freely: not on the contacts, not with stale
   // feedback, not in a state that stands still, and not with its edge at the dock's face (pressing a misaligned dock
   // is no deadband).
-  const bool moving_state = state == TaskState::kReachTaskingPoint || state == TaskState::kAlign ||
-                            state == TaskState::kRetry || state == TaskState::kUndocking;
-  const Real edge_m = config_.footprint.shape == FootprintShape::kCircular ? config_.footprint.radius_m
-                                                                           : config_.footprint.half_length_m;
-  const bool at_dock = t.dock.valid && std::fabs(t.dock.pose.x_m) - edge_m < kDeadbandDockClearanceM;
-  const bool learn = moving_state && !in.contact && !watch_.hold() && !at_dock;
+  const bool at_dock =
+      t.dock.valid && std::fabs(t.dock.pose.x_m) - body_front_m(config_.footprint) < kDeadbandDockClearanceM;
+  const bool learn = is_moving_state(state) && !in.contact && !watch_.hold() && !at_dock;
   deadband_.observe(sent_wheels_, twist_to_wheels(config_.drive, odometry_.twist()), in.now_us, learn);
 }
 

@@ -157,18 +157,11 @@ double clopper_pearson_lower(int n, int k, double alpha) {
 std::string cause_of(const docksim::SimRun& r) {
   const auto& o = r.outcome;
   if (o.final_state == dockcore::TaskState::kFault && !o.faults.empty()) {
-    int last = o.faults.rbegin()->first;
-    for (const auto& kv : o.faults) last = kv.first;  // codes in order; the run ends on one of them
+    const int last = o.faults.rbegin()->first;  // the highest code raised
     return std::to_string(last) + " " + dockcore::to_string(static_cast<dockcore::FaultCode>(last));
   }
   if (o.timed_out) return "timeout";
   return std::string("ended in ") + dockcore::to_string(o.final_state);
-}
-
-std::string fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, v);
-  return b;
 }
 
 void draw_envelope(const std::string& path, const std::string& title, const std::vector<std::vector<double>>& values,

@@ -13,6 +13,12 @@ namespace {
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 }  // namespace
 
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), f, v);
+  return buf;
+}
+
 double pct(std::vector<double> v, double p) {
   if (v.empty()) return std::nan("");
   std::sort(v.begin(), v.end());

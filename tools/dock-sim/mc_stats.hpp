@@ -12,6 +12,9 @@
 
 namespace docksim_cli {
 
+/// printf-formats one number (`f` takes one double). O(1).
+std::string fmt(const char* f, double v);
+
 /// Nearest-rank percentile p (0-100) of v; NaN for an empty v. O(n log n).
 double pct(std::vector<double> v, double p);
 

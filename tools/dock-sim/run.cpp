@@ -30,12 +30,6 @@ using docksim::SvgStyle;
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), f, v);
-  return buf;
-}
-
 double r6(double v) {
   return std::round(v * 1e6) / 1e6;
 }

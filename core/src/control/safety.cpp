@@ -59,8 +59,8 @@ void ObstacleChecker::configure(const FootprintParams& footprint, const DockProf
   }
 }
 
-Real ObstacleChecker::body_front_m() const {
-  return fp_.shape == FootprintShape::kCircular ? fp_.radius_m : fp_.half_length_m;
+Real body_front_m(const FootprintParams& fp) {
+  return fp.shape == FootprintShape::kCircular ? fp.radius_m : fp.half_length_m;
 }
 
 namespace {

@@ -33,12 +33,12 @@ const char* to_string(CommandResult r) {
   return "unknown";
 }
 
-namespace {
-
 bool is_moving_state(TaskState s) {
   return s == TaskState::kReachTaskingPoint || s == TaskState::kAlign || s == TaskState::kRetry ||
          s == TaskState::kUndocking;
 }
+
+namespace {
 
 /// States in which the docking task (started by a dock command) is running: the task timeout applies.
 bool is_docking_state(TaskState s) {
@@ -63,7 +63,6 @@ bool is_zero(const Twist2& t) { return t.vx_mps == 0 && t.vy_mps == 0 && t.wz_ra
 void TaskManager::configure(const TaskParams& params, const FootprintParams& footprint, const DockProfile& profile) {
   params_ = params;
   obstacles_.configure(footprint, &profile);
-  edge_m_ = footprint.shape == FootprintShape::kCircular ? footprint.radius_m : footprint.half_length_m;
   state_ = TaskState::kNotTasking;
   fault_ = FaultCode::kNone;
   faulted_in_ = TaskState::kNotTasking;
@@ -86,7 +85,7 @@ bool TaskManager::dock_fresh(const TaskInput& in) const {
   // The last stretch: odometry carries a confirmed estimate over a few centimetres with sub-millimetre error, while
   // the lidar may see only the dock's face from there.
   return state_ == TaskState::kAlign && in.dock.confirmed && age_s <= params_.blind_finish_max_s &&
-         std::fabs(in.dock.pose.x_m) - edge_m_ <= params_.blind_finish_m;
+         std::fabs(in.dock.pose.x_m) - obstacles_.body_front_m() <= params_.blind_finish_m;
 }
 
 void TaskManager::enter(TaskState s, const TaskInput& in) {

@@ -81,6 +81,8 @@ struct FootprintParams {
 FootprintParams square_footprint();
 /// Seed 004's circular robot: check area 0.3 x 0.5 m, circumscribed (= body) radius 0.275 m. O(1).
 FootprintParams circular_footprint();
+/// Distance from the rotation centre to the body's front (and rear) edge: half-length, or radius. O(1).
+Real body_front_m(const FootprintParams& fp);
 
 /// Result of one obstacle check.
 struct ObstacleFlags {
@@ -118,7 +120,7 @@ class ObstacleChecker {
 
   const FootprintParams& footprint() const { return fp_; }
   /// Distance from the rotation centre to the body's front (and rear) edge. O(1).
-  Real body_front_m() const;
+  Real body_front_m() const { return dockcore::body_front_m(fp_); }
 
  private:
   FootprintParams fp_{};

@@ -38,6 +38,8 @@ enum class TaskState : std::uint8_t {
 
 /// Stable name ("NOT_TASKING", ...). Never null. O(1).
 const char* to_string(TaskState s);
+/// The states in which the task may drive the robot: REACH_TASKING_POINT, ALIGN, RETRY, UNDOCKING. O(1).
+bool is_moving_state(TaskState s);
 
 /// Host command kinds (wire codes). Anything else is rejected as unknown.
 enum class HostCommandType : std::uint8_t {
@@ -255,7 +257,6 @@ class TaskManager {
   Twist2 want_{};              // the state's wanted twist for this tick; emit() decides what leaves
   bool hold_ = false;          // a stop condition of the running state (target lost)
   bool have_prev_tick_ = false;
-  Real edge_m_ = 0;  // robot centre to the footprint's edge (half-length or radius): where the pads meet the dock.
   std::uint64_t prev_tick_us_ = 0;
   std::uint64_t state_since_us_ = 0;
   std::uint64_t task_since_us_ = 0;
