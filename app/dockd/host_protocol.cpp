@@ -146,7 +146,8 @@ void HostProtocol::command_taken(const dockcore::TickOutput& out, TaskState befo
                         out.command_result == dockcore::CommandResult::kAlreadyDocked;
   const Slot* udp = take(out.command.token);
   const TaskState after = out.status.state;
-  if (!accepted) ++counters_.commands_rejected;
+  // A refused UDP request is counted by reply_error, with its error reply; a CAN or resumed command here.
+  if (!accepted && udp == nullptr) ++counters_.commands_rejected;
   if (udp != nullptr) {
     if (accepted) {
       char buf[256];

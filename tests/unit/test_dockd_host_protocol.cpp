@@ -165,6 +165,29 @@ TEST(DockdHostProtocol, RefusalsAreAnsweredAtOnceAndCounted) {
   STRCMP_CONTAINS("\"event\":\"command_rejected\"", actions.events[0].c_str());
 }
 
+TEST(DockdHostProtocol, ARequestTheTaskManagerRefusesIsCountedOnce) {
+  dockd::HostProtocol p(&link, nullptr, actions, counters);
+  link.pending.push_back(request(HostRequestKind::kUndock, 5));
+  p.poll(1000);
+  CHECK_EQUAL(1u, actions.submitted.size());
+  p.command_taken(taken(actions.submitted[0].token, dockcore::HostCommandType::kUndock, 3,
+                        dockcore::CommandResult::kRejectedNotDocked, dockcore::TaskState::kNotTasking),
+                  dockcore::TaskState::kNotTasking, 21000);
+  CHECK_EQUAL(1u, link.replies.size());
+  STRCMP_CONTAINS("\"seq\":5,\"code\":6,\"error\":\"rejected\"", link.replies[0].c_str());
+  CHECK_EQUAL(1u, counters.commands);
+  CHECK_EQUAL(1u, counters.commands_rejected);
+  CHECK_EQUAL(1u, link.c.rejected_later);
+  CHECK_EQUAL(1u, p.commands_rejected_total());
+
+  // A CAN command (no UDP request waits for it) refused by the task manager: counted once too.
+  p.command_taken(taken(0, dockcore::HostCommandType::kUndock, 3, dockcore::CommandResult::kRejectedNotDocked,
+                        dockcore::TaskState::kNotTasking),
+                  dockcore::TaskState::kNotTasking, 41000);
+  CHECK_EQUAL(2u, counters.commands_rejected);
+  CHECK_EQUAL(2u, p.commands_rejected_total());
+}
+
 TEST(DockdHostProtocol, AStopThatDisplacesAQueuedRequestLeavesThatOneUnanswered) {
   dockd::HostProtocol p(&link, nullptr, actions, counters);
   link.pending.push_back(request(HostRequestKind::kDock, 1));
