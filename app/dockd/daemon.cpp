@@ -31,9 +31,8 @@ Daemon::Daemon(const DockdConfig& config, const DaemonIo& io)
     : cfg_(config),
       io_(io),
       controllers_(config.seed000, config.seed004, config.seed003, config.smooth),
-      teach_storage_(std::make_unique<Teach>()),
-      teach_(*teach_storage_),
-      host_(io.udp_host, io.can_host, *this, counters_) {
+      host_(io.udp_host, io.can_host, *this, counters_),
+      teach_(cfg_, *this) {
   build_core();
 }
 
@@ -179,6 +178,34 @@ dockcore::SubmitResult Daemon::submit(HostCommandType type, std::uint16_t dock_i
   return res;
 }
 
+void Daemon::start_teach(const HostRequest& r, std::uint64_t now_us) {
+  TeachConditions c;
+  c.state = state();
+  c.on_charger = !chassis_stale() && fb_.charging_contact;
+  c.lidar_fresh = !lidar_stale();
+  teach_.start(r, c, now_us);
+}
+
+void Daemon::cancel_teach(std::uint64_t now_us) {
+  teach_.cancel(now_us);
+}
+
+bool Daemon::store_target(const TaughtTarget& t, std::string& error) {
+  StateData next = state_;
+  next.put(t);
+  if (!save_state(cfg_.state_file, next, error)) return false;
+  state_ = next;
+  return true;
+}
+
+void Daemon::reply(const HostRequest& r, const char* json, std::size_t len) {
+  host_.reply(r, json, len);
+}
+
+void Daemon::reply_error(const HostRequest& r, HostErrorCode code, const char* message) {
+  host_.reply_error(r, code, message);
+}
+
 void Daemon::send_wheels(const dockcore::hal::WheelCommand& w) {
   last_wheels_ = w;
   if (!io_.chassis->send_wheels(w)) ++counters_.wheel_send_failures;
@@ -233,7 +260,7 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
     const dockcore::DockEstimate* e = core_->on_scan(scan->view(), scan->stamp_us, now_us);
     if (e != nullptr && e->found) {
       ++counters_.detections;
-      if (teach_.active) teach_sample(*e);
+      teach_.sample(*e);
     }
   }
 }
@@ -346,7 +373,7 @@ void Daemon::on_tick(std::uint64_t now_us) {
   host_.poll(now_us);
   host_.report_held_events(now_us);
   watchdogs(now_us);
-  teach_progress(now_us);
+  teach_.progress(now_us);
   if (pending_cfg_ != nullptr && reload_can_apply()) {
     std::string msg;
     apply_reload(now_us, msg);  // logged there
@@ -361,8 +388,8 @@ void Daemon::on_tick(std::uint64_t now_us) {
   // teach runs. A dock/test for another dock (or after a teach changed the correction) needs the core configured for
   // it; that resets the task manager, so only while it is idle (otherwise the task manager answers "busy").
   const TaskState before = state();
-  in.hold_commands = teach_.active;
-  const dockcore::QueuedCommand* next = teach_.active ? nullptr : core_->next_command();
+  in.hold_commands = teach_.active();
+  const dockcore::QueuedCommand* next = teach_.active() ? nullptr : core_->next_command();
   if (next != nullptr &&
       (next->command.type == HostCommandType::kDock || next->command.type == HostCommandType::kTestMode) &&
       idle_state(before) && (next->command.dock_id != active_dock_ || active_raw_)) {

@@ -34,6 +34,7 @@
 #include "events.hpp"
 #include "host_protocol.hpp"
 #include "state_file.hpp"
+#include "teach.hpp"
 
 namespace dockd {
 
@@ -76,9 +77,10 @@ enum class ReloadResult : std::uint8_t {
   kRejected = 2,  ///< Invalid or changes a restart-only key: nothing changed; the message says why.
 };
 
-/// The daemon: the wiring of the inputs into the core, the tick, teach, reload and the status. The host protocol is
-/// its HostProtocol member, which asks the daemon for what a request needs through HostActions.
-class Daemon final : private HostActions {
+/// The daemon: the wiring of the inputs into the core, the tick, reload and the status. The host protocol is its
+/// HostProtocol member, which asks the daemon for what a request needs through HostActions; teach is its Teacher
+/// member, which asks through TeachHooks.
+class Daemon final : private HostActions, private TeachHooks {
  public:
   /// `config` is copied. Call start() before anything else.
   Daemon(const DockdConfig& config, const DaemonIo& io);
@@ -136,7 +138,7 @@ class Daemon final : private HostActions {
   const DaemonCounters& counters() const { return counters_; }
   const dockcore::Pose2& odom_pose() const { return core_->odometry().pose(); }
   const StateData& state_data() const { return state_; }
-  bool teaching() const { return teach_.active; }
+  bool teaching() const { return teach_.active(); }
   /// The profile currently configured (after any taught/configured target correction) and its dock id.
   std::uint16_t active_dock_id() const override { return active_dock_; }
   /// Current status as one JSON object (no newline). Returns the length (0 when it does not fit). O(1).
@@ -150,17 +152,6 @@ class Daemon final : private HostActions {
   std::uint32_t commands_rejected_total() const { return host_.commands_rejected_total(); }
 
  private:
-  struct Teach {
-    bool active = false;
-    std::uint16_t dock_id = 0;
-    std::uint16_t wanted = 0;
-    std::uint16_t have = 0;
-    double sx = 0, sy = 0, sc = 0, ss = 0;  // sums of x, y, cos yaw, sin yaw
-    dockcore::Pose2 samples[1000];
-    std::uint64_t deadline_us = 0;
-    dockcore::hal::HostRequest request{};
-  };
-
   void poll_chassis(std::uint64_t now_us);
   void poll_lidar(std::uint64_t now_us);
   void poll_camera(std::uint64_t now_us);
@@ -169,15 +160,18 @@ class Daemon final : private HostActions {
                                 std::uint32_t& displaced) override;
   void start_teach(const dockcore::hal::HostRequest& r, std::uint64_t now_us) override;
   void cancel_teach(std::uint64_t now_us) override;
+  // TeachHooks: what the teach asks of the daemon.
   /// Configures Dockcore for `dock_id` (profile corrected by its taught / configured target). Resets the task
   /// manager: only while idle.
-  bool configure_core(std::uint16_t dock_id, bool raw_profile);
+  bool configure_core(std::uint16_t dock_id, bool raw_profile) override;
+  /// Puts `t` into the state and saves the state file; the state is kept as it was when the file cannot be saved.
+  bool store_target(const TaughtTarget& t, std::string& error) override;
+  void reply(const dockcore::hal::HostRequest& r, const char* json, std::size_t len) override;
+  void reply_error(const dockcore::hal::HostRequest& r, dockcore::drivers::HostErrorCode code,
+                   const char* message) override;
   void watchdogs(std::uint64_t now_us);
   /// The own camera's stall watchdog (part of watchdogs): sets camera_stalled_, counts and logs its changes.
   void camera_watchdog(std::uint64_t now_us);
-  void teach_sample(const dockcore::DockEstimate& e);
-  void teach_progress(std::uint64_t now_us);
-  void finish_teach(bool ok, const char* why, std::uint64_t now_us);
   void publish_status(std::uint64_t now_us);
   void send_wheels(const dockcore::hal::WheelCommand& w);
   void emit_event(LogLevel level, const char* line, std::size_t len);
@@ -193,8 +187,6 @@ class Daemon final : private HostActions {
   dockcore::ControllerSet controllers_;
   dockcore::DockingController* controller_ = nullptr;  ///< The configured one of controllers_.
   std::unique_ptr<dockcore::Dockcore> core_;
-  std::unique_ptr<Teach> teach_storage_;
-  Teach& teach_;
   dockcore::DockcoreConfig core_cfg_{};
   StateData state_;
   std::uint16_t active_dock_ = 0;
@@ -228,6 +220,7 @@ class Daemon final : private HostActions {
   std::uint64_t prev_tick_us_ = 0;
   DaemonCounters counters_{};
   HostProtocol host_;  ///< The host links: requests, replies, the status on both links.
+  Teacher teach_;      ///< The running teach, if any.
   bool shutdown_logged_ = false;
   std::unique_ptr<DockdConfig> pending_cfg_;  ///< A validated reload waiting for an idle task.
   /// [record] loop: every call into the core, for dock-sim replay (null when off).

@@ -50,7 +50,7 @@ ReloadResult Daemon::request_reload(const DockdConfig& next, std::uint64_t now_u
 bool Daemon::reload_can_apply() const {
   // Rebuilding the core resets the task manager: only while nothing runs, no fault is latched (the host must see
   // it) and no watchdog resume waits — so no motion, charge or fault report changes under a reload.
-  return state() == TaskState::kNotTasking && !teach_.active && !core_->resume_pending();
+  return state() == TaskState::kNotTasking && !teach_.active() && !core_->resume_pending();
 }
 
 bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {

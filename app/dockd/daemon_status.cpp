@@ -85,7 +85,7 @@ void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_u
       .reals("deadband_fwd_radps", db_fwd, wheels, 2)
       .reals("deadband_rev_radps", db_rev, wheels, 2)
       .uint("deadband_raises", db.raises())
-      .boolean("teaching", teach_.active)
+      .boolean("teaching", teach_.active())
       .boolean("taught", state_.find(s.dock_id) != nullptr)
       .uint("ticks", stats_.ticks)
       .uint("tick_worst_us", stats_.worst_period_us)
