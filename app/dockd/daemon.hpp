@@ -51,10 +51,9 @@ struct DaemonIo {
   dockcore::hal::TagPoseSource* tags = nullptr;
   /// dockd's own camera's frame arrivals, for the stall watchdog (camera_stalled); null: no watchdog.
   const dockcore::hal::CameraFrameMonitor* camera_frames = nullptr;
-  /// Optional: writes the own camera's status fields ("camera_frames", …; no heap, never blocking) into the status
-  /// being written; when they do not fit the status goes without them. `ctx` is camera_status_ctx.
-  void (*camera_status)(const void* ctx, dockcore::drivers::JsonWriter& w) = nullptr;
-  const void* camera_status_ctx = nullptr;
+  /// dockd's own camera's state, for the status fields camera_connected, camera_frames, …; null: none. The status
+  /// goes without them when they do not fit.
+  const dockcore::hal::CameraStatusSource* camera_status = nullptr;
   const dockcore::hal::Clock* clock = nullptr;
   dockcore::hal::LogSink* event_log = nullptr;  ///< JSON-lines event log.
   /// Also print events at or above this level to stderr (journal). kError..kDebug.

@@ -163,24 +163,6 @@ void notify(const char* what) {
 
 enum Tag : std::uint64_t { kTimer = 1, kSignal, kLidar, kCan, kHost, kCamera, kCameraOwn };
 
-#ifdef DOCKD_HAVE_VISION
-/// The own camera's status fields (DaemonIo::camera_status): capture counters and the id of the target tag seen in
-/// the last frame (-1: none).
-/// A snapshot copy; never blocks, no heap.
-void own_camera_status(const void* ctx, dockcore::drivers::JsonWriter& w) {
-  const auto* p = static_cast<const dockcore::drivers::CameraPipeline*>(ctx);
-  const dockcore::drivers::CameraPipelineStats s = p->stats();
-  // Compact: the status is about 1.2 kB of the 1400-byte reply (kMaxHostReply); camera-check reports the rest.
-  w.boolean("camera_connected", s.connected)
-      .uint("camera_frames", s.capture.frames)
-      .uint("camera_dropped", s.capture.dropped)
-      .uint("camera_late", s.capture.late)
-      .uint("camera_corrupt", s.capture.corrupt)
-      .uint("camera_reconnects", s.capture.reconnects)
-      .sint("camera_tag_id", s.have_tag ? s.last_tag.id : -1);
-}
-#endif
-
 struct Registration {
   int fd = -1;
 };
@@ -378,10 +360,7 @@ int main(int argc, char** argv) {
   io.camera_own = camera_own.get();
   io.tags = camera_own.get();
   io.camera_frames = camera_own.get();
-  if (camera_own) {
-    io.camera_status = own_camera_status;
-    io.camera_status_ctx = camera_own.get();
-  }
+  io.camera_status = camera_own.get();
 #endif
   io.clock = &clock;
   io.event_log = &event_log;

@@ -194,4 +194,13 @@ CameraPipelineStats CameraPipeline::stats() const {
   return last_read_;
 }
 
+hal::CameraStatus CameraPipeline::camera_status() const {
+  const CameraPipelineStats s = stats();
+  hal::CameraStatus c;
+  c.connected = s.connected;
+  c.capture = s.capture;
+  c.tag_id = s.have_tag ? s.last_tag.id : -1;
+  return c;
+}
+
 }  // namespace dockcore::drivers

@@ -65,9 +65,13 @@ struct CameraPipelineStats {
   std::uint64_t last_tag_stamp_us = 0;
 };
 
-/// Also a hal::TagPoseSource: the target tag's pose of every frame that had one (with intrinsics), in frame order; and
-/// a hal::CameraFrameMonitor: when the thread last received a frame.
-class CameraPipeline final : public hal::CameraTargetSource, public hal::TagPoseSource, public hal::CameraFrameMonitor {
+/// Also a hal::TagPoseSource: the target tag's pose of every frame that had one (with intrinsics), in frame order; a
+/// hal::CameraFrameMonitor: when the thread last received a frame; and a hal::CameraStatusSource: its stats() as a
+/// status report shows them.
+class CameraPipeline final : public hal::CameraTargetSource,
+                             public hal::TagPoseSource,
+                             public hal::CameraFrameMonitor,
+                             public hal::CameraStatusSource {
  public:
   /// Starts the thread. The source and the detector must outlive the pipeline; only the thread uses them.
   /// nullptr + message when the wake-up descriptor or the thread cannot be created.
@@ -91,6 +95,8 @@ class CameraPipeline final : public hal::CameraTargetSource, public hal::TagPose
   int fd() const override { return event_fd_; }
   /// The latest snapshot; never blocks (when the thread is updating it, the previous snapshot is returned).
   CameraPipelineStats stats() const;
+  /// stats()' connection, capture counters and last target tag id. Never blocks, as stats(). O(1).
+  hal::CameraStatus camera_status() const override;
   /// Stops and joins the thread (also done by the destructor). Idempotent.
   void stop();
 

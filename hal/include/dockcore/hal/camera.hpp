@@ -5,7 +5,8 @@
 ///  - TagPoseSource: the dock tag's pose per frame (DockcoreBase::on_tag's input), from dockd's own detector;
 ///  - CameraFrameSource: raw grey frames from a capture device (a V4L2 camera), stamped by the driver, for a
 ///    detector that runs on the robot's board;
-///  - CameraFrameMonitor: when such a source last delivered a frame (the stall watchdog).
+///  - CameraFrameMonitor: when such a source last delivered a frame (the stall watchdog);
+///  - CameraStatusSource: such a camera's state for a status report (connected, its counters, the tag seen last).
 
 #include <cstddef>
 #include <cstdint>
@@ -67,6 +68,24 @@ struct CameraFrameCounters {
       0;  ///< Frames skipped: flagged as errored, fewer bytes than the format needs, or undecodable.
   std::uint32_t disconnects = 0;  ///< Times the device went away (open failures not counted).
   std::uint32_t reconnects = 0;   ///< Times it was opened again after a disconnect.
+};
+
+/// A camera's state as a status report shows it: a snapshot of the capture and of the tag detector's last frame.
+struct CameraStatus {
+  bool connected = false;         ///< The capture device is open and streaming.
+  CameraFrameCounters capture{};  ///< The frame source's counters.
+  std::int32_t tag_id = -1;       ///< The target tag's id in the last frame; -1 when the last frame had none.
+};
+
+/// The state of a camera that captures and detects on the robot's board (dockd's own camera, docs/camera.md).
+class CameraStatusSource {
+ public:
+  /// A snapshot copy. Never blocks (a source updated by another thread returns its previous snapshot while that
+  /// thread holds it), no allocation. O(1).
+  virtual CameraStatus camera_status() const = 0;
+
+ protected:
+  ~CameraStatusSource() = default;
 };
 
 /// Why next_frame() returned without a frame.
