@@ -7,11 +7,26 @@
 
 namespace dockd {
 
+/// What the host protocol counts of the UDP request datagrams (the link counts the datagrams, replies and
+/// subscribers).
+struct UdpRequestCounters {
+  std::uint32_t requests = 0;  ///< Parsed and answered or handed on (subscriptions included).
+  std::uint32_t malformed = 0;
+  std::uint32_t unknown_command = 0;
+  std::uint32_t bad_field = 0;
+  std::uint32_t too_long = 0;
+  /// Parsed, then refused with an error reply: unknown dock id, queue full, the task manager, teach.
+  std::uint32_t rejected_later = 0;
+
+  /// Datagrams refused because they did not parse (malformed, unknown command, bad field, too long). O(1).
+  std::uint32_t refused() const { return malformed + unknown_command + bad_field + too_long; }
+};
+
 /// Counters the daemon itself keeps (the drivers keep theirs).
 struct DaemonCounters {
   std::uint32_t commands = 0;  ///< Task commands handed to the task manager.
   /// By the task manager or dockd (unknown dock id, queue full), from CAN or UDP; the status field adds the UDP
-  /// link's own refusals (HostProtocol::commands_rejected_total()).
+  /// datagrams that did not parse (HostProtocol::commands_rejected_total()).
   std::uint32_t commands_rejected = 0;
   std::uint32_t queue_overflows = 0;
   std::uint32_t scans = 0;
@@ -25,6 +40,7 @@ struct DaemonCounters {
   std::uint32_t events_too_long = 0;          ///< Event lines that did not fit EventLine and were not written.
   /// Tag poses handed to the core, by what became of them (index: dockcore::TagStatus; kFused = fused).
   std::uint32_t tags[dockcore::kTagStatusCount] = {};
+  UdpRequestCounters udp{};  ///< The UDP request datagrams, by what became of them.
 };
 
 }  // namespace dockd

@@ -157,7 +157,7 @@ class Daemon final : private HostActions, private TeachHooks {
   // HostActions: what the host protocol asks of the daemon.
   dockcore::SubmitResult submit(dockcore::HostCommandType type, std::uint16_t dock_id, std::uint32_t token,
                                 std::uint32_t& displaced) override;
-  void start_teach(const dockcore::hal::HostRequest& r, std::uint64_t now_us) override;
+  void start_teach(const HostRequest& r, std::uint64_t now_us) override;
   void cancel_teach(std::uint64_t now_us) override;
   // TeachHooks: what the teach asks of the daemon.
   /// Configures Dockcore for `dock_id` (profile corrected by its taught / configured target). Resets the task
@@ -165,9 +165,8 @@ class Daemon final : private HostActions, private TeachHooks {
   bool configure_core(std::uint16_t dock_id, bool raw_profile) override;
   /// Puts `t` into the state and saves the state file; the state is kept as it was when the file cannot be saved.
   bool store_target(const TaughtTarget& t, std::string& error) override;
-  void reply(const dockcore::hal::HostRequest& r, const char* json, std::size_t len) override;
-  void reply_error(const dockcore::hal::HostRequest& r, dockcore::drivers::HostErrorCode code,
-                   const char* message) override;
+  void reply(const HostRequest& r, const char* json, std::size_t len) override;
+  void reply_error(const HostRequest& r, HostErrorCode code, const char* message) override;
   void watchdogs(std::uint64_t now_us);
   /// The own camera's stall watchdog (part of watchdogs): sets camera_stalled_, counts and logs its changes.
   void camera_watchdog(std::uint64_t now_us);

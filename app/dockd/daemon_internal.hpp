@@ -43,8 +43,5 @@ using dockcore::HostCommandType;
 using dockcore::Pose2;
 using dockcore::Real;
 using dockcore::TaskState;
-using dockcore::drivers::HostErrorCode;
-using dockcore::drivers::HostRequest;
-using dockcore::drivers::HostRequestKind;
 
 }  // namespace dockd

@@ -1,17 +1,158 @@
-// dockd: the host protocol — UDP requests and CAN host commands turned into replies and queued core commands, the
-// replies to queued requests once the core takes them, and the status on both links.
+// dockd: the host protocol — UDP request datagrams parsed and, with the CAN host commands, turned into replies and
+// queued core commands, the replies to queued requests once the core takes them, and the status on both links.
 #include "host_protocol.hpp"
 
 #include <cstdio>
+#include <cstring>
+
+#include "dockcore/drivers/flat_json.hpp"
 
 namespace dockd {
 
 using dockcore::HostCommandType;
 using dockcore::SubmitResult;
 using dockcore::TaskState;
-using dockcore::drivers::HostErrorCode;
-using dockcore::hal::HostRequest;
-using dockcore::hal::HostRequestKind;
+using dockcore::drivers::FlatJson;
+using dockcore::drivers::FlatJsonError;
+using dockcore::drivers::JsonWriter;
+using dockcore::hal::kMaxHostDatagram;
+
+const char* to_string(HostRequestKind k) {
+  switch (k) {
+    case HostRequestKind::kDock:
+      return "dock";
+    case HostRequestKind::kStop:
+      return "stop";
+    case HostRequestKind::kUndock:
+      return "undock";
+    case HostRequestKind::kTest:
+      return "test";
+    case HostRequestKind::kStatus:
+      return "status";
+    case HostRequestKind::kTeach:
+      return "teach";
+    case HostRequestKind::kSubscribe:
+      return "subscribe";
+    case HostRequestKind::kUnsubscribe:
+      return "unsubscribe";
+  }
+  return "?";
+}
+
+const char* to_string(HostErrorCode e) {
+  switch (e) {
+    case HostErrorCode::kNone:
+      return "none";
+    case HostErrorCode::kMalformed:
+      return "malformed";
+    case HostErrorCode::kUnknownCommand:
+      return "unknown_command";
+    case HostErrorCode::kBadField:
+      return "bad_field";
+    case HostErrorCode::kTooLong:
+      return "too_long";
+    case HostErrorCode::kUnknownDockId:
+      return "unknown_dock_id";
+    case HostErrorCode::kRejected:
+      return "rejected";
+    case HostErrorCode::kTeachFailed:
+      return "teach_failed";
+    case HostErrorCode::kSubscribersFull:
+      return "subscribers_full";
+    case HostErrorCode::kBusy:
+      return "busy";
+  }
+  return "?";
+}
+
+HostErrorCode parse_host_request(const char* data, std::size_t len, HostRequest& out, const char*& detail) {
+  detail = "";
+  if (len > kMaxHostDatagram) {
+    detail = "datagram longer than 512 bytes";
+    return HostErrorCode::kTooLong;
+  }
+  FlatJson j;
+  const FlatJsonError je = j.parse(data, len);
+  if (je != FlatJsonError::kOk) {
+    detail = to_string(je);
+    return HostErrorCode::kMalformed;
+  }
+  HostRequest r;
+  std::int64_t v = 0;
+  if (j.has("seq")) {
+    if (!j.get_int("seq", 0, 4294967295LL, v)) {
+      detail = "seq must be an integer 0..4294967295";
+      return HostErrorCode::kBadField;
+    }
+    r.has_seq = true;
+    r.seq = static_cast<std::uint32_t>(v);
+    out.has_seq = true;  // echoed in the error reply even when the rest is bad
+    out.seq = r.seq;
+  }
+  const char* cmd = nullptr;
+  if (!j.get_string("cmd", cmd)) {
+    detail = "\"cmd\" (a string) is required";
+    return HostErrorCode::kMalformed;
+  }
+  struct Name {
+    const char* name;
+    HostRequestKind kind;
+  };
+  static const Name kNames[] = {{"dock", HostRequestKind::kDock},
+                                {"stop", HostRequestKind::kStop},
+                                {"cancel", HostRequestKind::kStop},
+                                {"undock", HostRequestKind::kUndock},
+                                {"test", HostRequestKind::kTest},
+                                {"status", HostRequestKind::kStatus},
+                                {"teach", HostRequestKind::kTeach},
+                                {"subscribe", HostRequestKind::kSubscribe},
+                                {"unsubscribe", HostRequestKind::kUnsubscribe}};
+  bool found = false;
+  for (const Name& n : kNames) {
+    if (std::strcmp(n.name, cmd) == 0) {
+      r.kind = n.kind;
+      found = true;
+    }
+  }
+  if (!found) {
+    detail = "cmd is not one of dock, undock, stop, cancel, test, status, teach, subscribe, unsubscribe";
+    return HostErrorCode::kUnknownCommand;
+  }
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const char* k = j.key(i);
+    if (std::strcmp(k, "cmd") != 0 && std::strcmp(k, "seq") != 0 && std::strcmp(k, "dock_id") != 0 &&
+        std::strcmp(k, "scans") != 0) {
+      detail = "unknown field (expected cmd, seq, dock_id, scans)";
+      return HostErrorCode::kBadField;
+    }
+  }
+  if (j.has("dock_id")) {
+    if (!j.get_int("dock_id", 0, 65535, v)) {
+      detail = "dock_id must be an integer 0..65535";
+      return HostErrorCode::kBadField;
+    }
+    r.has_dock_id = true;
+    r.dock_id = static_cast<std::uint16_t>(v);
+  }
+  if (j.has("scans")) {
+    if (r.kind != HostRequestKind::kTeach || !j.get_int("scans", 1, 1000, v)) {
+      detail = "scans must be an integer 1..1000 and only with teach";
+      return HostErrorCode::kBadField;
+    }
+    r.scans = static_cast<std::uint16_t>(v);
+  }
+  out = r;
+  return HostErrorCode::kNone;
+}
+
+std::size_t format_host_error(char* buf, std::size_t size, bool has_seq, std::uint32_t seq, HostErrorCode code,
+                              const char* message) {
+  JsonWriter w(buf, size);
+  w.boolean("ok", false);
+  if (has_seq) w.uint("seq", seq);
+  w.uint("code", static_cast<unsigned>(code)).str("error", to_string(code)).str_cut("message", message, 255);
+  return w.finish();
+}
 
 HostProtocol::HostProtocol(dockcore::hal::HostRequestLink* udp, dockcore::hal::HostLink* can, HostActions& actions,
                            DaemonCounters& counters)
@@ -54,10 +195,10 @@ void HostProtocol::reply(const HostRequest& r, const char* json, std::size_t len
 
 void HostProtocol::reply_error(const HostRequest& r, HostErrorCode code, const char* message) {
   char buf[512];
-  const std::size_t n = dockcore::drivers::format_host_error(buf, sizeof buf, r.has_seq, r.seq, code, message);
+  const std::size_t n = format_host_error(buf, sizeof buf, r.has_seq, r.seq, code, message);
   reply(r, buf, n);
   ++counters_.commands_rejected;
-  if (udp_ != nullptr) udp_->count_rejected();
+  ++counters_.udp.rejected_later;
   if (!refusal_log_.admit(r.stamp_us)) return;
   EventLine e(r.stamp_us, "command_rejected");
   e.w.str("source", "udp").str("cmd", to_string(r.kind)).uint("seq", r.seq).str("error", to_string(code));
@@ -72,12 +213,69 @@ void HostProtocol::report_held_events(std::uint64_t now_us) {
   actions_.log_event(e, LogLevel::kWarn);
 }
 
+bool HostProtocol::handle_datagram(const dockcore::hal::HostDatagram& d, std::uint64_t now_us) {
+  HostRequest r;
+  const char* detail = "";
+  const HostErrorCode e = parse_host_request(d.data, d.len, r, detail);
+  if (e != HostErrorCode::kNone) {
+    // Answered and counted, but not a command_rejected event: nothing was asked of the daemon.
+    switch (e) {
+      case HostErrorCode::kTooLong:
+        ++counters_.udp.too_long;
+        break;
+      case HostErrorCode::kUnknownCommand:
+        ++counters_.udp.unknown_command;
+        break;
+      case HostErrorCode::kBadField:
+        ++counters_.udp.bad_field;
+        break;
+      default:
+        ++counters_.udp.malformed;
+        break;
+    }
+    char buf[512];
+    const std::size_t n = format_host_error(buf, sizeof buf, r.has_seq, r.seq, e, detail);
+    udp_->reply(d.peer, buf, n);
+    return false;
+  }
+  r.peer = d.peer;
+  r.stamp_us = d.stamp_us;
+  ++counters_.udp.requests;
+  if (r.kind == HostRequestKind::kSubscribe || r.kind == HostRequestKind::kUnsubscribe) {
+    handle_subscription(r, now_us);
+    return false;
+  }
+  handle_udp(r, now_us);
+  return true;
+}
+
+void HostProtocol::handle_subscription(const HostRequest& r, std::uint64_t now_us) {
+  char buf[256];
+  if (r.kind == HostRequestKind::kUnsubscribe) {
+    udp_->unsubscribe(r.peer);
+    JsonWriter w(buf, sizeof buf);
+    w.boolean("ok", true).str("cmd", "unsubscribe").uint("seq", r.seq);
+    reply(r, buf, w.finish());
+    return;
+  }
+  std::uint32_t expires_ms = 0;
+  if (!udp_->subscribe(r.peer, now_us, expires_ms)) {
+    const std::size_t n =
+        format_host_error(buf, sizeof buf, r.has_seq, r.seq, HostErrorCode::kSubscribersFull, "subscriber table full");
+    reply(r, buf, n);
+    return;
+  }
+  JsonWriter w(buf, sizeof buf);
+  w.boolean("ok", true).str("cmd", "subscribe").uint("seq", r.seq).uint("expires_ms", expires_ms);
+  reply(r, buf, w.finish());
+}
+
 void HostProtocol::handle_udp(const HostRequest& r, std::uint64_t now_us) {
   switch (r.kind) {
     case HostRequestKind::kStatus: {
       // The reply is the status object with {"ok":true,"cmd":"status","seq":N} in front.
-      char out[dockcore::drivers::kMaxHostReply];
-      dockcore::drivers::JsonWriter w(out, sizeof out);
+      char out[dockcore::hal::kMaxHostReply];
+      JsonWriter w(out, sizeof out);
       w.boolean("ok", true).str("cmd", "status").uint("seq", r.seq);
       actions_.status_fields(w, now_us);
       reply(r, out, w.finish());
@@ -116,14 +314,23 @@ void HostProtocol::handle_udp(const HostRequest& r, std::uint64_t now_us) {
     }
     case HostRequestKind::kSubscribe:
     case HostRequestKind::kUnsubscribe:
-      return;  // handled by the link
+      return;  // handle_subscription
   }
 }
 
 void HostProtocol::poll(std::uint64_t now_us) {
   if (udp_ != nullptr) {
-    HostRequest r;
-    for (int i = 0; i < 64 && udp_->poll_request(r, now_us); ++i) handle_udp(r, now_us);
+    dockcore::hal::HostDatagram d;
+    int requests = 0;
+    int others = 0;  // since the last request
+    while (requests < 64 && others < 64 && udp_->poll_datagram(d, now_us)) {
+      if (handle_datagram(d, now_us)) {
+        ++requests;
+        others = 0;
+      } else {
+        ++others;
+      }
+    }
   }
   if (can_ != nullptr) {
     dockcore::hal::HostCommandMessage m;
@@ -151,7 +358,7 @@ void HostProtocol::command_taken(const dockcore::TickOutput& out, TaskState befo
   if (udp != nullptr) {
     if (accepted) {
       char buf[256];
-      dockcore::drivers::JsonWriter w(buf, sizeof buf);
+      JsonWriter w(buf, sizeof buf);
       w.boolean("ok", true)
           .str("cmd", to_string(udp->request.kind))
           .uint("seq", udp->request.seq)
@@ -179,8 +386,8 @@ void HostProtocol::command_taken(const dockcore::TickOutput& out, TaskState befo
 void HostProtocol::publish_status(const dockcore::hal::StatusMessage& can_status, std::uint64_t now_us) {
   if (can_ != nullptr) can_->send_status(can_status);
   if (udp_ != nullptr && udp_->subscriber_count() > 0) {
-    char buf[dockcore::drivers::kMaxHostReply];
-    dockcore::drivers::JsonWriter w(buf, sizeof buf);
+    char buf[dockcore::hal::kMaxHostReply];
+    JsonWriter w(buf, sizeof buf);
     actions_.status_fields(w, now_us);
     const std::size_t n = w.finish();
     if (n > 0) udp_->publish(buf, n, now_us);
@@ -189,8 +396,8 @@ void HostProtocol::publish_status(const dockcore::hal::StatusMessage& can_status
 }
 
 std::uint32_t HostProtocol::commands_rejected_total() const {
-  // Requests the UDP link refused before dockd saw them (it answered them itself): still host commands refused.
-  return counters_.commands_rejected + (udp_ != nullptr ? udp_->counters().refused() : 0u);
+  // Datagrams that did not parse are host commands refused too, though not counted in commands_rejected.
+  return counters_.commands_rejected + counters_.udp.refused();
 }
 
 std::uint32_t HostProtocol::udp_not_allowed() const {

@@ -12,9 +12,8 @@
 
 #include "config.hpp"
 #include "dockcore/dockcore.hpp"
-#include "dockcore/drivers/udp_host_link.hpp"
-#include "dockcore/hal/host_link.hpp"
 #include "events.hpp"
+#include "host_protocol.hpp"
 #include "state_file.hpp"
 
 namespace dockd {
@@ -31,10 +30,9 @@ class TeachHooks {
   /// saved; nothing changed then. May allocate and write a file (once per teach).
   virtual bool store_target(const TaughtTarget& t, std::string& error) = 0;
   /// Sends `json` (one object, no newline) to the sender of `r`.
-  virtual void reply(const dockcore::hal::HostRequest& r, const char* json, std::size_t len) = 0;
+  virtual void reply(const HostRequest& r, const char* json, std::size_t len) = 0;
   /// Refuses `r` with an error reply (counted by the host protocol).
-  virtual void reply_error(const dockcore::hal::HostRequest& r, dockcore::drivers::HostErrorCode code,
-                           const char* message) = 0;
+  virtual void reply_error(const HostRequest& r, HostErrorCode code, const char* message) = 0;
   /// Writes the event to the event log.
   virtual void log_event(EventLine& e, LogLevel level) = 0;
 
@@ -67,7 +65,7 @@ class Teacher {
   /// configured for the dock's raw profile. Refused with an error reply when the dock is unknown, a teach runs
   /// already, the robot is not idle (NOT_TASKING, FINISH_TASKING or FAULT), not on the charger, the lidar is stale
   /// or the core refuses the profile. O(1) plus the core's configuration.
-  void start(const dockcore::hal::HostRequest& r, const TeachConditions& c, std::uint64_t now_us);
+  void start(const HostRequest& r, const TeachConditions& c, std::uint64_t now_us);
   /// A detection of the dock (robot frame) while a teach runs; ignored when none runs or it has its scans. O(1).
   void sample(const dockcore::DockEstimate& e);
   /// Once per tick: finishes the teach when it has its scans (the target stored and replied, or refused when the
@@ -91,7 +89,7 @@ class Teacher {
   double sx_ = 0, sy_ = 0, sc_ = 0, ss_ = 0;    // sums of x, y, cos yaw, sin yaw
   std::unique_ptr<dockcore::Pose2[]> samples_;  ///< kMaxScans poses (24 KiB in double): not inside the daemon.
   std::uint64_t deadline_us_ = 0;
-  dockcore::hal::HostRequest request_{};
+  HostRequest request_{};
 };
 
 }  // namespace dockd

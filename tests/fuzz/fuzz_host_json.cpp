@@ -1,14 +1,14 @@
-// fuzz-links: core drivers
-// dockd's UDP host requests: parse_host_request (flat JSON parser underneath) and the error reply it produces must
-// never crash, and a refused request must leave the output untouched except for the echoed seq.
+// fuzz-links: core drivers dockd_lib
+// dockd's UDP host requests: the host protocol's parse_host_request (flat JSON parser underneath) and the error reply
+// it produces must never crash, and a refused request must leave the output untouched except for the echoed seq.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 
-#include "dockcore/drivers/udp_host_link.hpp"
+#include "host_protocol.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  using namespace dockcore::drivers;
+  using namespace dockd;
   HostRequest r;
   r.dock_id = 4242;
   const char* detail = nullptr;

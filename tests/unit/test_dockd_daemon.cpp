@@ -524,7 +524,7 @@ TEST(DockdDaemon, UdpFloodStaysConsistentAndUnknownDockIsRejected) {
   r.run_until([] { return false; }, 0.5);
   CHECK_EQUAL(static_cast<int>(TaskState::kNotTasking), static_cast<int>(r.daemon->state()));
   CHECK_TRUE(r.wheels_zero());
-  CHECK(r.udp->counters().malformed >= 400);
+  CHECK(r.daemon->counters().udp.malformed >= 400);
   CHECK(r.daemon->counters().commands > 100);
   // The status counts every refusal: dockd's and the task manager's plus the link's malformed requests.
   CHECK(r.daemon->commands_rejected_total() >= r.daemon->counters().commands_rejected + 500);

@@ -1,5 +1,7 @@
-// dockd's host protocol on its own: requests from an in-memory request link, a scripted daemon behind HostActions.
-// Which reply each request gets, and when: at once (refusals), or once the core takes its queued command.
+// dockd's host protocol on its own: request datagrams from an in-memory request link, a scripted daemon behind
+// HostActions. How each datagram is parsed, which reply each request gets, and when: at once (refusals, status,
+// subscriptions), or once the core takes its queued command.
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <deque>
@@ -12,22 +14,27 @@
 
 namespace {
 
-using dockcore::hal::HostRequest;
-using dockcore::hal::HostRequestKind;
+using dockd::HostRequest;
+using dockd::HostRequestKind;
 
-/// Requests handed out in order; every reply and status datagram kept as text.
+/// Datagrams handed out in order, all from one peer; every reply and status datagram kept as text; a subscriber
+/// table of two.
 struct FakeRequestLink final : dockcore::hal::HostRequestLink {
-  std::deque<HostRequest> pending;
+  std::deque<std::string> pending;
   std::vector<std::string> replies;
   std::vector<std::string> published;
   dockcore::hal::HostRequestCounters c{};
   std::size_t subscribers = 0;
 
-  bool poll_request(HostRequest& out, std::uint64_t now_us) override {
+  bool poll_datagram(dockcore::hal::HostDatagram& out, std::uint64_t now_us) override {
     if (pending.empty()) return false;
-    out = pending.front();
+    const std::string& d = pending.front();
+    out.len = d.size();
+    std::memcpy(out.data, d.data(), std::min(d.size(), sizeof out.data));
+    out.peer = dockcore::hal::HostPeer{0x0100007fu, 0x3930u};
     out.stamp_us = now_us;
     pending.pop_front();
+    ++c.datagrams;
     return true;
   }
   bool reply(const dockcore::hal::HostPeer&, const char* json, std::size_t len) override {
@@ -35,9 +42,20 @@ struct FakeRequestLink final : dockcore::hal::HostRequestLink {
     return len > 0;
   }
   void publish(const char* json, std::size_t len, std::uint64_t) override { published.emplace_back(json, len); }
+  bool subscribe(const dockcore::hal::HostPeer&, std::uint64_t, std::uint32_t& expires_ms) override {
+    if (subscribers == 2) {
+      ++c.subscribers_rejected;
+      return false;
+    }
+    ++subscribers;
+    expires_ms = 10000;
+    return true;
+  }
+  void unsubscribe(const dockcore::hal::HostPeer&) override {
+    if (subscribers > 0) --subscribers;
+  }
   std::size_t subscriber_count() const override { return subscribers; }
   const dockcore::hal::HostRequestCounters& counters() const override { return c; }
-  void count_rejected() override { ++c.rejected_later; }
   bool set_allowlist(const std::vector<std::string>&, std::string&) override { return true; }
 };
 
@@ -83,12 +101,9 @@ struct FakeActions final : dockd::HostActions {
   }
 };
 
-HostRequest request(HostRequestKind kind, std::uint32_t seq) {
-  HostRequest r;
-  r.kind = kind;
-  r.has_seq = true;
-  r.seq = seq;
-  return r;
+/// The datagram {"cmd":"<cmd>","seq":<seq>}.
+std::string request(const char* cmd, std::uint32_t seq) {
+  return std::string("{\"cmd\":\"") + cmd + "\",\"seq\":" + std::to_string(seq) + "}";
 }
 
 /// What the core's tick reports when it takes the command queued under `token`.
@@ -113,7 +128,7 @@ TEST_GROUP(DockdHostProtocol) {
 
 TEST(DockdHostProtocol, AQueuedRequestIsAnsweredWhenTheCoreTakesItsCommand) {
   dockd::HostProtocol p(&link, nullptr, actions, counters);
-  link.pending.push_back(request(HostRequestKind::kDock, 7));
+  link.pending.push_back(request("dock", 7));
   p.poll(1000);
   CHECK_EQUAL(1u, actions.submitted.size());
   CHECK_EQUAL(1u, actions.submitted[0].dock_id);  // the default dock
@@ -139,17 +154,14 @@ TEST(DockdHostProtocol, AQueuedRequestIsAnsweredWhenTheCoreTakesItsCommand) {
 
 TEST(DockdHostProtocol, RefusalsAreAnsweredAtOnceAndCounted) {
   dockd::HostProtocol p(&link, nullptr, actions, counters);
-  HostRequest unknown = request(HostRequestKind::kDock, 1);
-  unknown.has_dock_id = true;
-  unknown.dock_id = 9;
-  link.pending.push_back(unknown);
+  link.pending.push_back("{\"cmd\":\"dock\",\"seq\":1,\"dock_id\":9}");
   p.poll(1000);
   CHECK_TRUE(actions.submitted.empty());
   CHECK_EQUAL(1u, link.replies.size());
   STRCMP_CONTAINS("\"code\":5,\"error\":\"unknown_dock_id\"", link.replies[0].c_str());
 
   actions.next_result = dockcore::SubmitResult::kFull;
-  link.pending.push_back(request(HostRequestKind::kUndock, 2));
+  link.pending.push_back(request("undock", 2));
   p.poll(2000);
   CHECK_EQUAL(1u, actions.submitted.size());
   CHECK_EQUAL(3u, actions.submitted[0].dock_id);  // undock goes to the active dock
@@ -158,8 +170,8 @@ TEST(DockdHostProtocol, RefusalsAreAnsweredAtOnceAndCounted) {
 
   CHECK_EQUAL(2u, counters.commands_rejected);
   CHECK_EQUAL(1u, counters.queue_overflows);
-  CHECK_EQUAL(2u, link.c.rejected_later);
-  link.c.malformed = 4;  // the link's own refusals count too
+  CHECK_EQUAL(2u, counters.udp.rejected_later);
+  counters.udp.malformed = 4;  // the datagrams that did not parse count too
   CHECK_EQUAL(6u, p.commands_rejected_total());
   CHECK_EQUAL(2u, actions.events.size());
   STRCMP_CONTAINS("\"event\":\"command_rejected\"", actions.events[0].c_str());
@@ -167,7 +179,7 @@ TEST(DockdHostProtocol, RefusalsAreAnsweredAtOnceAndCounted) {
 
 TEST(DockdHostProtocol, ARequestTheTaskManagerRefusesIsCountedOnce) {
   dockd::HostProtocol p(&link, nullptr, actions, counters);
-  link.pending.push_back(request(HostRequestKind::kUndock, 5));
+  link.pending.push_back(request("undock", 5));
   p.poll(1000);
   CHECK_EQUAL(1u, actions.submitted.size());
   p.command_taken(taken(actions.submitted[0].token, dockcore::HostCommandType::kUndock, 3,
@@ -177,7 +189,7 @@ TEST(DockdHostProtocol, ARequestTheTaskManagerRefusesIsCountedOnce) {
   STRCMP_CONTAINS("\"seq\":5,\"code\":6,\"error\":\"rejected\"", link.replies[0].c_str());
   CHECK_EQUAL(1u, counters.commands);
   CHECK_EQUAL(1u, counters.commands_rejected);
-  CHECK_EQUAL(1u, link.c.rejected_later);
+  CHECK_EQUAL(1u, counters.udp.rejected_later);
   CHECK_EQUAL(1u, p.commands_rejected_total());
 
   // A CAN command (no UDP request waits for it) refused by the task manager: counted once too.
@@ -190,13 +202,13 @@ TEST(DockdHostProtocol, ARequestTheTaskManagerRefusesIsCountedOnce) {
 
 TEST(DockdHostProtocol, AStopThatDisplacesAQueuedRequestLeavesThatOneUnanswered) {
   dockd::HostProtocol p(&link, nullptr, actions, counters);
-  link.pending.push_back(request(HostRequestKind::kDock, 1));
+  link.pending.push_back(request("dock", 1));
   p.poll(1000);
   const std::uint32_t dock_token = actions.submitted[0].token;
 
   actions.next_result = dockcore::SubmitResult::kReplacedNewest;
   actions.next_displaced = dock_token;
-  link.pending.push_back(request(HostRequestKind::kStop, 2));
+  link.pending.push_back(request("stop", 2));
   p.poll(2000);
   CHECK_EQUAL(1, actions.teach_cancels);  // a stop also ends a running teach
   CHECK_EQUAL(2u, actions.submitted.size());
@@ -225,9 +237,119 @@ TEST(DockdHostProtocol, StatusGoesToSubscribersOnlyWhenThereAreAny) {
   STRCMP_EQUAL("{\"type\":\"status\",\"stamp_us\":6}", link.published[0].c_str());
   CHECK_EQUAL(2u, counters.status_sent);
 
-  link.pending.push_back(request(HostRequestKind::kStatus, 4));
+  link.pending.push_back(request("status", 4));
   p.poll(7);
   CHECK_EQUAL(1u, link.replies.size());
   STRCMP_EQUAL("{\"ok\":true,\"cmd\":\"status\",\"seq\":4,\"type\":\"status\",\"stamp_us\":7}",
                link.replies[0].c_str());
+}
+
+TEST(DockdHostProtocol, DatagramsThatDoNotParseAreAnsweredWithTheirCodeAndCounted) {
+  dockd::HostProtocol p(&link, nullptr, actions, counters);
+  link.pending.push_back("{\"cmd\":\"dock\",\"dock_id\":1,\"seq\":7}");
+  link.pending.push_back("{\"cmd\":\"dock\",\"seq\":8");
+  link.pending.push_back("{\"cmd\":\"fly\",\"seq\":9}");
+  link.pending.push_back("{\"cmd\":\"dock\",\"dock_id\":\"x\",\"seq\":10}");
+  link.pending.push_back(std::string(600, ' '));
+  p.poll(1000);
+  CHECK_EQUAL(1u, actions.submitted.size());  // only the dock
+  CHECK_EQUAL(4u, link.replies.size());
+  STRCMP_EQUAL("{\"ok\":false,\"code\":1,\"error\":\"malformed\",\"message\":\"syntax\"}", link.replies[0].c_str());
+  STRCMP_EQUAL(
+      "{\"ok\":false,\"seq\":9,\"code\":2,\"error\":\"unknown_command\",\"message\":\"cmd is not one of dock, "
+      "undock, stop, cancel, test, status, teach, subscribe, unsubscribe\"}",
+      link.replies[1].c_str());
+  STRCMP_EQUAL(
+      "{\"ok\":false,\"seq\":10,\"code\":3,\"error\":\"bad_field\",\"message\":\"dock_id must be an integer "
+      "0..65535\"}",
+      link.replies[2].c_str());
+  STRCMP_EQUAL("{\"ok\":false,\"code\":4,\"error\":\"too_long\",\"message\":\"datagram longer than 512 bytes\"}",
+               link.replies[3].c_str());
+  CHECK_EQUAL(1u, counters.udp.requests);
+  CHECK_EQUAL(1u, counters.udp.malformed);
+  CHECK_EQUAL(1u, counters.udp.unknown_command);
+  CHECK_EQUAL(1u, counters.udp.bad_field);
+  CHECK_EQUAL(1u, counters.udp.too_long);
+  // Host commands refused, though nothing was asked of the daemon: no command_rejected event.
+  CHECK_EQUAL(0u, counters.commands_rejected);
+  CHECK_EQUAL(4u, p.commands_rejected_total());
+  CHECK_TRUE(actions.events.empty());
+}
+
+TEST(DockdHostProtocol, AFloodIsReadOverSeveralPolls) {
+  dockd::HostProtocol p(&link, nullptr, actions, counters);
+  for (int i = 0; i < 70; ++i) link.pending.push_back("{\"cmd\":");
+  link.pending.push_back(request("dock", 1));
+  p.poll(1000);  // 64 datagrams that ask nothing of the daemon in a row end the poll
+  CHECK_EQUAL(64u, link.replies.size());
+  CHECK_TRUE(actions.submitted.empty());
+  p.poll(21000);
+  CHECK_EQUAL(70u, link.replies.size());
+  CHECK_EQUAL(1u, actions.submitted.size());
+  CHECK_EQUAL(70u, counters.udp.malformed);
+}
+
+TEST(DockdHostProtocol, SubscriptionsAreAnsweredWithTheLinksTable) {
+  dockd::HostProtocol p(&link, nullptr, actions, counters);
+  for (std::uint32_t seq = 1; seq <= 3; ++seq) link.pending.push_back(request("subscribe", seq));
+  link.pending.push_back(request("unsubscribe", 4));
+  p.poll(1000);
+  CHECK_EQUAL(4u, link.replies.size());
+  STRCMP_EQUAL("{\"ok\":true,\"cmd\":\"subscribe\",\"seq\":1,\"expires_ms\":10000}", link.replies[0].c_str());
+  STRCMP_EQUAL("{\"ok\":true,\"cmd\":\"subscribe\",\"seq\":2,\"expires_ms\":10000}", link.replies[1].c_str());
+  STRCMP_EQUAL(
+      "{\"ok\":false,\"seq\":3,\"code\":8,\"error\":\"subscribers_full\",\"message\":\"subscriber table "
+      "full\"}",
+      link.replies[2].c_str());
+  STRCMP_EQUAL("{\"ok\":true,\"cmd\":\"unsubscribe\",\"seq\":4}", link.replies[3].c_str());
+  CHECK_EQUAL(1u, link.subscribers);
+  CHECK_EQUAL(1u, link.c.subscribers_rejected);
+  CHECK_EQUAL(4u, counters.udp.requests);
+  CHECK_EQUAL(0u, p.commands_rejected_total());
+  CHECK_TRUE(actions.submitted.empty());
+}
+
+TEST_GROUP(DockdHostRequestParser){};
+
+TEST(DockdHostRequestParser, ReadsEveryFieldAndRefusesWhatIsNotInTheProtocol) {
+  HostRequest r;
+  const char* detail = nullptr;
+  const char teach[] = "{\"cmd\":\"teach\",\"dock_id\":3,\"scans\":20,\"seq\":4294967295}";
+  CHECK_EQUAL(static_cast<int>(dockd::HostErrorCode::kNone),
+              static_cast<int>(dockd::parse_host_request(teach, sizeof teach - 1, r, detail)));
+  CHECK_EQUAL(static_cast<int>(HostRequestKind::kTeach), static_cast<int>(r.kind));
+  CHECK_TRUE(r.has_dock_id);
+  CHECK_EQUAL(3, r.dock_id);
+  CHECK_EQUAL(20, r.scans);
+  CHECK_TRUE(r.has_seq);
+  CHECK_EQUAL(4294967295u, r.seq);
+  const char cancel[] = "{\"cmd\":\"cancel\"}";
+  CHECK_EQUAL(static_cast<int>(dockd::HostErrorCode::kNone),
+              static_cast<int>(dockd::parse_host_request(cancel, sizeof cancel - 1, r, detail)));
+  CHECK_EQUAL(static_cast<int>(HostRequestKind::kStop), static_cast<int>(r.kind));
+  CHECK_FALSE(r.has_seq);
+  STRCMP_EQUAL("stop", dockd::to_string(r.kind));
+
+  struct Bad {
+    const char* text;
+    dockd::HostErrorCode e;
+  } bad[] = {{"{\"seq\":1}", dockd::HostErrorCode::kMalformed},
+             {"{\"cmd\":\"dock\",\"scans\":5,\"seq\":2}", dockd::HostErrorCode::kBadField},
+             {"{\"cmd\":\"teach\",\"scans\":1001,\"seq\":3}", dockd::HostErrorCode::kBadField},
+             {"{\"cmd\":\"dock\",\"speed\":1,\"seq\":4}", dockd::HostErrorCode::kBadField},
+             {"{\"cmd\":\"dock\",\"seq\":-1}", dockd::HostErrorCode::kBadField},
+             {"[1]", dockd::HostErrorCode::kMalformed}};
+  for (const Bad& b : bad) {
+    HostRequest out;
+    out.dock_id = 4242;
+    CHECK_EQUAL_TEXT(static_cast<int>(b.e),
+                     static_cast<int>(dockd::parse_host_request(b.text, std::strlen(b.text), out, detail)), b.text);
+    CHECK_EQUAL(4242, out.dock_id);  // untouched but for the echoed seq
+    CHECK(std::strlen(detail) > 0);
+  }
+  HostRequest out;
+  const char bad_scans[] = "{\"cmd\":\"dock\",\"scans\":5,\"seq\":2}";
+  dockd::parse_host_request(bad_scans, sizeof bad_scans - 1, out, detail);
+  CHECK_TRUE(out.has_seq);
+  CHECK_EQUAL(2u, out.seq);
 }

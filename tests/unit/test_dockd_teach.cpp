@@ -12,8 +12,8 @@
 
 namespace {
 
-using dockcore::hal::HostRequest;
-using dockcore::hal::HostRequestKind;
+using dockd::HostRequest;
+using dockd::HostRequestKind;
 
 /// The daemon's side: every call recorded, the core and the state file scripted.
 struct FakeHooks final : dockd::TeachHooks {
@@ -44,7 +44,7 @@ struct FakeHooks final : dockd::TeachHooks {
     return true;
   }
   void reply(const HostRequest&, const char* json, std::size_t len) override { replies.emplace_back(json, len); }
-  void reply_error(const HostRequest&, dockcore::drivers::HostErrorCode code, const char* message) override {
+  void reply_error(const HostRequest&, dockd::HostErrorCode code, const char* message) override {
     errors.push_back(std::to_string(static_cast<unsigned>(code)) + ":" + message);
   }
   void log_event(dockd::EventLine& e, dockd::LogLevel) override {
