@@ -23,7 +23,6 @@
 #include "counters.hpp"
 #include "dockcore/control/controllers.hpp"
 #include "dockcore/dockcore.hpp"
-#include "dockcore/drivers/json_writer.hpp"
 #include "dockcore/drivers/loop_record.hpp"
 #include "dockcore/hal/camera.hpp"
 #include "dockcore/hal/chassis.hpp"
@@ -144,9 +143,9 @@ class Daemon final : private HostActions, private TeachHooks {
   std::size_t status_json(char* buf, std::size_t size, std::uint64_t now_us) const;
   /// The status's fields, written into `w` (status_json and the status reply); optional groups (tag fusion, camera)
   /// only when they fit.
-  void status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_us) const override;
+  void status_fields(JsonWriter& w, std::uint64_t now_us) const override;
   /// Every host command refused, whatever refused it: dockd and the task manager (counters().commands_rejected)
-  /// plus the UDP link's parse refusals (malformed, unknown command, bad field, too long). The status field
+  /// plus the UDP datagrams that did not parse (malformed, unknown command, bad field, too long). The status field
   /// `commands_rejected`. O(1).
   std::uint32_t commands_rejected_total() const { return host_.commands_rejected_total(); }
 

@@ -27,12 +27,12 @@ void Daemon::publish_status(std::uint64_t now_us) {
 }
 
 std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_us) const {
-  dockcore::drivers::JsonWriter w(buf, size);
+  JsonWriter w(buf, size);
   status_fields(w, now_us);
   return w.finish();
 }
 
-void Daemon::status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_us) const {
+void Daemon::status_fields(JsonWriter& w, std::uint64_t now_us) const {
   const dockcore::TaskStatus& s = last_out_.status;
   const FaultCode watchdog_fault = chassis_stale() ? FaultCode::kChassisStale
                                    : lidar_stale() ? FaultCode::kLidarStale

@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "dockcore/drivers/json_writer.hpp"
+#include "json_writer.hpp"
 
 namespace dockd {
 
@@ -54,7 +54,7 @@ struct EventLine {
   EventLine(const EventLine&) = delete;
   EventLine& operator=(const EventLine&) = delete;
   char buf[1536];
-  dockcore::drivers::JsonWriter w;
+  JsonWriter w;
 };
 
 }  // namespace dockd

@@ -14,7 +14,6 @@ using dockcore::SubmitResult;
 using dockcore::TaskState;
 using dockcore::drivers::FlatJson;
 using dockcore::drivers::FlatJsonError;
-using dockcore::drivers::JsonWriter;
 using dockcore::hal::kMaxHostDatagram;
 
 const char* to_string(HostRequestKind k) {

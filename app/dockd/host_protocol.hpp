@@ -14,9 +14,9 @@
 #include "config.hpp"
 #include "counters.hpp"
 #include "dockcore/dockcore.hpp"
-#include "dockcore/drivers/json_writer.hpp"
 #include "dockcore/hal/host_link.hpp"
 #include "events.hpp"
+#include "json_writer.hpp"
 
 namespace dockd {
 
@@ -79,7 +79,7 @@ std::size_t format_host_error(char* buf, std::size_t size, bool has_seq, std::ui
 class HostActions {
  public:
   /// The status object's fields (the status reply and the stream).
-  virtual void status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_us) const = 0;
+  virtual void status_fields(JsonWriter& w, std::uint64_t now_us) const = 0;
   /// The running configuration: the dock database and the default dock.
   virtual const DockdConfig& config() const = 0;
   /// The dock the core is configured for: undock and stop go to it.

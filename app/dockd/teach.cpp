@@ -106,14 +106,14 @@ void Teacher::finish(bool ok, const char* why, std::uint64_t now_us) {
   const Pose2 nom = nominal_docked_target(cfg_);
   // The taught target, once for the event and once inside the reply.
   char tb[256];
-  dockcore::drivers::JsonWriter target(tb, sizeof tb);
+  JsonWriter target(tb, sizeof tb);
   target.uint("dock_id", id)
       .uint("scans", t.scans)
       .real("target_x_m", static_cast<double>(t.target.x_m), 4)
       .real("target_y_m", static_cast<double>(t.target.y_m), 4)
       .real("target_yaw_deg", deg(t.target.yaw_rad), 3);
   char buf[512];
-  dockcore::drivers::JsonWriter reply(buf, sizeof buf);
+  JsonWriter reply(buf, sizeof buf);
   reply.boolean("ok", true)
       .str("cmd", "teach")
       .uint("seq", r.seq)

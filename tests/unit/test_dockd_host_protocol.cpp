@@ -82,7 +82,7 @@ struct FakeActions final : dockd::HostActions {
     cfg.docks.push_back(d);
     cfg.default_dock_id = 1;
   }
-  void status_fields(dockcore::drivers::JsonWriter& w, std::uint64_t now_us) const override {
+  void status_fields(dockd::JsonWriter& w, std::uint64_t now_us) const override {
     w.str("type", "status").uint("stamp_us", now_us);
   }
   const dockd::DockdConfig& config() const override { return cfg; }

@@ -135,8 +135,8 @@ row_stop
 post post_bad_commands
 rej=$(json_field "$RD/status.json" commands_rejected)
 echo "FIGURE host_bad_commands_rejected $rej"
-# 3 on UDP (malformed and unknown command refused by the link's parser, unknown dock id by dockd) + 2 on CAN (the task
-# manager's rejected_unknown / rejected_dock_id): all in commands_rejected.
+# 3 on UDP (malformed and unknown command refused by the host protocol's parser, unknown dock id by dockd) + 2 on CAN
+# (the task manager's rejected_unknown / rejected_dock_id): all in commands_rejected.
 check host_bad_commands_all_counted test "${rej:-0}" -ge 5
 # CAN: the task manager's verdicts, in the event log and in DockStatus LastResult (CommandResult).
 check host_bad_commands_can_unknown_rejected json_has "$RD/record/events.jsonl" \

@@ -10,7 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace dockcore::drivers {
+namespace dockd {
 
 class JsonWriter {
  public:
@@ -58,4 +58,4 @@ class JsonWriter {
   bool first_ = true;
 };
 
-}  // namespace dockcore::drivers
+}  // namespace dockd

@@ -1,10 +1,10 @@
-#include "dockcore/drivers/json_writer.hpp"
+#include "json_writer.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 
-namespace dockcore::drivers {
+namespace dockd {
 
 namespace {
 // Room kept back by every field for finish(): "}", "\n" and the terminator.
@@ -149,4 +149,4 @@ std::size_t JsonWriter::finish(bool newline) {
   return n;
 }
 
-}  // namespace dockcore::drivers
+}  // namespace dockd
