@@ -54,8 +54,8 @@ class Teacher {
   /// Most detections one teach averages (the request's `scans` is 1..this).
   static constexpr std::uint16_t kMaxScans = 1000;
 
-  /// `config` (dock database, teach_scans, teach_timeout_s, state of the pads) and `hooks` must outlive the object;
-  /// `config` is read at each start() and finish. Allocates the sample buffer (kMaxScans poses) once.
+  /// `config` (dock database, teach_scans, teach_timeout_s, the pads for the nominal target) and `hooks` must outlive
+  /// the object; `config` is read at each start() and finish. Allocates the sample buffer (kMaxScans poses) once.
   Teacher(const DockdConfig& config, TeachHooks& hooks);
   ~Teacher();
   Teacher(const Teacher&) = delete;
