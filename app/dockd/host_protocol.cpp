@@ -319,15 +319,16 @@ void HostProtocol::handle_udp(const HostRequest& r, std::uint64_t now_us) {
 
 void HostProtocol::poll(std::uint64_t now_us) {
   if (udp_ != nullptr) {
+    // Datagrams the link has read, those it dropped (foreign peers) included: a bound on the reads between two
+    // requests, whoever sent them.
+    const auto reads = [this] { return udp_->counters().datagrams + udp_->counters().not_allowed; };
     dockcore::hal::HostDatagram d;
     int requests = 0;
-    int others = 0;  // since the last request
-    while (requests < 64 && others < 64 && udp_->poll_datagram(d, now_us)) {
+    std::uint32_t round_start = reads();
+    while (requests < 64 && reads() - round_start < 64 && udp_->poll_datagram(d, now_us)) {
       if (handle_datagram(d, now_us)) {
         ++requests;
-        others = 0;
-      } else {
-        ++others;
+        round_start = reads();
       }
     }
   }

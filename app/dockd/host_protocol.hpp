@@ -106,9 +106,10 @@ class HostProtocol {
   HostProtocol(dockcore::hal::HostRequestLink* udp, dockcore::hal::HostLink* can, HostActions& actions,
                DaemonCounters& counters);
 
-  /// Reads the links: at most 64 UDP requests for the daemon, and at most 64 datagrams after the last of them that
-  /// need nothing of it (refused, subscriptions), so a flood is answered over several calls instead of stalling one;
-  /// and 16 CAN host commands. Each datagram is parsed here: one that does not parse gets its error reply and is
+  /// Reads the links: at most 64 UDP requests for the daemon, each after at most 64 datagrams read by the link since
+  /// the one before (those that need nothing of the daemon — refused, subscriptions — and foreign ones it drops; its
+  /// last read may drop up to 63 more), so a flood is answered over several calls instead of stalling one; and 16 CAN
+  /// host commands. Each datagram is parsed here: one that does not parse gets its error reply and is
   /// counted (counters().udp), a subscription is answered with the link's table, status and refusals are answered at
   /// once, teach handed to HostActions::start_teach, task commands queued in the core (full queue: a `busy` reply; a
   /// stop replaces the newest queued command).

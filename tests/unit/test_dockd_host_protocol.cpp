@@ -17,8 +17,8 @@ namespace {
 using dockd::HostRequest;
 using dockd::HostRequestKind;
 
-/// Datagrams handed out in order, all from one peer; every reply and status datagram kept as text; a subscriber
-/// table of two.
+/// Datagrams handed out in order, all from one peer ("!" stands for one from a foreign peer: dropped and counted, at
+/// most 64 per call, as the UDP link does); every reply and status datagram kept as text; a subscriber table of two.
 struct FakeRequestLink final : dockcore::hal::HostRequestLink {
   std::deque<std::string> pending;
   std::vector<std::string> replies;
@@ -27,7 +27,11 @@ struct FakeRequestLink final : dockcore::hal::HostRequestLink {
   std::size_t subscribers = 0;
 
   bool poll_datagram(dockcore::hal::HostDatagram& out, std::uint64_t now_us) override {
-    if (pending.empty()) return false;
+    for (int i = 0; i < 64 && !pending.empty() && pending.front() == "!"; ++i) {
+      pending.pop_front();
+      ++c.not_allowed;
+    }
+    if (pending.empty() || pending.front() == "!") return false;
     const std::string& d = pending.front();
     out.len = d.size();
     std::memcpy(out.data, d.data(), std::min(d.size(), sizeof out.data));
@@ -287,6 +291,17 @@ TEST(DockdHostProtocol, AFloodIsReadOverSeveralPolls) {
   CHECK_EQUAL(70u, link.replies.size());
   CHECK_EQUAL(1u, actions.submitted.size());
   CHECK_EQUAL(70u, counters.udp.malformed);
+
+  // Datagrams the link drops (foreign peers) count too.
+  for (int i = 0; i < 40; ++i) link.pending.push_back("!");
+  for (int i = 0; i < 30; ++i) link.pending.push_back("{\"cmd\":");
+  link.pending.push_back(request("dock", 2));
+  p.poll(41000);
+  CHECK_EQUAL(40u, link.c.not_allowed);
+  CHECK_EQUAL(70u + 24u, link.replies.size());  // 40 dropped + 24 refused: 64 read
+  p.poll(61000);
+  CHECK_EQUAL(100u, link.replies.size());
+  CHECK_EQUAL(2u, actions.submitted.size());
 }
 
 TEST(DockdHostProtocol, SubscriptionsAreAnsweredWithTheLinksTable) {
