@@ -26,6 +26,17 @@ constexpr Real kTwoPi = static_cast<Real>(6.28318530717958647692);
 constexpr Real deg_to_rad(Real deg) { return deg * kPi / static_cast<Real>(180); }
 /// Radians to degrees. O(1).
 constexpr Real rad_to_deg(Real rad) { return rad * static_cast<Real>(180) / kPi; }
+/// A double constant (a literal, a datasheet or tolerance value) as a Real. O(1).
+constexpr Real to_real(double v) {
+  return static_cast<Real>(v);
+}
+
+/// `v` limited to [-limit, limit]; `limit` >= 0. A NaN `v` is returned unchanged. O(1).
+inline Real clamp_abs(Real v, Real limit) {
+  if (v > limit) return limit;
+  if (v < -limit) return -limit;
+  return v;
+}
 
 /// Wraps an angle to (-pi, pi]. Finite input required; O(1) for any magnitude (uses remainder, no loop).
 inline Real wrap_angle(Real angle_rad) {
@@ -113,5 +124,10 @@ struct Pose2 {
     return Pose2{t.x(), t.y(), wrap_angle(-yaw_rad)};
   }
 };
+
+/// True when the position and the heading of `p` are all finite. O(1).
+inline bool finite_pose(const Pose2& p) {
+  return std::isfinite(p.x_m) && std::isfinite(p.y_m) && std::isfinite(p.yaw_rad);
+}
 
 }  // namespace dockcore

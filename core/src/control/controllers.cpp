@@ -10,12 +10,6 @@ constexpr Real kZero = 0;
 constexpr Real kOne = 1;
 constexpr Real kHalfPi = kPi / static_cast<Real>(2);
 
-Real clamp_abs(Real v, Real lim) {
-  if (v > lim) return lim;
-  if (v < -lim) return -lim;
-  return v;
-}
-
 Real sign_of(Real v) { return v < 0 ? -kOne : kOne; }
 
 // |v| clamped into [lo, hi], sign kept (v == 0 stays 0).
@@ -56,10 +50,6 @@ bool stalled(const DockingCommonParams& c, Real pad_x_m, Real dt_s, Real* stall_
     *stall_s = 0;
   }
   return *stall_s >= c.stall_timeout_s;
-}
-
-bool finite_pose(const Pose2& p) {
-  return std::isfinite(p.x_m) && std::isfinite(p.y_m) && std::isfinite(p.yaw_rad);
 }
 
 // The checks every controller makes before its own law, in this order: contact ends the run (arrived, sticky), a

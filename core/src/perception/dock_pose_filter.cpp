@@ -1,12 +1,6 @@
 #include "dockcore/perception/dock_pose_filter.hpp"
 
 namespace dockcore {
-namespace {
-
-bool finite_pose(const Pose2& p) { return std::isfinite(p.x_m) && std::isfinite(p.y_m) && std::isfinite(p.yaw_rad); }
-
-}  // namespace
-
 void DockPoseFilter::reset() {
   initialised_ = false;
   have_odom_ = false;

@@ -19,8 +19,6 @@ void copy_name(const char* src, char (&dst)[24]) {
   for (; i < sizeof(dst); ++i) dst[i] = '\0';
 }
 
-Real r(double v) { return static_cast<Real>(v); }
-
 }  // namespace
 
 const char* to_string(ProfileError e) {
@@ -91,7 +89,7 @@ ProfileError make_profile(const Vec2* vertices_m, std::size_t n, Real contact_of
   if (!std::isfinite(contact_offset_m)) return ProfileError::kNotFinite;
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(vertices_m[i].x()) || !std::isfinite(vertices_m[i].y())) return ProfileError::kNotFinite;
-    if (i > 0 && (vertices_m[i] - vertices_m[i - 1]).norm() < r(0.001)) return ProfileError::kDegenerateSegment;
+    if (i > 0 && (vertices_m[i] - vertices_m[i - 1]).norm() < to_real(0.001)) return ProfileError::kDegenerateSegment;
   }
   DockProfile p;
   for (std::size_t i = 0; i < n; ++i) p.vertices_m[i] = vertices_m[i] - Vec2(contact_offset_m, 0);
@@ -109,21 +107,30 @@ ProfileError builtin_profile(const char* name, DockProfile& out) {
     // Seed 000's feature dock: raised face (x = 0) with two 0.06 m deep, 0.03 m wide slots; 0.02 m end blocks.
     // Scanning across it gives four 0.06 m range jumps (inside the seed's 0.025-0.065 m band at normal incidence);
     // the 0.10 m deep body sides give jumps outside the band.
-    const Vec2 v[] = {Vec2(r(-0.10), r(-0.15)), Vec2(0, r(-0.15)),         Vec2(0, r(-0.13)),
-                      Vec2(r(-0.06), r(-0.13)), Vec2(r(-0.06), r(-0.10)), Vec2(0, r(-0.10)),
-                      Vec2(0, r(0.10)),         Vec2(r(-0.06), r(0.10)),  Vec2(r(-0.06), r(0.13)),
-                      Vec2(0, r(0.13)),         Vec2(0, r(0.15)),         Vec2(r(-0.10), r(0.15))};
+    const Vec2 v[] = {Vec2(to_real(-0.10), to_real(-0.15)),
+                      Vec2(0, to_real(-0.15)),
+                      Vec2(0, to_real(-0.13)),
+                      Vec2(to_real(-0.06), to_real(-0.13)),
+                      Vec2(to_real(-0.06), to_real(-0.10)),
+                      Vec2(0, to_real(-0.10)),
+                      Vec2(0, to_real(0.10)),
+                      Vec2(to_real(-0.06), to_real(0.10)),
+                      Vec2(to_real(-0.06), to_real(0.13)),
+                      Vec2(0, to_real(0.13)),
+                      Vec2(0, to_real(0.15)),
+                      Vec2(to_real(-0.10), to_real(0.15))};
     return make_profile(v, sizeof(v) / sizeof(v[0]), 0, "breakpoint", out);
   }
   if (same_name(name, "v-marker")) {
     // Seed 004's triangle label: a 0.30 m wide mouth with a 90° notch, apex 0.15 m behind the mouth line.
-    const Vec2 v[] = {Vec2(0, r(-0.15)), Vec2(r(-0.15), 0), Vec2(0, r(0.15))};
+    const Vec2 v[] = {Vec2(0, to_real(-0.15)), Vec2(to_real(-0.15), 0), Vec2(0, to_real(0.15))};
     return make_profile(v, 3, 0, "v-marker", out);
   }
   if (same_name(name, "plate-v")) {
     // 0.30 m flat face, 0.10 m wings swept back at 45° (the common open-source lidar dock).
-    const Real w = r(0.10 * 0.70710678118654752);
-    const Vec2 v[] = {Vec2(-w, r(-0.15) - w), Vec2(0, r(-0.15)), Vec2(0, r(0.15)), Vec2(-w, r(0.15) + w)};
+    const Real w = to_real(0.10 * 0.70710678118654752);
+    const Vec2 v[] = {Vec2(-w, to_real(-0.15) - w), Vec2(0, to_real(-0.15)), Vec2(0, to_real(0.15)),
+                      Vec2(-w, to_real(0.15) + w)};
     return make_profile(v, 4, 0, "plate-v", out);
   }
   return ProfileError::kUnknownName;

@@ -5,10 +5,6 @@
 namespace dockcore {
 namespace {
 
-Real r(double v) {
-  return static_cast<Real>(v);
-}
-
 /// Distance below which a point counts as lying on a line (metres): well under the 1 mm vertex spacing, well above
 /// rounding at dock sizes.
 constexpr double kOnLineM = 1e-6;
@@ -21,14 +17,14 @@ Real cross(const Vec2& a, const Vec2& b) {
 int side(const Vec2& a, const Vec2& b, const Vec2& c) {
   const Vec2 d = b - a;
   const Real dist = cross(d, c - a) / d.norm();
-  if (dist > r(kOnLineM)) return 1;
-  if (dist < -r(kOnLineM)) return -1;
+  if (dist > to_real(kOnLineM)) return 1;
+  if (dist < -to_real(kOnLineM)) return -1;
   return 0;
 }
 
 /// c lies within the bounding box of a-b (used once c is known to be on the line a-b).
 bool within(const Vec2& a, const Vec2& b, const Vec2& c) {
-  const Real tol = r(kOnLineM);
+  const Real tol = to_real(kOnLineM);
   return c.x() >= (a.x() < b.x() ? a.x() : b.x()) - tol && c.x() <= (a.x() > b.x() ? a.x() : b.x()) + tol &&
          c.y() >= (a.y() < b.y() ? a.y() : b.y()) - tol && c.y() <= (a.y() > b.y() ? a.y() : b.y()) + tol;
 }
@@ -53,14 +49,14 @@ void sym3_eigen(const Mat3& a, Vec3* values, Mat3* vectors) {
   for (int sweep = 0; sweep < 32; ++sweep) {
     const Real off = m(0, 1) * m(0, 1) + m(0, 2) * m(0, 2) + m(1, 2) * m(1, 2);
     const Real diag = m(0, 0) * m(0, 0) + m(1, 1) * m(1, 1) + m(2, 2) * m(2, 2);
-    if (!(off > r(1e-30) * diag)) break;
+    if (!(off > to_real(1e-30) * diag)) break;
     for (const auto& pq : pairs) {
       const Eigen::Index p = pq[0];
       const Eigen::Index q = pq[1];
       if (m(p, q) == 0) continue;
       const Real theta = (m(q, q) - m(p, p)) / (2 * m(p, q));
       const Real abs_theta = std::fabs(theta);
-      Real t = abs_theta > r(1e15) ? 1 / (2 * abs_theta) : 1 / (abs_theta + std::sqrt(theta * theta + 1));
+      Real t = abs_theta > to_real(1e15) ? 1 / (2 * abs_theta) : 1 / (abs_theta + std::sqrt(theta * theta + 1));
       if (theta < 0) t = -t;
       const Real c = 1 / std::sqrt(t * t + 1);
       const Real s = t * c;
@@ -157,7 +153,7 @@ ProfileCheck check_profile(const DockProfile& profile, Real beam_spacing_rad, Re
       // Adjacent segments share a vertex; they overlap only when the second doubles back along the first.
       const Vec2 d0 = v[i + 1] - v[i];
       const Vec2 d1 = v[i + 2] - v[i + 1];
-      if (std::fabs(cross(d0, d1)) <= r(kOnLineM) * d0.norm() * d1.norm() && d0.dot(d1) < 0) {
+      if (std::fabs(cross(d0, d1)) <= to_real(kOnLineM) * d0.norm() * d1.norm() && d0.dot(d1) < 0) {
         out.reason = ProfileCheckReason::kSelfIntersecting;
         out.segment_a = i;
         out.segment_b = i + 1;
@@ -242,7 +238,7 @@ ProfileCheck check_profile(const DockProfile& profile, Real beam_spacing_rad, Re
   // 3. All visible surfaces, yaw scaled by the lever L.
   const Real lever_m = std::sqrt(sum_sq_m2 / static_cast<Real>(out.beams));
   out.lever_m = lever_m;
-  const Real yaw_scale = lever_m > r(1e-6) ? 1 / lever_m : 1;
+  const Real yaw_scale = lever_m > to_real(1e-6) ? 1 / lever_m : 1;
   Mat3 scale = Mat3::Identity();
   scale(2, 2) = yaw_scale;
   Mat3 all = Mat3::Zero();

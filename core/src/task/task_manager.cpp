@@ -50,12 +50,6 @@ bool is_active_state(TaskState s) {
   return s != TaskState::kNotTasking && s != TaskState::kFault && s != TaskState::kTestMode;
 }
 
-Real clamp_abs(Real v, Real limit) {
-  if (v > limit) return limit;
-  if (v < -limit) return -limit;
-  return v;
-}
-
 bool is_zero(const Twist2& t) { return t.vx_mps == 0 && t.vy_mps == 0 && t.wz_radps == 0; }
 
 }  // namespace

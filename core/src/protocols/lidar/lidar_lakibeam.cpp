@@ -5,11 +5,6 @@
 namespace dockcore {
 
 namespace {
-std::uint16_t rd16(const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
-void wr16(std::uint8_t* p, std::uint16_t v) {
-  p[0] = static_cast<std::uint8_t>(v & 0xFFu);
-  p[1] = static_cast<std::uint8_t>(v >> 8);
-}
 constexpr std::size_t kTrailer = kLakibeamBlocks * kLakibeamBlockBytes;  // timestamp at 1200, 0x40 0x37 at 1204
 }  // namespace
 
@@ -31,7 +26,7 @@ std::size_t LakibeamParser::feed_datagram(const std::uint8_t* data, std::size_t 
   if (ok) ok = data[kTrailer + 4] == 0x40 && data[kTrailer + 5] == 0x37;
   for (std::size_t b = 0; ok && b < kLakibeamBlocks; ++b) {
     const std::uint8_t* blk = data + b * kLakibeamBlockBytes;
-    ok = blk[0] == 0xFF && blk[1] == 0xEE && rd16(blk + 2) < 36000u;
+    ok = blk[0] == 0xFF && blk[1] == 0xEE && read_le16(blk + 2) < 36000u;
   }
   if (!ok) {
     ++counters_.bad_packets;
@@ -47,14 +42,14 @@ std::size_t LakibeamParser::feed_datagram(const std::uint8_t* data, std::size_t 
   std::uint32_t step16 = 0;  // azimuth step over one block, 0.01 deg
   for (std::size_t b = 0; b < kLakibeamBlocks; ++b) {
     const std::uint8_t* blk = data + b * kLakibeamBlockBytes;
-    const std::uint32_t az = rd16(blk + 2);
-    if (b + 1 < kLakibeamBlocks) step16 = (rd16(blk + kLakibeamBlockBytes + 2) + 36000u - az) % 36000u;
+    const std::uint32_t az = read_le16(blk + 2);
+    if (b + 1 < kLakibeamBlocks) step16 = (read_le16(blk + kLakibeamBlockBytes + 2) + 36000u - az) % 36000u;
     for (std::size_t k = 0; k < kLakibeamPointsPerBlock; ++k) {
       const std::uint8_t* pt = blk + 4 + 6 * k;
       Real cdeg = static_cast<Real>(az) + static_cast<Real>(step16) * static_cast<Real>(k) /
                                               static_cast<Real>(kLakibeamPointsPerBlock);
       if (cdeg >= static_cast<Real>(36000)) cdeg -= static_cast<Real>(36000);
-      add_point(cdeg / static_cast<Real>(100), static_cast<Real>(rd16(pt)) / static_cast<Real>(1000),
+      add_point(cdeg / static_cast<Real>(100), static_cast<Real>(read_le16(pt)) / static_cast<Real>(1000),
                 static_cast<Real>(pt[2]), stamp_us);
     }
   }
@@ -108,12 +103,12 @@ std::size_t LakibeamEncoder::encode_scan(const ScanView& scan, std::uint32_t tim
     if (k == 0) {
       blk[0] = 0xFF;
       blk[1] = 0xEE;
-      wr16(blk + 2, static_cast<std::uint16_t>(cdeg));
+      write_le16(blk + 2, static_cast<std::uint16_t>(cdeg));
     }
     std::uint8_t* pt = blk + 4 + 6 * k;
-    wr16(pt, mm);
+    write_le16(pt, mm);
     pt[2] = rssi;
-    wr16(pt + 3, mm);
+    write_le16(pt + 3, mm);
     pt[5] = rssi;
     if (++pending_ < kLakibeamPointsPerDatagram) continue;
     pending_ = 0;

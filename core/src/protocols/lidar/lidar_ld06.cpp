@@ -6,12 +6,6 @@ namespace dockcore {
 
 namespace {
 
-std::uint16_t rd16(const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
-void wr16(std::uint8_t* p, std::uint16_t v) {
-  p[0] = static_cast<std::uint8_t>(v & 0xFFu);
-  p[1] = static_cast<std::uint8_t>(v >> 8);
-}
-
 // Length of a packet of this kind, 0 for an unknown kind.
 std::size_t ld06_length(std::uint8_t kind) {
   switch (kind) {
@@ -40,14 +34,14 @@ struct CrcTable {
 constexpr CrcTable kCrcTable{};
 
 void decode_fields(const std::uint8_t* in, Ld06Packet& out) {
-  out.speed_dps = rd16(in + 2);
-  out.start_cdeg = rd16(in + 4);
+  out.speed_dps = read_le16(in + 2);
+  out.start_cdeg = read_le16(in + 4);
   for (std::size_t i = 0; i < kLd06PointsPerPacket; ++i) {
-    out.distance_mm[i] = rd16(in + 6 + 3 * i);
+    out.distance_mm[i] = read_le16(in + 6 + 3 * i);
     out.intensity[i] = in[8 + 3 * i];
   }
-  out.end_cdeg = rd16(in + 42);
-  out.timestamp_ms = rd16(in + 44);
+  out.end_cdeg = read_le16(in + 42);
+  out.timestamp_ms = read_le16(in + 44);
 }
 }  // namespace
 
@@ -60,14 +54,14 @@ std::uint8_t ld06_crc8(const std::uint8_t* data, std::size_t n) {
 void ld06_encode_packet(const Ld06Packet& p, std::uint8_t out[kLd06PacketBytes]) {
   out[0] = kLd06Header;
   out[1] = kLd06DataKind;
-  wr16(out + 2, p.speed_dps);
-  wr16(out + 4, p.start_cdeg);
+  write_le16(out + 2, p.speed_dps);
+  write_le16(out + 4, p.start_cdeg);
   for (std::size_t i = 0; i < kLd06PointsPerPacket; ++i) {
-    wr16(out + 6 + 3 * i, p.distance_mm[i]);
+    write_le16(out + 6 + 3 * i, p.distance_mm[i]);
     out[8 + 3 * i] = p.intensity[i];
   }
-  wr16(out + 42, p.end_cdeg);
-  wr16(out + 44, p.timestamp_ms);
+  write_le16(out + 42, p.end_cdeg);
+  write_le16(out + 44, p.timestamp_ms);
   out[46] = ld06_crc8(out, 46);
 }
 

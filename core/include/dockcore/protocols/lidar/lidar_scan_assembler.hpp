@@ -1,8 +1,9 @@
 #pragma once
 /// @file What every lidar parser shares: the counters (a superset of hal::LidarCounters' fields, same names), the
-/// angle convention conversion from a sensor's own angle to core's (counter-clockwise seen from above, 0 = +x
-/// forward), and the assembler that drops (angle, range, intensity) samples onto a fixed angular grid to make one
-/// LaserScan per turn. Pure core: no heap, no clocks; times come in as parameters.
+/// little-endian 16-bit field codec of the LD06 and Lakibeam wire formats, the angle convention conversion from a
+/// sensor's own angle to core's (counter-clockwise seen from above, 0 = +x forward), and the assembler that drops
+/// (angle, range, intensity) samples onto a fixed angular grid to make one LaserScan per turn. Pure core: no heap, no
+/// clocks; times come in as parameters.
 
 #include <cstddef>
 #include <cstdint>
@@ -11,6 +12,16 @@
 #include "dockcore/laser_scan.hpp"
 
 namespace dockcore {
+
+/// The little-endian u16 at p[0..1]. O(1).
+inline std::uint16_t read_le16(const std::uint8_t* p) {
+  return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
+}
+/// Writes `v` little-endian to p[0..1]. O(1).
+inline void write_le16(std::uint8_t* p, std::uint16_t v) {
+  p[0] = static_cast<std::uint8_t>(v & 0xFFu);
+  p[1] = static_cast<std::uint8_t>(v >> 8);
+}
 
 /// Counters every lidar parser keeps. The first four have hal::LidarCounters' names and meaning, so a driver copies
 /// them field by field; the rest say why something was discarded. Counters only grow (u32 wrap after 2^32 events).
