@@ -442,6 +442,29 @@ TEST(ChassisDock, CannotPassThroughAndStalls) {
   CHECK(px(c.state()) < 1.7);
 }
 
+// Something the lidar does not see holds the pads stop_short_m before the contact plane: the same hard stop, moved
+// forward; the contacts never close and the wheels stall, and odometry stops with the robot.
+TEST(ChassisDock, HeldShortOfTheContactsStallsWithoutContact) {
+  ChassisParams p = ideal(DriveKind::kDifferential);
+  Chassis c(p, 1);
+  const Pose2 dock{2.0, 0.0, kPi};
+  DockPlacement d{dock, 0.15, false};
+  d.stop_short_m = 0.02;
+  c.set_dock(d);
+  c.command_wheels(diff_cmd(4.0, 4.0));
+  c.run_for(12.0);
+  REAL_EQUAL(2.0 - 0.02 - 0.225, px(c.state()), 1e-9);
+  REAL_EQUAL(-0.02, c.state().press_m, 1e-9);
+  CHECK_TRUE(c.state().stalled);
+  CHECK_TRUE(c.state().at_hard_stop);
+  CHECK_FALSE(c.state().contact);
+  REAL_EQUAL(0.0, c.state().wheel_measured_radps[0], 0.05);
+  const double odom_x = c.state().odom_pose.x_m;
+  c.run_for(2.0);
+  REAL_EQUAL(odom_x, c.state().odom_pose.x_m, 1e-6);
+  CHECK_FALSE(c.state().contact);
+}
+
 TEST(ChassisDock, RealisticMotorsAndYawedApproachStillStop) {
   ChassisParams p;  // defaults: latency, lag, accel limit, deadband, slip on
   Chassis c(p, 7);

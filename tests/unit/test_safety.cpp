@@ -250,11 +250,13 @@ TEST(Safety, EveryFaultCodeHasItsStableName) {
   const char* const names[] = {"detection_failed", "distance_deviation",   "angle_deviation", "obstacle_timeout",
                                "target_lost",      "charge_not_confirmed", "contacts_lost",   "chassis_stale",
                                "lidar_stale",      "undock_failed",        "bad_command",     "align_failed",
-                               "task_timeout"};
-  for (std::uint16_t code = 177; code <= 189; ++code) {
+                               "task_timeout",     "contacts_not_reached"};
+  LONGS_EQUAL(177, kFirstFaultCode);
+  LONGS_EQUAL(190, kLastFaultCode);
+  for (std::uint16_t code = kFirstFaultCode; code <= kLastFaultCode; ++code) {
     STRCMP_EQUAL(names[code - 177], to_string(static_cast<FaultCode>(code)));
   }
   STRCMP_EQUAL("none", to_string(FaultCode::kNone));
   STRCMP_EQUAL("unknown", to_string(static_cast<FaultCode>(176)));
-  STRCMP_EQUAL("unknown", to_string(static_cast<FaultCode>(190)));
+  STRCMP_EQUAL("unknown", to_string(static_cast<FaultCode>(191)));
 }

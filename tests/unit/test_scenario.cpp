@@ -229,6 +229,24 @@ TEST(Scenario, ShippedFilesLoad) {
   }
 }
 
+// [dock] dead and stop_short_m reach the chassis's dock; the final push's bounds are [task] keys.
+TEST(Scenario, ADeadChargerAndAnUnseenStopShortOfTheContacts) {
+  const docksim::Scenario none = docksim::parse_scenario_toml("", "none.toml");
+  CHECK(!none.dock_dead);
+  REAL_EQUAL(0.0, none.dock_stop_short_m, 0);
+  const docksim::Scenario sc = docksim::parse_scenario_toml(
+      "[dock]\ndead = true\nstop_short_m = 0.02\n[task]\npush_zone_m = 0.12\nmax_push_m = 0.2\nmax_push_s = 8\n",
+      "s.toml");
+  const docksim::DockPlacement dp = docksim::dock_placement(sc);
+  CHECK(dp.dead);
+  REAL_EQUAL(0.02, dp.stop_short_m, 1e-12);
+  REAL_EQUAL(0.12, static_cast<double>(sc.task.push_zone_m), 1e-9);
+  REAL_EQUAL(0.2, static_cast<double>(sc.task.max_push_m), 1e-9);
+  REAL_EQUAL(8.0, static_cast<double>(sc.task.max_push_s), 1e-9);
+  CHECK_EQUAL(2, expect_error("[dock]\nstop_short_m = 0.6\n").line());
+  CHECK_EQUAL(2, expect_error("[task]\nmax_push_s = 0\n").line());
+}
+
 TEST(Scenario, SmoothLineupParametersAreSettable) {
   const docksim::Scenario sc = docksim::parse_scenario_toml(
       "[controller]\nname = \"smooth\"\n[controller.smooth]\nlineup_distance_m = 0.35\nlineup_max_curvature_inv_m = 2.5\n",

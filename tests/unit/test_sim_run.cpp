@@ -19,10 +19,14 @@ const bool kNamesReady = !docksim::controller_names().empty();
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
-docksim::Scenario default_scenario() {
+docksim::Scenario scenario_file(const std::string& name) {
   std::string f = __FILE__;  // .../tests/unit/test_sim_run.cpp
   for (int i = 0; i < 3; ++i) f = f.substr(0, f.find_last_of('/'));
-  return docksim::load_scenario_file(f + "/tools/scenarios/default.toml");
+  return docksim::load_scenario_file(f + "/tools/scenarios/" + name);
+}
+
+docksim::Scenario default_scenario() {
+  return scenario_file("default.toml");
 }
 
 // Appends a timed event of `kind` lasting `duration_s` to the scenario's timeline.
@@ -328,6 +332,64 @@ TEST(SimRun, ChargingNeverStartsEndsInFault182) {
   CHECK_EQUAL(1, r.outcome.retries);
   // Backing off and coming again is a reversal each way.
   CHECK(r.outcome.reversals >= 2);
+}
+
+int contact_closings(const docksim::SimRun& r) {
+  int n = 0;
+  for (const auto& e : r.timeline) n += e.kind == docksim::TimelineKind::kContact && e.text == "contacts closed";
+  return n;
+}
+
+// Every recorded sample outside the moving states commands zero (FAULT included).
+void check_still_outside_moving_states(const docksim::SimRun& r) {
+  for (const auto& p : r.trajectory) {
+    if (!dockcore::is_moving_state(static_cast<dockcore::TaskState>(p.state))) CHECK(p.vx_cmd_mps == 0);
+  }
+}
+
+// A dead charger (tools/scenarios/dead-charger.toml, [dock] dead): every attempt closes the contacts and gets no
+// current; the robot retries and ends in fault 182, backed off and standing.
+TEST(SimRun, ADeadChargerRetriesThenFault182) {
+  docksim::Scenario sc = scenario_file("dead-charger.toml");
+  CHECK(sc.dock_dead);
+  sc.task.max_retries = 1;
+  const docksim::StartPose start = docksim::start_from(sc, 1.0, 0, 0);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  for (const char* ctl : {"smooth", "seed004"}) {
+    const docksim::SimRun r = docksim::run_docking(sc, ctl, 5, opt);
+    CHECK_TEXT(!r.outcome.charging_confirmed, ctl);
+    CHECK_TEXT(r.outcome.faults.size() == 1 && r.outcome.faults.count(182) == 1, ctl);
+    CHECK(r.outcome.final_state == dockcore::TaskState::kFault);
+    CHECK_EQUAL(1, r.outcome.retries);
+    CHECK_EQUAL(2, contact_closings(r));    // both attempts reached the contacts
+    CHECK(r.outcome.longitudinal_m > 0.2);  // backed off
+    check_still_outside_moving_states(r);
+  }
+}
+
+// Held 2 cm short of the contacts by something the lidar does not see (tools/scenarios/held-short.toml, [dock]
+// stop_short_m): the contacts never close; each attempt's final push ends on max_push_s, and the robot ends in fault
+// 190, backed off and standing, long before the task timeout.
+TEST(SimRun, HeldShortOfTheContactsTheFinalPushEndsInFault190) {
+  docksim::Scenario sc = scenario_file("held-short.toml");
+  DOUBLES_EQUAL(0.02, sc.dock_stop_short_m, 1e-12);
+  sc.task.max_retries = 1;
+  const docksim::StartPose start = docksim::start_from(sc, 1.0, 0, 0);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  for (const char* ctl : {"smooth", "seed004"}) {
+    const docksim::SimRun r = docksim::run_docking(sc, ctl, 5, opt);
+    CHECK_TEXT(!r.outcome.charging_confirmed, ctl);
+    CHECK_TEXT(r.outcome.faults.size() == 1 && r.outcome.faults.count(190) == 1, ctl);
+    CHECK(r.outcome.final_state == dockcore::TaskState::kFault);
+    CHECK_EQUAL(1, r.outcome.retries);
+    CHECK_EQUAL(0, contact_closings(r));
+    // Two attempts of approach plus at most max_push_s of pushing each, and the back-offs: well inside the timeout.
+    CHECK(r.outcome.end_time_s < 2 * (20 + static_cast<double>(sc.task.max_push_s)) + 20);
+    CHECK(r.outcome.longitudinal_m > 0.2);  // backed off
+    check_still_outside_moving_states(r);
+  }
 }
 
 TEST(SimRun, ObstacleClearanceIsMeasured) {

@@ -38,6 +38,12 @@ class FakeController : public DockingController {
       o.status = ControlStatus::kArrived;
       return o;
     }
+    const double x = in.dock_in_robot.x_m, y = in.dock_in_robot.y_m;
+    const double gap = std::sqrt(x * x + y * y) - kHalfLength;
+    if (in.dock_valid && gap <= arrive_at_gap_m) {  // a success test of its own, contacts or not
+      o.status = ControlStatus::kArrived;
+      return o;
+    }
     if (fail) {
       o.status = ControlStatus::kFailed;
       return o;
@@ -46,15 +52,14 @@ class FakeController : public DockingController {
       o.status = ControlStatus::kLost;
       return o;
     }
-    const double x = in.dock_in_robot.x_m, y = in.dock_in_robot.y_m;
     const double bearing = std::atan2(y, x);
-    const double gap = std::sqrt(x * x + y * y) - kHalfLength;
     o.phase = 1;
     o.cmd.vx_mps = std::fmax(0.06, std::fmin(0.2, 0.5 * gap));
     o.cmd.wz_radps = 1.5 * bearing;
     return o;
   }
   bool fail = false;
+  double arrive_at_gap_m = -1;  // >= 0: also kArrived when the estimate puts the front edge this close to the dock
   int resets = 0;
   int steps = 0;
 };
@@ -92,6 +97,8 @@ struct Sim {
   bool charge_enable = false;
   bool current_stays_on = false;  // undock-failure script
   bool chassis_ok = true, lidar_ok = true;
+  double stop_short_m = 0;       // > 0: something the lidar does not see holds the front edge this far before the dock
+  bool wheels_spin = false;      // held there, the wheels keep turning: odometry goes on as commanded
   std::vector<Vec2> obstacles;   // box centres, 0.1 m boxes
   TaskOutput out;
   std::vector<TaskState> states;  // state changes in order
@@ -178,12 +185,13 @@ struct Sim {
     const Pose2 delta = arc(out.cmd, dt);
     world = world.compose(delta);
     odom = odom.compose(delta);
-    // The dock is a hard stop: the front edge may not pass the dock plane (x = 0 in the dock frame).
+    // The dock is a hard stop: the front edge may not pass the dock plane (x = 0 in the dock frame), or the plane
+    // stop_short_m before it.
     const Vec2 front = dock.inverse_transform(world.transform(Vec2(kHalfLength, 0)));
-    if (front.x() < 0 && std::fabs(front.y()) < 0.3) {
-      const double back = -front.x();
+    if (front.x() < stop_short_m && std::fabs(front.y()) < 0.3) {
+      const double back = stop_short_m - front.x();
       world.x_m += back;  // the dock faces +x
-      odom = odom.compose(dockcore_test::pose(-back / std::fabs(std::cos(world.yaw_rad)), 0, 0));
+      if (!wheels_spin) odom = odom.compose(dockcore_test::pose(-back / std::fabs(std::cos(world.yaw_rad)), 0, 0));
     }
     const Vec2 f2 = dock.inverse_transform(world.transform(Vec2(kHalfLength, 0)));
     contact = f2.x() <= 0.002 && std::fabs(f2.y()) < 0.05;
@@ -643,6 +651,178 @@ TEST(TaskManager, ControllerFailureRetriesThenFault188) {
   LONGS_EQUAL(0, static_cast<int>(s->out.status.retry_reason));
   LONGS_EQUAL(188, static_cast<int>(s->out.status.fault));
   LONGS_EQUAL(s->params.max_retries, s->out.status.retries);
+}
+
+// Steps until the state changes to `to` (true) or `max_s` passes; `exit_cmd` gets the twist of the tick it changed on.
+bool step_until_state(Sim& s, TaskState to, double max_s, Twist2* exit_cmd) {
+  const int n = static_cast<int>(max_s / (Sim::kTickUs * 1e-6));
+  for (int i = 0; i < n; ++i) {
+    const TaskOutput o = s.step();
+    if (o.status.state == to) {
+      *exit_cmd = o.cmd;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool is_zero_twist(const Twist2& t) {
+  return t.vx_mps == 0 && t.vy_mps == 0 && t.wz_radps == 0;
+}
+
+// Contacts closed, no current (a dead charger, an unpowered dock): each attempt ends in RETRY with reason 182, the
+// last in fault 182 — retried like any failed attempt — and every exit commands zero on its own tick.
+TEST(TaskManager, ContactsClosedWithoutCurrentRetryThenFault182WithZeroOnEveryExit) {
+  auto s = std::make_unique<Sim>();
+  s->charger_works = false;
+  s->params.max_retries = 1;
+  s->reconfigure();
+  s->command(HostCommandType::kDock);
+  Twist2 cmd{1, 1, 1};
+  CHECK(step_until_state(*s, TaskState::kWaitForCharge, 30, &cmd));
+  CHECK(is_zero_twist(cmd));
+  CHECK(s->contact);
+  CHECK(step_until_state(*s, TaskState::kRetry, 10, &cmd));
+  CHECK(is_zero_twist(cmd));
+  LONGS_EQUAL(182, static_cast<int>(s->out.status.retry_reason));
+  CHECK(step_until_state(*s, TaskState::kReachTaskingPoint, 20, &cmd));
+  CHECK(is_zero_twist(cmd));
+  CHECK(step_until_state(*s, TaskState::kRetry, 40, &cmd));
+  CHECK(is_zero_twist(cmd));
+  LONGS_EQUAL(182, static_cast<int>(s->out.status.retry_reason));
+  CHECK(step_until_state(*s, TaskState::kFault, 20, &cmd));
+  CHECK(is_zero_twist(cmd));
+  LONGS_EQUAL(182, static_cast<int>(s->out.status.fault));
+  LONGS_EQUAL(2, s->wait_entries);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+// Something the lidar does not see holds the robot 2 cm before the dock: the estimate says it is not there yet, the
+// controller keeps creeping, the wheels stall. The final push ends after max_push_s (its odometry travel well within
+// max_push_m), each attempt retries with reason 190 and the last ends in fault 190, backed off and standing.
+TEST(TaskManager, HeldShortOfTheContactsThePushEndsOnTimeThenFault190) {
+  auto s = std::make_unique<Sim>();
+  s->stop_short_m = 0.02;
+  s->params.max_retries = 1;
+  s->params.max_push_s = 4.0;
+  s->reconfigure();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 10));
+  Twist2 cmd{1, 1, 1};
+  std::uint64_t push_start_us = 0;
+  for (int i = 0; i < 2000 && s->out.status.state == TaskState::kAlign; ++i) {
+    const TaskOutput o = s->step();
+    if (push_start_us == 0 && s->tm.in_final_push()) push_start_us = s->now_us - Sim::kTickUs;
+    if (o.status.state != TaskState::kAlign) cmd = o.cmd;
+  }
+  CHECK(s->out.status.state == TaskState::kRetry);
+  CHECK(is_zero_twist(cmd));
+  LONGS_EQUAL(190, static_cast<int>(s->out.status.retry_reason));
+  CHECK(!s->saw(TaskState::kWaitForCharge));
+  // The bound in time: ended on the first tick past max_push_s, measured from the push's first tick.
+  CHECK(s->tm.push_elapsed_s() > 4.0);
+  CHECK(s->tm.push_elapsed_s() <= 4.0 + 0.021);
+  REAL_EQUAL(s->tm.push_elapsed_s(), (s->now_us - Sim::kTickUs - push_start_us) * 1e-6, 1e-9);
+  // It began in the zone: the front edge within push_zone_m of the face by the estimate.
+  CHECK(s->tm.push_travel_m() < s->params.max_push_m);
+  CHECK(s->tm.push_travel_m() > s->params.push_zone_m - 0.02 - 0.01);
+  CHECK(step_until_state(*s, TaskState::kFault, 60, &cmd));
+  CHECK(is_zero_twist(cmd));
+  LONGS_EQUAL(190, static_cast<int>(s->out.status.fault));
+  LONGS_EQUAL(1, s->out.status.retries);
+  CHECK(!s->contact);
+  CHECK(!s->out.status.charge_enable);
+  REAL_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.004);  // a clean end: backed off
+  const Pose2 p = s->world;
+  s->run_for(2.0);
+  REAL_EQUAL(p.x_m, s->world.x_m, 0);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+// Held short while the wheels spin (slip): odometry runs on, the robot does not. The push ends on its distance,
+// well before its time.
+TEST(TaskManager, HeldShortWithSpinningWheelsThePushEndsOnDistance) {
+  auto s = std::make_unique<Sim>();
+  s->stop_short_m = 0.02;
+  s->wheels_spin = true;
+  s->params.max_push_m = 0.15;
+  s->reconfigure();
+  s->command(HostCommandType::kDock);
+  Twist2 cmd{1, 1, 1};
+  CHECK(step_until_state(*s, TaskState::kRetry, 40, &cmd));
+  CHECK(is_zero_twist(cmd));
+  LONGS_EQUAL(190, static_cast<int>(s->out.status.retry_reason));
+  // Ended on the first tick past max_push_m: one tick adds at most the creep's 0.06 m/s × 20 ms.
+  CHECK(s->tm.push_travel_m() > 0.15);
+  CHECK(s->tm.push_travel_m() <= 0.15 + 0.06 * 0.02 + 1e-9);
+  CHECK(s->tm.push_elapsed_s() < s->params.max_push_s);
+  CHECK(!s->saw(TaskState::kWaitForCharge));
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+// A docking that reaches the contacts is unchanged by the push bound: same ticks, same pose, same states as with
+// bounds that can never bind; its push stayed well inside both.
+TEST(TaskManager, APushThatReachesTheContactsIsNotCutShort) {
+  auto bounded = std::make_unique<Sim>();
+  auto unbounded = std::make_unique<Sim>();
+  unbounded->params.max_push_m = 1e6;
+  unbounded->params.max_push_s = 1e6;
+  unbounded->reconfigure();
+  for (Sim* s : {bounded.get(), unbounded.get()}) {
+    s->command(HostCommandType::kDock);
+    CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  }
+  LONGS_EQUAL(unbounded->ticks, bounded->ticks);
+  REAL_EQUAL(unbounded->world.x_m, bounded->world.x_m, 0);
+  REAL_EQUAL(unbounded->world.y_m, bounded->world.y_m, 0);
+  CHECK(unbounded->states == bounded->states);
+  LONGS_EQUAL(1, bounded->wait_entries);
+  CHECK(bounded->tm.in_final_push());
+  CHECK(bounded->tm.push_travel_m() > 0.08);
+  CHECK(bounded->tm.push_travel_m() < 0.5 * bounded->params.max_push_m);
+  CHECK(bounded->tm.push_elapsed_s() < 0.5 * bounded->params.max_push_s);
+  LONGS_EQUAL(0, bounded->zero_violations);
+}
+
+// The push starts only lined up with the dock: a robot passing along the face (heading parallel to it) with its side
+// close to it is not pushing.
+TEST(TaskManager, ThePushZoneNeedsTheRobotLinedUpWithTheDock) {
+  auto s = std::make_unique<Sim>();
+  s->world = s->odom = dockcore_test::pose(0.30, 0.6, -kPi / 2);  // 0.30 m out, heading along the face
+  s->start_yaw = -kPi / 2;
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 10));
+  int checked = 0;
+  for (int i = 0; i < 100 && s->out.status.state == TaskState::kAlign; ++i) {
+    s->step();
+    // Its edge would be past the face were it lined up (centre 0.30 m out, half-length 0.37 m).
+    if (std::fabs(std::cos(s->world.yaw_rad)) < 0.7) {
+      CHECK(!s->tm.in_final_push());
+      ++checked;
+    }
+  }
+  CHECK(checked > 10);
+}
+
+// A controller may arrive by a test of its own: when the contacts then never close in WAIT_FOR_CHARGE the robot is
+// not on them, and the attempt is "contacts not reached" (190), not a charger fault.
+TEST(TaskManager, WaitingWithTheContactsOpenThroughoutIs190) {
+  auto s = std::make_unique<Sim>();
+  s->stop_short_m = 0.02;
+  s->ctrl.arrive_at_gap_m = 0.03;
+  s->params.max_retries = 0;
+  s->reconfigure();
+  s->command(HostCommandType::kDock);
+  Twist2 cmd{1, 1, 1};
+  CHECK(step_until_state(*s, TaskState::kWaitForCharge, 30, &cmd));
+  CHECK(is_zero_twist(cmd));
+  CHECK(!s->contact);
+  CHECK(step_until_state(*s, TaskState::kRetry, 10, &cmd));
+  CHECK(is_zero_twist(cmd));
+  LONGS_EQUAL(190, static_cast<int>(s->out.status.retry_reason));
+  CHECK(step_until_state(*s, TaskState::kFault, 20, &cmd));
+  LONGS_EQUAL(190, static_cast<int>(s->out.status.fault));
+  LONGS_EQUAL(0, s->zero_violations);
 }
 
 TEST(TaskManager, ContactsLostWhileCharging183) {

@@ -171,7 +171,7 @@ class Decoder {
         add("state", m.task_state, "", m.task_state <= 9 ? dockcore::to_string(static_cast<dockcore::TaskState>(m.task_state)) : "?");
         add("phase", m.align_phase);
         add("fault", m.fault_code, "",
-            m.fault_code == 0 || (m.fault_code >= 177 && m.fault_code <= 189)
+            m.fault_code == 0 || (m.fault_code >= dockcore::kFirstFaultCode && m.fault_code <= dockcore::kLastFaultCode)
                 ? dockcore::to_string(static_cast<dockcore::FaultCode>(m.fault_code))
                 : "?");
         add("retries", m.retries);
@@ -301,12 +301,10 @@ void write_svg(const std::string& path, double t_end, const std::map<std::string
       {2 * panel + 2 * gap, {"cmd0", "cmd1", "meas0", "meas1"}, {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728"}, "m/s"},
       {panel + gap, {"state"}, {"#9467bd"}, "state"},
       {0, {"fault"}, {"#d62728"}, "fault"}};
-  const std::map<std::string, std::string> legend = {{"cmd0", "commanded wheel 0 / linear"},
-                                                     {"cmd1", "commanded wheel 1 / angular"},
-                                                     {"meas0", "measured wheel 0 / linear"},
-                                                     {"meas1", "measured wheel 1 / angular"},
-                                                     {"state", "task state (0..9)"},
-                                                     {"fault", "fault code (0, 177..189)"}};
+  const std::map<std::string, std::string> legend = {
+      {"cmd0", "commanded wheel 0 / linear"}, {"cmd1", "commanded wheel 1 / angular"},
+      {"meas0", "measured wheel 0 / linear"}, {"meas1", "measured wheel 1 / angular"},
+      {"state", "task state (0..9)"},         {"fault", "fault code (0, 177..190)"}};
   for (const Panel& p : panels) {
     double lo = 0, hi = 0;
     bool any = false;

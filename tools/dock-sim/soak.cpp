@@ -121,10 +121,7 @@ class SoakWorld {
         target_world_(sc.dock_pose.transform(sc.camera.target_in_dock)) {
     core_ = std::make_unique<dockcore::Dockcore>(ctl);  // ~334 KiB: heap, not stack
     configured_ = core_->configure(sc.profile, docksim::core_config(sc));
-    docksim::DockPlacement dp;
-    dp.pose_world = sc.dock_pose;
-    dp.face_half_width_m = sc.dock_face_half_width_m;
-    chassis_.set_dock(dp);
+    chassis_.set_dock(docksim::dock_placement(sc));
     chassis_.reset_odometry(Pose2{});
     // Scans in flight: the latency is a few scan periods at most; a fixed ring keeps the loop free of per-scan heap.
     for (auto& p : ring_) p = std::make_unique<Pending>();

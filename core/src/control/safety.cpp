@@ -20,6 +20,8 @@ const char* to_string(FaultCode f) {
     case FaultCode::kBadCommand: return "bad_command";
     case FaultCode::kAlignFailed: return "align_failed";
     case FaultCode::kTaskTimeout: return "task_timeout";
+    case FaultCode::kContactsNotReached:
+      return "contacts_not_reached";
   }
   return "unknown";
 }

@@ -82,12 +82,36 @@ bool TaskManager::dock_fresh(const TaskInput& in) const {
          std::fabs(in.dock.pose.x_m) - obstacles_.body_front_m() <= params_.blind_finish_m;
 }
 
+bool TaskManager::in_push_zone(const TaskInput& in) const {
+  if (!in.dock.valid) return false;
+  const Pose2 robot = in.dock.pose.inverse();  // the robot in the dock frame: x = its centre's distance from the face
+  const bool lined_up = std::fabs(std::cos(robot.yaw_rad)) >= static_cast<Real>(0.70710678);  // within 45°
+  return lined_up && robot.x_m - obstacles_.body_front_m() <= params_.push_zone_m;
+}
+
+bool TaskManager::push_exhausted(const TaskInput& in) {
+  if (!pushing_) {
+    if (!in_push_zone(in)) return false;
+    pushing_ = true;
+    push_since_us_ = in.now_us;
+    push_prev_odom_ = in.odom_pose;
+    push_travel_m_ = 0;
+  }
+  const Real dx = in.odom_pose.x_m - push_prev_odom_.x_m;
+  const Real dy = in.odom_pose.y_m - push_prev_odom_.y_m;
+  push_travel_m_ += std::sqrt(dx * dx + dy * dy);
+  push_prev_odom_ = in.odom_pose;
+  push_elapsed_s_ = since_s(push_since_us_, in);
+  return push_travel_m_ > params_.max_push_m || push_elapsed_s_ > params_.max_push_s;
+}
+
 void TaskManager::enter(TaskState s, const TaskInput& in) {
   state_ = s;
   state_since_us_ = in.now_us;
   blocked_ = false;
   lost_ = false;
   charge_ok_ = false;
+  contact_seen_ = in.contact;
   contact_open_ = false;
   swing_leg_ = 0;
   undock_backing_ = false;
@@ -216,6 +240,9 @@ void TaskManager::run_reach(const TaskInput& in) {
   if (dock_fresh(in)) {
     start_distance_m_ = std::sqrt(in.dock.pose.x_m * in.dock.pose.x_m + in.dock.pose.y_m * in.dock.pose.y_m);
     deviation_count_ = 0;
+    pushing_ = false;
+    push_travel_m_ = 0;
+    push_elapsed_s_ = 0;
     ctrl_->reset();
     enter(TaskState::kAlign, in);
     return;
@@ -309,6 +336,12 @@ void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
     fail_attempt(FaultCode::kAlignFailed, in);
     return;
   }
+  // The final push is bounded in distance and time: a robot held short of the contacts, or slipping, would
+  // otherwise push on (the deadband learning raising its command) until the task timeout.
+  if (push_exhausted(in)) {
+    fail_attempt(FaultCode::kContactsNotReached, in);
+    return;
+  }
   if (!dock_fresh(in) || co.status == ControlStatus::kLost) {
     if (!lost_) {
       lost_ = true;
@@ -327,6 +360,7 @@ void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
 }
 
 void TaskManager::run_wait_for_charge(const TaskInput& in) {
+  contact_seen_ = contact_seen_ || in.contact;
   if (in.contact && in.charge_current_a >= params_.charge_current_threshold_a) {
     if (!charge_ok_) {
       charge_ok_ = true;
@@ -340,7 +374,11 @@ void TaskManager::run_wait_for_charge(const TaskInput& in) {
   } else {
     charge_ok_ = false;
   }
-  if (since_s(state_since_us_, in) > params_.charge_confirm_timeout_s) fail_attempt(FaultCode::kChargeNotConfirmed, in);
+  if (since_s(state_since_us_, in) > params_.charge_confirm_timeout_s) {
+    // Contacts closed without a charge held: the charger (dead, unpowered, or a poor contact). Contacts that never
+    // closed (a controller arriving by its own test alone): the robot is not on them.
+    fail_attempt(contact_seen_ ? FaultCode::kChargeNotConfirmed : FaultCode::kContactsNotReached, in);
+  }
 }
 
 void TaskManager::run_finish(const TaskInput& in) {

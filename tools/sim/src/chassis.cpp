@@ -248,7 +248,8 @@ void Chassis::step() {
     double prev_x, prev_y, cand_x, cand_y;
     pad_in_dock(x0, y0, yaw0, &prev_x, &prev_y);
     pad_in_dock(xc, yc, yawc, &cand_x, &cand_y);
-    const double limit = p_.contact.press_limit_m;
+    // The spring contacts' end of travel, or what holds the pads short of the contacts.
+    const double limit = dock_.stop_short_m > 0 ? -dock_.stop_short_m : p_.contact.press_limit_m;
     if (prev_x >= -limit - 1e-9 && cand_x < -limit && std::fabs(cand_y) <= dock_.face_half_width_m) {
       double lo = 0.0, hi = 1.0;
       for (int it = 0; it < 48; ++it) {

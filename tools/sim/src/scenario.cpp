@@ -316,6 +316,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         {"y_m", p.real(&sc.dock_pose.y_m, -1e3, 1e3)},
         {"yaw_deg", p.real_deg(&sc.dock_pose.yaw_rad, -180, 180)},
         {"face_half_width_m", p.num(&sc.dock_face_half_width_m, 0.005, 2)},
+        {"dead", p.flag(&sc.dock_dead)},
+        {"stop_short_m", p.num(&sc.dock_stop_short_m, 0, 0.5)},
         {"wall", p.flag(&sc.wall)},
         {"wall_gap_m", p.num(&sc.wall_gap_m, 0, static_cast<double>(dockcore::kMaxWallGapM))},
         {"wall_glass", p.flag(&sc.wall_glass)},

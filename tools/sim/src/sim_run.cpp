@@ -263,6 +263,15 @@ StartPose draw_start(const Scenario& sc, std::uint64_t seed) {
   return start_from(sc, d, b, h);
 }
 
+DockPlacement dock_placement(const Scenario& sc) {
+  DockPlacement dp;
+  dp.pose_world = sc.dock_pose;
+  dp.face_half_width_m = sc.dock_face_half_width_m;
+  dp.dead = sc.dock_dead;
+  dp.stop_short_m = sc.dock_stop_short_m;
+  return dp;
+}
+
 std::vector<Vec2> footprint_outline(const ChassisParams& c) {
   const FootprintParams& f = c.footprint;
   std::vector<Vec2> pts;
@@ -327,10 +336,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   if (!core->configure(sc.profile, cfg)) throw ScenarioError("dock profile has no segments");
 
   Chassis chassis(sc.chassis, mix64(seed ^ 0x43484153ull));
-  DockPlacement dp;
-  dp.pose_world = sc.dock_pose;
-  dp.face_half_width_m = sc.dock_face_half_width_m;
-  chassis.set_dock(dp);
+  chassis.set_dock(dock_placement(sc));
   chassis.set_true_pose(run.start.robot_world);
   chassis.reset_odometry(Pose2{});
   Rng lidar_rng(mix64(seed ^ 0x4C494441ull));

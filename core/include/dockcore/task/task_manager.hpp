@@ -95,6 +95,16 @@ struct TaskParams {
   /// robot's front comes too close to see more than the dock's flat face, which fixes no lateral position.
   Real blind_finish_m = static_cast<Real>(0.10);
   Real blind_finish_max_s = static_cast<Real>(10.0);  ///< Longest the last stretch runs on odometry alone, s.
+  /// The final push: it starts on the first ALIGN tick on which the estimate puts the robot lined up with the dock
+  /// (its axis within 45° of the dock's, pads fore or aft) with its edge (footprint half-length or radius) this close
+  /// to the dock's face, m (> 0), and lasts until ALIGN ends. Within it the robot may travel at most max_push_m on
+  /// odometry and spend at most max_push_s without the contacts closing; then the attempt ends (RETRY, and fault 190
+  /// when no retry is left). A robot held short of the contacts (something the lidar does not see between the pads
+  /// and the contacts) would otherwise push on, its command raised by the wheel deadband learning, until the task
+  /// timeout; one that slips or runs past the dock's face would drive on.
+  Real push_zone_m = static_cast<Real>(0.10);
+  Real max_push_m = static_cast<Real>(0.30);  ///< Odometry path length allowed in the final push, m (> 0).
+  Real max_push_s = static_cast<Real>(15.0);  ///< Time allowed in the final push, s (> 0).
   // Pose deviation (ALIGN) and obstacle handling.
   DeviationParams deviation{};
   MotionGateParams gate{};
@@ -104,7 +114,7 @@ struct TaskParams {
   Real charge_confirm_hold_s = static_cast<Real>(0.3);  ///< Contact and current held this long confirm charging.
   Real charge_confirm_timeout_s = static_cast<Real>(5.0);  ///< No confirmation within this: retry.
   Real contact_lost_debounce_s = static_cast<Real>(0.3);   ///< Contacts open this long while charging: fault 183.
-  std::uint8_t max_retries = 3;  ///< Attempts after the first; then fault 182/188 with the robot backed off.
+  std::uint8_t max_retries = 3;  ///< Attempts after the first; then fault 182/188/190 with the robot backed off.
   // Backing off (RETRY, UNDOCKING).
   Real staging_distance_m = static_cast<Real>(0.6);   ///< Back off until the robot centre is this far from the dock.
   Real fallback_backoff_m = static_cast<Real>(0.3);   ///< Without a dock estimate: back off this far on odometry.
@@ -179,7 +189,9 @@ struct TaskStatus {
   FaultCode fault = FaultCode::kNone;
   std::uint8_t retries = 0;        ///< Retries used in the current/last task.
   /// In RETRY: why the attempt ended (kAlignFailed: the controller gave up, e.g. pressed without contact;
-  /// kChargeNotConfirmed: no charging current), the fault raised when no retry is left. kNone in every other state.
+  /// kChargeNotConfirmed: the contacts closed but no charging current; kContactsNotReached: the final push used up
+  /// its distance or time, or the contacts stayed open while waiting for the charge), the fault raised when no retry
+  /// is left. kNone in every other state.
   FaultCode retry_reason = FaultCode::kNone;
   bool dock_valid = false;         ///< dock_pose is a current estimate (not older than target_lost_after_s).
   Pose2 dock_pose{};               ///< Dock in the robot frame.
@@ -215,6 +227,14 @@ class TaskManager {
   TaskState state() const { return state_; }
   /// A detection failed the push test and the next agreeing one would raise 178/179 (ALIGN). O(1).
   bool push_suspected() const { return deviation_count_ > 0; }
+  /// The current attempt is in its final push (ALIGN, see TaskParams::push_zone_m). O(1).
+  bool in_final_push() const { return pushing_; }
+  /// Odometry path length travelled in the final push so far, m; that of the last push once ALIGN has ended, 0
+  /// before any. O(1).
+  Real push_travel_m() const { return push_travel_m_; }
+  /// Time spent in the final push so far, s (at the last tick); that of the last push once ALIGN has ended, 0
+  /// before any. O(1).
+  Real push_elapsed_s() const { return push_elapsed_s_; }
   FaultCode fault() const { return fault_; }
   const TaskParams& params() const { return params_; }
   const ObstacleChecker& obstacle_checker() const { return obstacles_; }
@@ -234,9 +254,14 @@ class TaskManager {
   void run_finish(const TaskInput& in);
   void run_retry(const TaskInput& in);
   void run_undocking(const TaskInput& in);
-  /// Attempt failed (charge not confirmed or controller failure): back off, then retry or fault with `final_fault`.
+  /// Attempt failed (charge not confirmed, contacts not reached, controller failure): back off, then retry or fault
+  /// with `final_fault`.
   void fail_attempt(FaultCode final_fault, const TaskInput& in);
   bool dock_fresh(const TaskInput& in) const;
+  /// The estimate puts the robot in the final push's zone (TaskParams::push_zone_m).
+  bool in_push_zone(const TaskInput& in) const;
+  /// Starts or advances the final push on this tick's odometry; true when it has used up its distance or time.
+  bool push_exhausted(const TaskInput& in);
   static Real since_s(std::uint64_t t_us, const TaskInput& in);
   /// The one place the output twist is produced.
   void emit(const TaskInput& in, TaskOutput& out);
@@ -271,12 +296,18 @@ class TaskManager {
   Real start_distance_m_ = 0;
   std::uint8_t deviation_count_ = 0;  ///< Consecutive detections failing the push test, each agreeing with the last.
   Pose2 deviation_pose_{};            ///< The last failing detection in the odometry frame.
+  bool pushing_ = false;              ///< In the final push (reset on entering ALIGN).
+  std::uint64_t push_since_us_ = 0;
+  Pose2 push_prev_odom_{};  ///< Odometry pose of the previous tick in the push.
+  Real push_travel_m_ = 0;
+  Real push_elapsed_s_ = 0;
   // Obstacles.
   bool blocked_ = false;
   std::uint64_t blocked_since_us_ = 0;
   // Charging.
   bool charge_ok_ = false;
   std::uint64_t charge_ok_since_us_ = 0;
+  bool contact_seen_ = false;  ///< The contacts were closed on entering WAIT_FOR_CHARGE or since.
   bool contact_open_ = false;
   std::uint64_t contact_open_since_us_ = 0;
   // Back-off.

@@ -145,10 +145,15 @@ struct ContactParams {
 /// neither slides along the face nor turns (friction, pads seated in the contacts) — only motion that takes the pads
 /// back off the face is free. So a robot that arrives misaligned stays misaligned until it backs off.
 /// Outside the face width the robot passes by (the dock's sides are not modelled).
+///
+/// stop_short_m > 0 moves that stop in front of the contacts: something the lidar does not see (a raised lip of the
+/// dock's base plate, a cable, a door sill across the face's width) holds the pads stop_short_m before the contact
+/// plane, with the same hard-stop mechanics, so the contacts never close and pushing only stalls the wheels.
 struct DockPlacement {
   Pose2 pose_world;                ///< Dock frame in the world.
   double face_half_width_m = 0.15; ///< Half-width of the face that stops the robot.
   bool dead = false;               ///< True: contacts may close but the charger never delivers current.
+  double stop_short_m = 0;         ///< > 0: the pads are stopped this far in front of the contact plane, m.
 };
 
 /// Electrical load of the robot.

@@ -197,6 +197,8 @@ struct Scenario {
   std::string profile_name = "plate-v";
   Pose2 dock_pose{};  ///< Dock frame in the world.
   double dock_face_half_width_m = 0.15;
+  bool dock_dead = false;        ///< [dock] dead: the contacts close but the charger never delivers current.
+  double dock_stop_short_m = 0;  ///< [dock] stop_short_m: the pads are held this far before the contacts, m.
   /// The world behind the dock (what the lidar sees, whatever the detector is told: that is profile.mounting):
   bool wall = true;         ///< A wall behind the dock, parallel to its face; false: free-standing.
   double wall_gap_m = 0;    ///< The wall's face lies this far behind the profile's minimum x, m, [0, 0.5].

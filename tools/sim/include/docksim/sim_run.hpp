@@ -141,6 +141,8 @@ struct SimOptions {
 SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint64_t seed,
                    const SimOptions& options = SimOptions{});
 
+/// The chassis's dock for a scenario: pose, face width, a dead charger, what holds the pads short. O(1).
+DockPlacement dock_placement(const Scenario& sc);
 /// The robot's outline in the body frame (rectangle corners or a 24-gon). O(1).
 std::vector<dockcore::Vec2> footprint_outline(const ChassisParams& chassis);
 
