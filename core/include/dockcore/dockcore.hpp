@@ -292,24 +292,25 @@ class DockcoreBase {
   std::uint32_t pending_dropped_ = 0;  ///< Detections beyond kMaxDetectionsPerTick between two ticks (not tested).
   std::uint32_t tag_counts_[kTagStatusCount] = {};
   bool have_tag_ = false;
-  std::uint64_t last_tag_us_ = 0;  ///< Newest tag frame past the id and order checks.
-  TaskState prev_state_ = TaskState::kNotTasking;
+  TaskState prev_state_ = TaskState::kNotTasking;  // beside the flag: the two share one padded word
+  std::uint64_t last_tag_us_ = 0;                  ///< Newest tag frame past the id and order checks.
   Twist2 prev_drive_cmd_{};    ///< The previous tick's command before the deadband: the acceleration limit's start.
   Twist2 sent_drive_cmd_{};    ///< drive_cmd of the previous tick (after the deadband).
   WheelSpeeds sent_wheels_{};  ///< wheels of the previous tick: what the measured wheel speeds are compared with.
   WheelDeadband deadband_{};
   bool filter_confirmed_ = false;  ///< The filter fused a detection since its last (re)initialisation.
-  /// The confirmed estimate from before the filter's most recent restart (this task), for a resumed command.
+  // The flags of the three references below, kept together (one padded word).
   bool restart_ref_set_ = false;
+  bool push_ref_set_ = false;
+  bool confirmed_ref_set_ = false;
+  /// The confirmed estimate from before the filter's most recent restart (this task), for a resumed command.
   Pose2 restart_ref_in_odom_{};
   std::uint64_t restart_ref_us_ = 0;  ///< Last detection fused into it.
   /// The push test's reference after a resume (the resume policy's command), replacing the restarted filter.
-  bool push_ref_set_ = false;
   Pose2 push_ref_in_odom_{};
   /// This task's newest confirmed estimate (dock in odom; equal to the filter's while filter_confirmed_) and the
   /// stamp of the detection that made it: the push test's reference, also while the filter rests on one detection
   /// after a restart.
-  bool confirmed_ref_set_ = false;
   Pose2 confirmed_ref_in_odom_{};
   std::uint64_t confirmed_ref_us_ = 0;
 };
