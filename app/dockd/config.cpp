@@ -178,6 +178,17 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
     return h;
   };
   std::vector<const toml::node*> dock_profile_nodes;
+  std::vector<const toml::node*> dock_detector_nodes;  ///< Where each dock set its detector (nullptr: not given).
+  // The detector key of one dock entry, from the parameter table: its values, stored into `d`.
+  const params::ParamSpec* const detector_spec = params::find_param("docks", "detector", params::kDockd);
+  auto detector_key = [&](DockEntry* d, const toml::node** where) {
+    return [&p, detector_spec, d, where](const toml::node& v) {
+      const params::ParamTargets t{nullptr, nullptr, nullptr, nullptr, nullptr, nullptr,     nullptr,
+                                   nullptr, nullptr, nullptr, nullptr, nullptr, &d->detector};
+      params::param_handler(p, *detector_spec, t)(v);
+      *where = &v;
+    };
+  };
   std::vector<toml::source_region> dock_tag_nodes;  ///< Where a [[docks]] entry set tag_id (for the camera check).
   // Per dock: the [mounting] given in its entry, which replaces the profile's own (the same dock shape may stand
   // against a wall in one place and free in another).
@@ -260,9 +271,11 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
       };
     };
     std::pair<bool, dockcore::DockMounting> mounting{false, {}};
+    const toml::node* detector_node = nullptr;
     const std::string base = p.key() + ".";
     p.each(t, base,
            Handlers{{"id", p.integ(&d.id, 0, 31)},
+                    {"detector", detector_key(&d, &detector_node)},
                     {"profile",
                      [&](const toml::node& v) {
                        d.profile_ref = p.string(v);
@@ -317,6 +330,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
     }
     c.docks.push_back(d);
     dock_profile_nodes.push_back(profile_node);
+    dock_detector_nodes.push_back(detector_node);
     dock_mountings.push_back(mounting);
     if (tag_id_set) dock_tag_nodes.push_back(tag_id_region);
   };
@@ -403,11 +417,26 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
          DockEntry d;
          const toml::node* profile_node = &n;
          std::pair<bool, dockcore::DockMounting> mounting{false, {}};
+         const toml::node* detector_node = nullptr;
          bool entry = false;
          p.each(t, "dock.",
                 Handlers{{"default_id", p.integ(&c.default_dock_id, 0, 31)},
-                         {"id", [&](const toml::node& v) { d.id = static_cast<std::uint16_t>(p.integer(v, 0, 31)); entry = true; }},
-                         {"profile", [&](const toml::node& v) { d.profile_ref = p.string(v); profile_node = &v; entry = true; }},
+                         {"id",
+                          [&](const toml::node& v) {
+                            d.id = static_cast<std::uint16_t>(p.integer(v, 0, 31));
+                            entry = true;
+                          }},
+                         {"profile",
+                          [&](const toml::node& v) {
+                            d.profile_ref = p.string(v);
+                            profile_node = &v;
+                            entry = true;
+                          }},
+                         {"detector",
+                          [&](const toml::node& v) {
+                            detector_key(&d, &detector_node)(v);
+                            entry = true;
+                          }},
                          {"mounting", [&](const toml::node& v) {
                             mounting_handler(&mounting, "dock.mounting.")(v);
                             entry = true;
@@ -418,6 +447,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
            }
            c.docks.push_back(d);
            dock_profile_nodes.push_back(profile_node);
+           dock_detector_nodes.push_back(detector_node);
            dock_mountings.push_back(mounting);
          }
        }},
@@ -498,6 +528,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
     DockEntry d;
     c.docks.push_back(d);
     dock_profile_nodes.push_back(&root);
+    dock_detector_nodes.push_back(nullptr);
     dock_mountings.push_back({false, {}});
   }
   std::uint32_t mask = 0;
@@ -515,6 +546,13 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
                                                   ") nor a .toml file");
     }
     if (dock_mountings[i].first) d.profile.mounting = dock_mountings[i].second;
+    const dockcore::ConfigureStatus detector_ok = dockcore::detector_supports(d.detector, d.profile);
+    if (detector_ok != dockcore::ConfigureStatus::kOk) {
+      const toml::node* at = dock_detector_nodes[i] != nullptr ? dock_detector_nodes[i] : dock_profile_nodes[i];
+      p.fail(at->source(), std::string("dock ") + std::to_string(d.id) + ": detector = \"" +
+                               dockcore::to_string(d.detector) + "\" with profile \"" + d.profile_ref +
+                               "\": " + dockcore::to_string(detector_ok));
+    }
     mask |= 1u << d.id;
   }
   c.task.accepted_dock_ids = mask;

@@ -15,6 +15,7 @@
 #include "dockcore/control/kinematics.hpp"
 #include "dockcore/control/safety.hpp"
 #include "dockcore/control/wheel_deadband.hpp"
+#include "dockcore/dockcore.hpp"
 #include "dockcore/drivers/can_link.hpp"
 #include "dockcore/drivers/lidar_driver.hpp"
 #include "dockcore/drivers/udp_camera.hpp"
@@ -54,6 +55,8 @@ struct DockEntry {
   /// The dock's AprilTag (docs/camera.md, "Fusion"): id −1 = none. Its place is in this dock's frame (before a
   /// taught or configured target corrects the frame; dockd maps it with the profile).
   dockcore::DockTag tag{};
+  /// Which detector finds this dock (the parameter table's docks.detector); checked against the profile.
+  dockcore::DockDetector detector = dockcore::DockDetector::kEstimator;
 };
 
 enum class LogLevel : std::uint8_t { kError = 0, kWarn = 1, kInfo = 2, kDebug = 3 };

@@ -51,6 +51,12 @@ void Daemon::build_core() {
   controller_ = controllers_.by_name(cfg_.controller.c_str());
   if (controller_ == nullptr) controller_ = &controllers_.smooth;  // the config validates the name
   core_ = std::make_unique<dockcore::Dockcore>(*controller_);
+  for (const DockEntry& d : cfg_.docks) {
+    if (d.detector == dockcore::DockDetector::kBreakpoint && !breakpoint_) {
+      breakpoint_ = std::make_unique<dockcore::BreakpointDetector>();
+    }
+  }
+  core_->attach_breakpoint(breakpoint_.get());
   core_cfg_ = dockcore::DockcoreConfig{};
   core_cfg_.estimator = cfg_.estimator;
   core_cfg_.task = cfg_.task;
@@ -109,6 +115,7 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
     }
   }
   core_cfg_.tag.dock_tag = tag;
+  core_cfg_.detector = d->detector;
   if (loop_record_) loop_record_->configure(loop_controller(), prof, core_cfg_);
   if (!core_->configure(prof, core_cfg_)) return false;
   active_dock_ = dock_id;

@@ -183,6 +183,8 @@ class Daemon final : private HostActions, private TeachHooks {
   DaemonIo io_;
   dockcore::ControllerSet controllers_;
   dockcore::DockingController* controller_ = nullptr;  ///< The configured one of controllers_.
+  /// Seed 000's detector, allocated once when a dock of the database picks it; outlives every core it is attached to.
+  std::unique_ptr<dockcore::BreakpointDetector> breakpoint_;
   std::unique_ptr<dockcore::Dockcore> core_;
   dockcore::DockcoreConfig core_cfg_{};
   StateData state_;

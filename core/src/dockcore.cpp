@@ -2,7 +2,42 @@
 
 #include <cmath>
 
+#include "dockcore/perception/breakpoint_measurement.hpp"
+
 namespace dockcore {
+
+const char* to_string(DockDetector d) {
+  switch (d) {
+    case DockDetector::kEstimator:
+      return "estimator";
+    case DockDetector::kBreakpoint:
+      return "breakpoint";
+  }
+  return "unknown detector";
+}
+
+const char* to_string(ConfigureStatus s) {
+  switch (s) {
+    case ConfigureStatus::kOk:
+      return "ok";
+    case ConfigureStatus::kBadProfile:
+      return "the dock profile has no segments";
+    case ConfigureStatus::kDetectorNotAttached:
+      return "detector breakpoint needs a BreakpointDetector attached";
+    case ConfigureStatus::kDetectorProfileMismatch:
+      return "detector breakpoint finds only the breakpoint dock (its outline, vertex for vertex)";
+    case ConfigureStatus::kDetectorNeedsWall:
+      return "detector breakpoint needs the dock against a wall (its mounting is free_standing)";
+  }
+  return "unknown configure status";
+}
+
+ConfigureStatus detector_supports(DockDetector detector, const DockProfile& profile) {
+  if (detector != DockDetector::kBreakpoint) return ConfigureStatus::kOk;
+  if (!breakpoint_outline_frame(profile)) return ConfigureStatus::kDetectorProfileMismatch;
+  if (profile.mounting.kind == DockMountKind::kFreeStanding) return ConfigureStatus::kDetectorNeedsWall;
+  return ConfigureStatus::kOk;
+}
 
 bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& config) {
   config_ = config;
@@ -24,7 +59,59 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
   sent_drive_cmd_ = Twist2{};
   sent_wheels_ = WheelSpeeds{};
   deadband_.configure(config.deadband);
-  return estimator_.configure(profile, config.estimator);
+  detector_ = DockDetector::kEstimator;
+  configure_status_ = ConfigureStatus::kOk;
+  if (!estimator_.configure(profile, config.estimator)) {
+    configure_status_ = ConfigureStatus::kBadProfile;
+    return false;
+  }
+  if (config.detector == DockDetector::kBreakpoint) {
+    configure_status_ =
+        breakpoint_ == nullptr ? ConfigureStatus::kDetectorNotAttached : detector_supports(config.detector, profile);
+    if (configure_status_ != ConfigureStatus::kOk) return false;
+  }
+  detector_ = config.detector;
+  return true;
+}
+
+DockEstimate DockcoreBase::breakpoint_estimate(const ScanView& scan) {
+  DockEstimate e;
+  Pose2 native_in_dock;
+  if (breakpoint_ == nullptr || !breakpoint_outline_frame(estimator_.profile(), &native_in_dock)) {
+    e.status = EstimateStatus::kNoProfile;
+    return e;
+  }
+  breakpoint_->set_params(breakpoint_params_for_scan(scan.angle_increment_rad, breakpoint_->params()));
+  const BreakpointDetection d = breakpoint_->detect(scan);
+  switch (d.status) {
+    case BreakpointStatus::kFound:
+      e.status = EstimateStatus::kNotVerified;
+      break;  // until the pose is made
+    case BreakpointStatus::kBadScan:
+    case BreakpointStatus::kBadWindow:
+      e.status = EstimateStatus::kBadScan;
+      break;
+    case BreakpointStatus::kEmptyWindow:
+      e.status = EstimateStatus::kNoPoints;
+      break;
+    case BreakpointStatus::kTooFewMutations:
+    case BreakpointStatus::kNoPattern:
+      e.status = EstimateStatus::kNoCandidates;
+      break;
+  }
+  Pose2 native_in_robot;
+  Mat3 cov;
+  if (!breakpoint_measurement(d, scan.angle_increment_rad, config_.lidar_mount, config_.estimator.range_sigma_m,
+                              &native_in_robot, &cov, breakpoint_->params().min_jump_m)) {
+    return e;
+  }
+  // The profile's frame may be the built-in's moved (a taught target): dock = native ∘ native_in_dock⁻¹. The
+  // covariance is of the built-in frame's pose; the move is a few millimetres and degrees, so it stays as it is.
+  e.found = true;
+  e.status = EstimateStatus::kOk;
+  e.pose = native_in_robot.compose(native_in_dock.inverse());
+  e.covariance = cov;
+  return e;
 }
 
 void DockcoreBase::take_inputs(const DockcoreBase& from) {
@@ -81,7 +168,8 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
     hint = filter_.dock_in_robot(odom_pose);
     hint_ptr = &hint;
   }
-  last_estimate_ = estimator_.estimate(scan, config_.lidar_mount, hint_ptr);
+  last_estimate_ = detector_ == DockDetector::kBreakpoint ? breakpoint_estimate(scan)
+                                                          : estimator_.estimate(scan, config_.lidar_mount, hint_ptr);
   if (last_estimate_.found) {
     // The push test's reference is the filter before this detection: once fused (or adopted by a restart) it
     // would agree with the detection whatever happened to the robot.

@@ -237,6 +237,7 @@ namespace {
 struct ReplayCore {
   explicit ReplayCore(const LoopController& c) : controllers(c.seed000, c.seed004, c.seed003, c.smooth) {}
   ControllerSet controllers;
+  std::unique_ptr<BreakpointDetector> breakpoint;  ///< For docks configured with DockDetector::kBreakpoint.
   std::unique_ptr<Dockcore> core;
 };
 
@@ -322,6 +323,10 @@ ReplayResult replay_loop_record(const std::string& path) {
           if (rc) next->core->take_inputs(*rc->core);
           rc = std::move(next);
           rebuild = false;
+        }
+        if (config.detector == DockDetector::kBreakpoint && !rc->breakpoint) {
+          rc->breakpoint = std::make_unique<BreakpointDetector>();
+          rc->core->attach_breakpoint(rc->breakpoint.get());
         }
         rc->core->configure(profile, config);
         break;

@@ -321,3 +321,35 @@ TEST(DockdConfig, EstimatorTuningKeys) {
   STRCMP_CONTAINS("t.toml:3:14: estimator.segments.min_points = 1 is out of range [2, 100]",
                   error_of("[estimator.segments]\n\nmin_points = 1\n").c_str());
 }
+
+TEST(DockdConfig, EachDockPicksItsDetector) {
+  const dockd::DockdConfig c = dockd::parse_config_toml(
+      "[dock]\ndefault_id = 1\n[[docks]]\nid = 1\nprofile = \"breakpoint\"\ndetector = \"breakpoint\"\n"
+      "[[docks]]\nid = 2\nprofile = \"breakpoint\"\n[[docks]]\nid = 3\ndetector = \"estimator\"\n",
+      "t.toml");
+  CHECK(c.find_dock(1)->detector == dockcore::DockDetector::kBreakpoint);
+  CHECK(c.find_dock(2)->detector == dockcore::DockDetector::kEstimator);  // the default
+  CHECK(c.find_dock(3)->detector == dockcore::DockDetector::kEstimator);
+  // The [dock] shorthand takes it too.
+  const dockd::DockdConfig s = dockd::parse_config_toml(
+      "[dock]\nid = 4\ndefault_id = 4\nprofile = \"breakpoint\"\ndetector = \"breakpoint\"\n", "t.toml");
+  CHECK(s.find_dock(4)->detector == dockcore::DockDetector::kBreakpoint);
+}
+
+TEST(DockdConfig, BadDetectorIsRefusedWithItsPosition) {
+  STRCMP_CONTAINS("t.toml:3:12: docks.detector = \"vmarker\" is not one of estimator, breakpoint",
+                  error_of("[[docks]]\nid = 1\ndetector = \"vmarker\"\n").c_str());
+  STRCMP_CONTAINS("t.toml:3:12: docks.detector must be a string",
+                  error_of("[[docks]]\nid = 1\ndetector = 1\n").c_str());
+  // A detector that cannot find the dock: at the detector key, naming dock, detector and profile.
+  STRCMP_CONTAINS(
+      "t.toml:4:12: dock 1: detector = \"breakpoint\" with profile \"plate-v\": detector breakpoint "
+      "finds only the breakpoint dock",
+      error_of("[[docks]]\nid = 1\nprofile = \"plate-v\"\ndetector = \"breakpoint\"\n").c_str());
+  STRCMP_CONTAINS(
+      "t.toml:3:12: dock 1: detector = \"breakpoint\" with profile \"breakpoint\": detector breakpoint "
+      "needs the dock against a wall",
+      error_of("[[docks]]\nid = 1\ndetector = \"breakpoint\"\nprofile = \"breakpoint\"\n"
+               "[docks.mounting]\nkind = \"free_standing\"\n")
+          .c_str());
+}

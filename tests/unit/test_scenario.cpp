@@ -420,3 +420,16 @@ TEST(Scenario, EstimatorTuningKeys) {
   refused_at("[estimator]\nwall_tolerance_m = 0.3\n", 2, 20, "estimator.wall_tolerance_m = 0.3 is out of range [0, 0.2]");
   refused_at("[estimator]\nrequire_wall_behind = false\n", 2, 1, "unknown key 'estimator.require_wall_behind'");
 }
+
+TEST(Scenario, TheDockTakesItsDetector) {
+  const docksim::Scenario sc = docksim::load_scenario_file(scenario_dir() + "seed000.toml");
+  CHECK(sc.detector == dockcore::DockDetector::kBreakpoint);
+  STRCMP_EQUAL("seed000", sc.controller.c_str());
+  CHECK(docksim::parse_scenario_toml("", "s.toml").detector == dockcore::DockDetector::kEstimator);
+  // A bad value, and a detector that cannot find the dock's profile, at the key.
+  const docksim::ScenarioError bad = expect_error("[dock]\ndetector = \"vmarker\"\n");
+  STRCMP_CONTAINS("s.toml:2:12: dock.detector = \"vmarker\" is not one of estimator, breakpoint", bad.what());
+  const docksim::ScenarioError mismatch = expect_error("[dock]\nprofile = \"plate-v\"\ndetector = \"breakpoint\"\n");
+  STRCMP_CONTAINS("s.toml:3:12: dock.detector = \"breakpoint\": detector breakpoint finds only the breakpoint dock",
+                  mismatch.what());
+}

@@ -120,6 +120,10 @@ class SoakWorld {
         geom_(docksim::core_drive_geometry(sc.chassis.geometry)),
         target_world_(sc.dock_pose.transform(sc.camera.target_in_dock)) {
     core_ = std::make_unique<dockcore::Dockcore>(ctl);  // ~334 KiB: heap, not stack
+    if (sc.detector == dockcore::DockDetector::kBreakpoint) {  // seed 000's detector, for a dock that picks it
+      breakpoint_ = std::make_unique<dockcore::BreakpointDetector>();
+      core_->attach_breakpoint(breakpoint_.get());
+    }
     configured_ = core_->configure(sc.profile, docksim::core_config(sc));
     chassis_.set_dock(docksim::dock_placement(sc));
     chassis_.reset_odometry(Pose2{});
@@ -239,6 +243,7 @@ class SoakWorld {
   docksim::World world_;
   dockcore::DriveGeometry geom_;
   dockcore::Vec2 target_world_;
+  std::unique_ptr<dockcore::BreakpointDetector> breakpoint_;  // before core_: outlives it
   std::unique_ptr<dockcore::Dockcore> core_;
   bool configured_ = false;
   std::uint64_t k_ = 0;

@@ -38,6 +38,11 @@
 ///   Refusals are counted by reason and change nothing else. Tag measurements are not raw detections for the push
 ///   test, and the lidar's scan stays the obstacle check's input: the tag replaces the lidar's dock detection, not
 ///   its safety role.
+/// - The detector is a per-dock choice (DockcoreConfig::detector): the estimator (any profile), or seed 000's
+///   BreakpointDetector for the built-in breakpoint dock (breakpoint_measurement.hpp turns its detection into a pose
+///   and covariance; it has no evidence for the sequential test and takes no hint). The breakpoint detector is not
+///   part of the core: its owner attaches one (attach_breakpoint), so a core whose docks do not use it does not carry
+///   its buffers.
 /// No heap. DockcoreN<N> holds the estimator's buffers and the scan copy for N beams (docs/architecture.md: about
 /// 81 KiB with double at 720 beams, 334 KiB at kMaxScanPoints): keep it static or a member, never on a small stack.
 
@@ -50,6 +55,7 @@
 #include "dockcore/control/wheel_deadband.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
+#include "dockcore/perception/breakpoint_detector.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_pose_filter.hpp"
 #include "dockcore/perception/dock_profile.hpp"
@@ -59,6 +65,34 @@
 #include "dockcore/task/task_manager.hpp"
 
 namespace dockcore {
+
+/// Which detector finds the dock in each scan: a per-dock choice (dockd's [[docks]] detector, a scenario's
+/// [dock] detector). docs/docks.md says which detector finds which dock.
+enum class DockDetector : std::uint8_t {
+  kEstimator = 0,  ///< DockPoseEstimator: any profile; pose, covariance and evidence. The default.
+  kBreakpoint =
+      1,  ///< BreakpointDetector (seed 000): the breakpoint dock only, against a wall; needs attach_breakpoint.
+};
+
+/// "estimator" / "breakpoint", as in config files. Never null.
+const char* to_string(DockDetector d);
+
+/// Why DockcoreBase::configure() refused a configuration (configure_status()).
+enum class ConfigureStatus : std::uint8_t {
+  kOk = 0,
+  kBadProfile,               ///< The profile has no segments (the estimator refuses it).
+  kDetectorNotAttached,      ///< DockDetector::kBreakpoint without a BreakpointDetector attached (attach_breakpoint).
+  kDetectorProfileMismatch,  ///< DockDetector::kBreakpoint with a profile that is not the breakpoint outline.
+  kDetectorNeedsWall,        ///< DockDetector::kBreakpoint with a free-standing mounting: its pattern needs a wall.
+};
+
+/// A one-line reason for a ConfigureStatus. Never null.
+const char* to_string(ConfigureStatus s);
+
+/// Whether `detector` can find a dock of `profile`: kOk, or kDetectorProfileMismatch / kDetectorNeedsWall for the
+/// breakpoint detector (breakpoint_outline_frame; a mounting of kind free_standing). The estimator takes every
+/// profile configure() takes. Config readers call it to refuse a file's pairing before a core exists. O(vertices).
+ConfigureStatus detector_supports(DockDetector detector, const DockProfile& profile);
 
 /// Everything Dockcore needs besides the profile and the controller.
 struct DockcoreConfig {
@@ -81,6 +115,8 @@ struct DockcoreConfig {
   /// The camera, the active dock's tag and the tag noise model (on_tag). dock_tag.id −1 (the default): every tag
   /// detection is refused as kWrongId.
   TagFusionParams tag{};
+  /// This dock's detector. kBreakpoint uses estimator.range_sigma_m for its covariance (breakpoint_measurement.hpp).
+  DockDetector detector = DockDetector::kEstimator;
 };
 
 /// Per-tick input from the chassis and the host.
@@ -112,8 +148,17 @@ class DockcoreBase {
 
   /// Configures every part but the inputs: the odometry, the input watch's history and the latest scan run on across
   /// docks and configurations (rescan() runs that scan through the new profile). False (unusable until a good call)
-  /// when the profile has no segments. O(vertices).
+  /// when the profile has no segments or config.detector cannot run on it (configure_status() says which). O(vertices).
   bool configure(const DockProfile& profile, const DockcoreConfig& config);
+  /// What the last configure() decided (kOk before the first). O(1).
+  ConfigureStatus configure_status() const { return configure_status_; }
+  /// The BreakpointDetector docks configured with DockDetector::kBreakpoint run (nullptr: none; such a configure()
+  /// is refused). `detector` must outlive this object or be detached first; configure() checks it, so attach before
+  /// configuring. Each scan sets its beam-count thresholds to the seed's at that scan's resolution
+  /// (breakpoint_params_for_scan); its other parameters are its own. O(1).
+  void attach_breakpoint(BreakpointDetector* detector) { breakpoint_ = detector; }
+  /// The attached breakpoint detector (nullptr: none), e.g. for its counters. O(1).
+  const BreakpointDetector* breakpoint() const { return breakpoint_; }
 
   /// Measured wheel speeds (rad/s, DockcoreConfig::drive's order) at `stamp_us`, integrated into the odometry
   /// (Odometry::add_wheels). False when the stamp is 0 or repeats the previous feedback's. O(1).
@@ -132,13 +177,14 @@ class DockcoreBase {
   void take_inputs(const DockcoreBase& from);
 
   /// One scan stamped `stamp_us` (its first sample; 0 or later than `now_us` is taken as `now_us`), read at `now_us`:
-  /// the input watch's check (a late scan is not used: nullptr, counted), then detection (hint = the filter's
-  /// prediction for the odometry pose at the stamp), filter update, scan copy. Feed the chassis feedback up to the
-  /// scan's time first. Returns the scan's estimate (last_estimate()). Cost: the estimator's plus
-  /// O(count + Odometry::kHistory).
+  /// the input watch's check (a late scan is not used: nullptr, counted), then detection (the configured detector;
+  /// the estimator's hint = the filter's prediction for the odometry pose at the stamp), filter update, scan copy.
+  /// Feed the chassis feedback up to the scan's time first. Returns the scan's estimate (last_estimate(); from the
+  /// breakpoint detector: found, status, pose and covariance only). Cost: the detector's (the estimator's, or
+  /// BreakpointDetector::detect's O(beams)) plus O(count + Odometry::kHistory).
   const DockEstimate* on_scan(const ScanView& scan, std::uint64_t stamp_us, std::uint64_t now_us);
   /// The latest scan (last_scan()) through detection again, e.g. for a profile configure() just set; copies nothing.
-  /// An empty estimate before the first scan. Cost: the estimator's.
+  /// An empty estimate before the first scan. Cost: the detector's.
   const DockEstimate& rescan();
 
   /// The input watch's verdict at `now_us` (tick() makes the same call): which of lidar and chassis changed between
@@ -214,8 +260,10 @@ class DockcoreBase {
   /// The resume policy's bookkeeping after the task manager's tick: what the taken command started or stopped, and
   /// which fault left a command to resume (file comment). O(1).
   void resume_policy(TaskState before, bool have_cmd, const QueuedCommand& cmd, TickOutput* out);
-  /// Copies `scan` (unless it is the kept copy) and runs detection and the filter on it. Cost: the estimator's.
+  /// Copies `scan` (unless it is the kept copy) and runs detection and the filter on it. Cost: the detector's.
   const DockEstimate& estimate_scan(const ScanView& scan, std::uint64_t stamp_us);
+  /// The attached breakpoint detector on `scan`, as an estimate of the configured profile's frame. O(beams).
+  DockEstimate breakpoint_estimate(const ScanView& scan);
   DockcoreConfig config_{};
   Odometry odometry_{};
   InputWatch watch_{};
@@ -232,33 +280,37 @@ class DockcoreBase {
   Real* scan_intensities_;
   std::size_t scan_capacity_;
   ScanView scan_{};
-  bool have_scan_ = false;
+  BreakpointDetector* breakpoint_ = nullptr;  ///< attach_breakpoint's; the owner's.
   std::size_t scan_copy_bytes_ = 0;
   std::uint64_t last_scan_us_ = 0;
   DockEstimate last_estimate_{};
   DetectionInput pending_[kMaxDetectionsPerTick] = {};
   std::uint8_t pending_count_ = 0;
+  bool have_scan_ = false;
+  DockDetector detector_ = DockDetector::kEstimator;  ///< The configured one (kEstimator after a refusal).
+  ConfigureStatus configure_status_ = ConfigureStatus::kOk;
   std::uint32_t pending_dropped_ = 0;  ///< Detections beyond kMaxDetectionsPerTick between two ticks (not tested).
   std::uint32_t tag_counts_[kTagStatusCount] = {};
   bool have_tag_ = false;
-  std::uint64_t last_tag_us_ = 0;  ///< Newest tag frame past the id and order checks.
-  TaskState prev_state_ = TaskState::kNotTasking;
+  TaskState prev_state_ = TaskState::kNotTasking;  // beside the flag: the two share one padded word
+  std::uint64_t last_tag_us_ = 0;                  ///< Newest tag frame past the id and order checks.
   Twist2 prev_drive_cmd_{};    ///< The previous tick's command before the deadband: the acceleration limit's start.
   Twist2 sent_drive_cmd_{};    ///< drive_cmd of the previous tick (after the deadband).
   WheelSpeeds sent_wheels_{};  ///< wheels of the previous tick: what the measured wheel speeds are compared with.
   WheelDeadband deadband_{};
   bool filter_confirmed_ = false;  ///< The filter fused a detection since its last (re)initialisation.
-  /// The confirmed estimate from before the filter's most recent restart (this task), for a resumed command.
+  // The flags of the three references below, kept together (one padded word).
   bool restart_ref_set_ = false;
+  bool push_ref_set_ = false;
+  bool confirmed_ref_set_ = false;
+  /// The confirmed estimate from before the filter's most recent restart (this task), for a resumed command.
   Pose2 restart_ref_in_odom_{};
   std::uint64_t restart_ref_us_ = 0;  ///< Last detection fused into it.
   /// The push test's reference after a resume (the resume policy's command), replacing the restarted filter.
-  bool push_ref_set_ = false;
   Pose2 push_ref_in_odom_{};
   /// This task's newest confirmed estimate (dock in odom; equal to the filter's while filter_confirmed_) and the
   /// stamp of the detection that made it: the push test's reference, also while the filter rests on one detection
   /// after a restart.
-  bool confirmed_ref_set_ = false;
   Pose2 confirmed_ref_in_odom_{};
   std::uint64_t confirmed_ref_us_ = 0;
 };

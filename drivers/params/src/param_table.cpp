@@ -129,6 +129,27 @@ const ParamSpec kTable[] = {
     DC_INT("robot.footprint", "min_points", "–", 1, 1000, kBoth, footprint, min_points,
            "Returns in an area that block it."),
 
+    // The dock's detector (DockcoreConfig::detector): a scenario's [dock], each of dockd's [[docks]] entries.
+    [] {
+      ParamSpec s{"dock",
+                  "detector",
+                  "–",
+                  ParamType::kChoice,
+                  0,
+                  1,
+                  kBoth,
+                  "Which detector finds this dock in each scan: `estimator` (any profile) or `breakpoint` (seed 000's "
+                  "range-jump detector; only the `breakpoint` profile, against a wall; a pose covariance from its beam "
+                  "spacing and `range_sigma_m`). docs/docks.md, \"Which detector works with which dock\".",
+                  [](const ParamTargets& t) { return *t.detector == DockDetector::kBreakpoint ? 1.0 : 0.0; },
+                  [](const ParamTargets& t, double v) {
+                    *t.detector = v != 0 ? DockDetector::kBreakpoint : DockDetector::kEstimator;
+                  }};
+      s.choices = "estimator|breakpoint";
+      s.dockd_table = "docks";
+      return s;
+    }(),
+
     // [estimator]: EstimatorParams. The range keys sit in dockd's [lidar].
     [] {
       ParamSpec s = DC_REAL("estimator", "min_range_m", "m", 0, 10, kBoth, estimator, min_range_m,
@@ -551,8 +572,9 @@ std::string markdown_table(const std::string& table, ParamUse use) {
   TagFusionParams tag_fusion;
   WatchdogParams watchdog;
   WheelDeadbandParams deadband;
-  const ParamTargets defaults{&drive,   &limits,  &footprint, &task,       &estimator, &seed000,
-                              &seed004, &seed003, &smooth,    &tag_fusion, &watchdog,  &deadband};
+  DockDetector detector = DockDetector::kEstimator;
+  const ParamTargets defaults{&drive,   &limits, &footprint,  &task,     &estimator, &seed000, &seed004,
+                              &seed003, &smooth, &tag_fusion, &watchdog, &deadband,  &detector};
   apply_defaults(defaults, use);
   std::ostringstream out;
   bool any = false;

@@ -185,8 +185,9 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   // dockcore's parameters: the keys, bounds and defaults of the parameter table, the same as dockd's config. The
   // obstacle footprint's body is derived from the chassis below.
   namespace params = dockcore::params;
-  const params::ParamTargets targets{nullptr,     &sc.limits,  &sc.safety, &sc.task,       &sc.estimator, &sc.seed000,
-                                     &sc.seed004, &sc.seed003, &sc.smooth, &sc.tag_fusion, &sc.watchdog,  &sc.deadband};
+  const params::ParamTargets targets{nullptr,      &sc.limits,   &sc.safety,  &sc.task,   &sc.estimator,
+                                     &sc.seed000,  &sc.seed004,  &sc.seed003, &sc.smooth, &sc.tag_fusion,
+                                     &sc.watchdog, &sc.deadband, &sc.detector};
   params::apply_defaults(targets, params::kScenario);
   auto table_keys = [&](const std::string& table, Handlers h) {
     params::add_params(p, h, table, targets, params::kScenario);
@@ -546,7 +547,12 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
       {"settle_after_end_s", p.num(&sc.settle_after_end_s, 0, 100)},
       {"robot", p.sub("robot.", robot_handlers)},
       {"lidar", p.sub("lidar.", lidar_handlers)},
-      {"dock", p.sub("dock.", dock_handlers)},
+      {"dock", p.sub("dock.",
+                     [&]() {
+                       Handlers h = dock_handlers();
+                       params::add_params(p, h, "dock", targets, params::kScenario);  // detector
+                       return h;
+                     })},
       {"world", p.sub("world.", world_handlers)},
       {"start", p.sub("start.", start_handlers)},
       {"events", events_handler},
@@ -606,6 +612,13 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   }
   // What the detector is told is independent of the world: [dock.mounting] replaces the profile file's.
   if (st.mounting_set) sc.profile.mounting = st.mounting;
+  // The detector must be able to find this dock (refused here rather than when the run configures the core).
+  const dockcore::ConfigureStatus detector_ok = dockcore::detector_supports(sc.detector, sc.profile);
+  if (detector_ok != dockcore::ConfigureStatus::kOk) {
+    p.fail(p.where("dock.detector", root.source()), std::string("dock.detector = \"") +
+                                                        dockcore::to_string(sc.detector) +
+                                                        "\": " + dockcore::to_string(detector_ok));
+  }
   if (!sc.wall) {
     for (const char* key : {"dock.wall_gap_m", "dock.wall_glass"}) {
       const toml::source_region none{};

@@ -180,6 +180,7 @@ dockcore::DockcoreConfig core_config(const Scenario& sc) {
   cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
   cfg.watchdog = sc.watchdog;
   cfg.deadband = sc.deadband;
+  cfg.detector = sc.detector;
   return cfg;
 }
 
@@ -333,7 +334,15 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     frame_camera = opt.make_frame_camera(sc);
     if (sc.camera.fuse_tags) cfg.tag = tag_fusion_params(sc);
   }
-  if (!core->configure(sc.profile, cfg)) throw ScenarioError("dock profile has no segments");
+  // Seed 000's detector, for a dock that picks it (its ~37 KiB of buffers only then).
+  std::unique_ptr<dockcore::BreakpointDetector> breakpoint;
+  if (cfg.detector == dockcore::DockDetector::kBreakpoint) {
+    breakpoint = std::make_unique<dockcore::BreakpointDetector>();
+    core->attach_breakpoint(breakpoint.get());
+  }
+  if (!core->configure(sc.profile, cfg)) {
+    throw ScenarioError(std::string("dock: ") + dockcore::to_string(core->configure_status()));
+  }
 
   Chassis chassis(sc.chassis, mix64(seed ^ 0x43484153ull));
   chassis.set_dock(dock_placement(sc));

@@ -16,6 +16,7 @@
 #include "dockcore/control/kinematics.hpp"
 #include "dockcore/control/safety.hpp"
 #include "dockcore/control/wheel_deadband.hpp"
+#include "dockcore/dockcore.hpp"
 #include "dockcore/geometry.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_profile.hpp"
@@ -213,6 +214,8 @@ struct Scenario {
   std::vector<ScenarioEvent> events;  ///< Sorted by t_s (stable).
 
   // Dockcore.
+  /// The dock's detector ([dock] detector; the parameter table). Checked against the profile when parsed.
+  dockcore::DockDetector detector = dockcore::DockDetector::kEstimator;
   dockcore::EstimatorParams estimator{};
   dockcore::TaskParams task{};
   HostSpec host{};

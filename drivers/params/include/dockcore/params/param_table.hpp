@@ -15,6 +15,7 @@
 #include "dockcore/control/kinematics.hpp"
 #include "dockcore/control/safety.hpp"
 #include "dockcore/control/wheel_deadband.hpp"
+#include "dockcore/dockcore.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
 #include "dockcore/task/input_watch.hpp"
@@ -52,6 +53,7 @@ struct ParamTargets {
   TagFusionParams* tag_fusion = nullptr;  ///< dockd only: [camera.fusion].
   WatchdogParams* watchdog = nullptr;
   WheelDeadbandParams* deadband = nullptr;
+  DockDetector* detector = nullptr;  ///< One dock's detector (dockd: each [[docks]] entry; a scenario: [dock]).
 };
 
 /// One parameter.
