@@ -2,6 +2,7 @@
 // start, events take effect (a push raises fault 178/179; a 1 s occlusion is ridden out), runs are deterministic.
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "dockcore/task/faults.hpp"
@@ -376,25 +377,34 @@ void check_still_outside_moving_states(const docksim::SimRun& r) {
   }
 }
 
-// A dead charger (tools/scenarios/dead-charger.toml, [dock] dead): every attempt closes the contacts and gets no
-// current; the robot retries and ends in fault 182, backed off and standing.
-TEST(SimRun, ADeadChargerRetriesThenFault182) {
-  docksim::Scenario sc = scenario_file("dead-charger.toml");
-  CHECK(sc.dock_dead);
-  sc.task.max_retries = 1;
+// A finish that cannot charge, from 1 m straight ahead with one retry, for smooth and seed004: not charged, `fault`
+// alone, in FAULT after the one retry, the contacts closed `closings` times, backed off and standing. `check` adds
+// the case's own checks of each run.
+void check_failed_finish(const docksim::Scenario& sc, int fault, int closings,
+                         const std::function<void(const docksim::SimRun&)>& check) {
   const docksim::StartPose start = docksim::start_from(sc, 1.0, 0, 0);
   docksim::SimOptions opt;
   opt.start = &start;
   for (const char* ctl : {"smooth", "seed004"}) {
     const docksim::SimRun r = docksim::run_docking(sc, ctl, 5, opt);
     CHECK_TEXT(!r.outcome.charging_confirmed, ctl);
-    CHECK_TEXT(r.outcome.faults.size() == 1 && r.outcome.faults.count(182) == 1, ctl);
+    CHECK_TEXT(r.outcome.faults.size() == 1 && r.outcome.faults.count(fault) == 1, ctl);
     CHECK(r.outcome.final_state == dockcore::TaskState::kFault);
     CHECK_EQUAL(1, r.outcome.retries);
-    CHECK_EQUAL(2, contact_closings(r));    // both attempts reached the contacts
+    CHECK_EQUAL(closings, contact_closings(r));
+    check(r);
     CHECK(r.outcome.longitudinal_m > 0.2);  // backed off
     check_still_outside_moving_states(r);
   }
+}
+
+// A dead charger (tools/scenarios/dead-charger.toml, [dock] dead): every attempt closes the contacts and gets no
+// current; the robot retries and ends in fault 182, backed off and standing.
+TEST(SimRun, ADeadChargerRetriesThenFault182) {
+  docksim::Scenario sc = scenario_file("dead-charger.toml");
+  CHECK(sc.dock_dead);
+  sc.task.max_retries = 1;
+  check_failed_finish(sc, 182, 2, [](const docksim::SimRun&) {});  // both attempts reached the contacts
 }
 
 // Held 2 cm short of the contacts by something the lidar does not see (tools/scenarios/held-short.toml, [dock]
@@ -404,21 +414,11 @@ TEST(SimRun, HeldShortOfTheContactsTheFinalPushEndsInFault190) {
   docksim::Scenario sc = scenario_file("held-short.toml");
   DOUBLES_EQUAL(0.02, sc.dock_stop_short_m, 1e-12);
   sc.task.max_retries = 1;
-  const docksim::StartPose start = docksim::start_from(sc, 1.0, 0, 0);
-  docksim::SimOptions opt;
-  opt.start = &start;
-  for (const char* ctl : {"smooth", "seed004"}) {
-    const docksim::SimRun r = docksim::run_docking(sc, ctl, 5, opt);
-    CHECK_TEXT(!r.outcome.charging_confirmed, ctl);
-    CHECK_TEXT(r.outcome.faults.size() == 1 && r.outcome.faults.count(190) == 1, ctl);
-    CHECK(r.outcome.final_state == dockcore::TaskState::kFault);
-    CHECK_EQUAL(1, r.outcome.retries);
-    CHECK_EQUAL(0, contact_closings(r));
+  const double max_push_s = static_cast<double>(sc.task.max_push_s);
+  check_failed_finish(sc, 190, 0, [max_push_s](const docksim::SimRun& r) {
     // Two attempts of approach plus at most max_push_s of pushing each, and the back-offs: well inside the timeout.
-    CHECK(r.outcome.end_time_s < 2 * (20 + static_cast<double>(sc.task.max_push_s)) + 20);
-    CHECK(r.outcome.longitudinal_m > 0.2);  // backed off
-    check_still_outside_moving_states(r);
-  }
+    CHECK(r.outcome.end_time_s < 2 * (20 + max_push_s) + 20);
+  });
 }
 
 TEST(SimRun, ObstacleClearanceIsMeasured) {

@@ -120,10 +120,7 @@ class SoakWorld {
         geom_(docksim::core_drive_geometry(sc.chassis.geometry)),
         target_world_(sc.dock_pose.transform(sc.camera.target_in_dock)) {
     core_ = std::make_unique<dockcore::Dockcore>(ctl);  // ~334 KiB: heap, not stack
-    if (sc.detector == dockcore::DockDetector::kBreakpoint) {  // seed 000's detector, for a dock that picks it
-      breakpoint_ = std::make_unique<dockcore::BreakpointDetector>();
-      core_->attach_breakpoint(breakpoint_.get());
-    }
+    breakpoint_ = docksim::attach_detector(sc, *core_);
     configured_ = core_->configure(sc.profile, docksim::core_config(sc));
     chassis_.set_dock(docksim::dock_placement(sc));
     chassis_.reset_odometry(Pose2{});

@@ -264,6 +264,13 @@ StartPose draw_start(const Scenario& sc, std::uint64_t seed) {
   return start_from(sc, d, b, h);
 }
 
+std::unique_ptr<dockcore::BreakpointDetector> attach_detector(const Scenario& sc, dockcore::DockcoreBase& core) {
+  if (sc.detector != dockcore::DockDetector::kBreakpoint) return nullptr;
+  auto breakpoint = std::make_unique<dockcore::BreakpointDetector>();
+  core.attach_breakpoint(breakpoint.get());
+  return breakpoint;
+}
+
 DockPlacement dock_placement(const Scenario& sc) {
   DockPlacement dp;
   dp.pose_world = sc.dock_pose;
@@ -334,12 +341,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     frame_camera = opt.make_frame_camera(sc);
     if (sc.camera.fuse_tags) cfg.tag = tag_fusion_params(sc);
   }
-  // Seed 000's detector, for a dock that picks it (its ~37 KiB of buffers only then).
-  std::unique_ptr<dockcore::BreakpointDetector> breakpoint;
-  if (cfg.detector == dockcore::DockDetector::kBreakpoint) {
-    breakpoint = std::make_unique<dockcore::BreakpointDetector>();
-    core->attach_breakpoint(breakpoint.get());
-  }
+  const std::unique_ptr<dockcore::BreakpointDetector> breakpoint = attach_detector(sc, *core);
   if (!core->configure(sc.profile, cfg)) {
     throw ScenarioError(std::string("dock: ") + dockcore::to_string(core->configure_status()));
   }

@@ -47,6 +47,10 @@ dockcore::DriveGeometry core_drive_geometry(const DriveGeometry& g);
 /// caller's (tag_fusion_params). With odometry from wheel speeds the drive geometry is the one the robot believes
 /// (the chassis's radius and base errors applied), as a user would configure a robot whose dimensions are off. O(1).
 dockcore::DockcoreConfig core_config(const Scenario& sc);
+/// Seed 000's detector for a scenario whose dock picks it (sc.detector kBreakpoint), attached to `core`; nullptr
+/// (nothing attached) otherwise, so its ~37 KiB of buffers exist only then. Keep the result alive as long as `core`
+/// and attach before DockcoreBase::configure. O(1) plus one allocation.
+std::unique_ptr<dockcore::BreakpointDetector> attach_detector(const Scenario& sc, dockcore::DockcoreBase& core);
 /// Hands the chassis's feedback at `now_us` to the core as the scenario's odometry source says: the chassis
 /// firmware's pose and the measured twist, or the measured wheel speeds (each scaled by its own believed radius
 /// over the common one, so a left/right radius difference reaches the core's odometry). O(1).
