@@ -424,7 +424,9 @@ ControlOutput SmoothController::step(const ControlInput& in) {
   if (guard == ControlStatus::kArrived) phase_ = SmoothPhase::kDocked;
   if (guard != ControlStatus::kRunning) return stopped(guard, static_cast<std::uint8_t>(phase_));
   // The law runs on the docking frame: the real body frame, or for rear pads the body frame turned by π.
-  Pose2 robot = in.dock_in_robot.inverse();
+  const Pose2 aim = in.aim_lateral_m == Real(0) ? in.dock_in_robot
+                                                : in.dock_in_robot.compose(Pose2{Real(0), in.aim_lateral_m, Real(0)});
+  Pose2 robot = aim.inverse();
   if (p_.backwards) robot.yaw_rad = wrap_angle(robot.yaw_rad + kPi);
   const Vec2 pad = robot.transform(Vec2(c.pad_reach_m, 0));
   if (stalled(c, pad.x(), positive_dt(in), &stall_s_)) {

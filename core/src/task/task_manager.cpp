@@ -63,6 +63,7 @@ void TaskManager::configure(const TaskParams& params, const FootprintParams& foo
   last_result_ = TaskResult::kNone;
   last_command_ = CommandResult::kNone;
   retries_ = 0;
+  lateral_misses_ = 0;
   phase_ = 0;
   have_prev_tick_ = false;
 }
@@ -144,6 +145,7 @@ void TaskManager::handle_command(const TaskInput& in, TaskOutput& out) {
       } else if (state_ == TaskState::kNotTasking || state_ == TaskState::kFault) {
         fault_ = FaultCode::kNone;
         retries_ = 0;
+        lateral_misses_ = 0;
         dock_id_ = id;
         task_since_us_ = in.now_us;
         ctrl_->reset();
@@ -225,12 +227,16 @@ bool TaskManager::run_backoff(const TaskInput& in) {
   const Real dx = in.odom_pose.x_m - backoff_start_.x_m;
   const Real dy = in.odom_pose.y_m - backoff_start_.y_m;
   if (std::sqrt(dx * dx + dy * dy) >= backoff_needed_m_) return true;
-  want_.vx_mps = -params_.backoff_speed_mps;
+  want_.vx_mps = params_.pads_rear ? params_.backoff_speed_mps : -params_.backoff_speed_mps;
   return false;
 }
 
 void TaskManager::fail_attempt(FaultCode final_fault, const TaskInput& in) {
   retry_reason_ = final_fault;
+  if ((final_fault == FaultCode::kAlignFailed || final_fault == FaultCode::kContactsNotReached) &&
+      lateral_misses_ < 255) {
+    ++lateral_misses_;
+  }
   pending_fault_ = retries_ >= params_.max_retries ? final_fault : FaultCode::kNone;
   enter(TaskState::kRetry, in);
   start_backoff(in);
@@ -304,6 +310,15 @@ bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in)
   return false;
 }
 
+Real TaskManager::retry_lateral_offset_m() const {
+  // The first miss is retried on the axis (a transient cause: a stall, a bump, a late estimate); misses 2, 3, 4, 5 ...
+  // aim at +1, -1, +2, -2 ... steps beside it.
+  if (lateral_misses_ < 2) return Real(0);
+  const int j = lateral_misses_ - 1;
+  const Real steps = static_cast<Real>((j + 1) / 2);
+  return (j % 2 == 1 ? Real(1) : Real(-1)) * steps * params_.retry_lateral_step_m;
+}
+
 void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
   // Every detection since the last tick, in order: a push followed by a stall shows only in the first scans of the
   // backlog (the later ones may already have restarted the filter at the pushed pose).
@@ -316,6 +331,7 @@ void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
   ci.dt_s = dt_s_;
   ci.dock_valid = in.dock.valid;
   ci.dock_in_robot = in.dock.pose;
+  ci.aim_lateral_m = retry_lateral_offset_m();
   ci.dock_covariance = in.dock.covariance;
   ci.dock_stamp_us = in.dock.stamp_us;
   ci.odom_pose = in.odom_pose;

@@ -305,6 +305,9 @@ const ParamSpec kTable[] = {
             "Odometry distance the final push may travel without the contacts closing: retry, then fault 190."),
     DC_REAL("task", "max_push_s", "s", 0.5, 600, kBoth, task, max_push_s,
             "Time the final push may last without the contacts closing: retry, then fault 190."),
+    DC_REAL("task", "retry_lateral_step_m", "m", 0, 0.1, kBoth, task, retry_lateral_step_m,
+            "After two attempts that missed the contacts (188, 190), the next aim this much to one side, then the "
+            "other, then twice as far; 0: off."),
     DC_REAL("task", "obstacle_timeout_s", "s", 0.1, 600, kBoth, task, obstacle_timeout_s,
             "Blocked this long: fault 180."),
     DC_REAL("task", "charge_current_threshold_a", "A", 0, 200, kBoth, task, charge_current_threshold_a,

@@ -49,6 +49,9 @@ struct ControlInput {
   Pose2 lidar_mount{};       ///< Lidar in the robot frame.
   bool contact = false;      ///< Charging contacts closed (chassis report).
   bool charging = false;     ///< Charging current flowing (chassis report).
+  /// Aim this far beside the dock's axis, m along the dock frame's y: the task manager's lateral search on retries
+  /// (TaskParams::retry_lateral_step_m). `smooth` honours it; the seeds' controllers keep their published method.
+  Real aim_lateral_m = 0;
 };
 
 /// How a controller's run is going.

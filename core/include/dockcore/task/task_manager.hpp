@@ -115,10 +115,21 @@ struct TaskParams {
   Real charge_confirm_timeout_s = static_cast<Real>(5.0);  ///< No confirmation within this: retry.
   Real contact_lost_debounce_s = static_cast<Real>(0.3);   ///< Contacts open this long while charging: fault 183.
   std::uint8_t max_retries = 3;  ///< Attempts after the first; then fault 182/188/190 with the robot backed off.
+  /// Lateral search on retries, m (>= 0; 0: off). After an attempt that reached the dock without the contacts closing
+  /// (retry reason 188 or 190), the next attempt aims on the axis again (the miss may have had a transient cause), and
+  /// every further one beside it: +s, -s, +2s, -2s ... from the dock's axis. A lidar whose mount is off its configured
+  /// pose by a centimetre (a calibration error nobody measured) puts every attempt the same centimetre beside the
+  /// contacts; the search finds them. The controller gets the aim as ControlInput::aim_lateral_m (`smooth` honours it).
+  /// Neighbouring aims overlap when the step is at most the contacts' lateral window (±tolerance) less twice the
+  /// docking's own lateral error: 2 × (10 − 4) mm for the simulated ±10 mm contacts.
+  Real retry_lateral_step_m = static_cast<Real>(0.012);
   // Backing off (RETRY, UNDOCKING).
   Real staging_distance_m = static_cast<Real>(0.6);   ///< Back off until the robot centre is this far from the dock.
   Real fallback_backoff_m = static_cast<Real>(0.3);   ///< Without a dock estimate: back off this far on odometry.
   Real backoff_speed_mps = static_cast<Real>(0.1);    ///< Backing speed (above the drive deadband).
+  /// The charging pads are at the robot's rear: it docks backwards, so backing off from the dock (RETRY, UNDOCKING)
+  /// drives forwards. Not a key of its own: dockd and the scenarios derive it from the footprint's `pads`.
+  bool pads_rear = false;
   Real backoff_timeout_s = static_cast<Real>(20.0);   ///< Back-off not done in this time: fault (186 undocking).
   Real charge_off_timeout_s = static_cast<Real>(2.0); ///< Undock: current must stop within this, else fault 186.
   // Limits and timing.
@@ -227,6 +238,8 @@ class TaskManager {
   TaskState state() const { return state_; }
   /// A detection failed the push test and the next agreeing one would raise 178/179 (ALIGN). O(1).
   bool push_suspected() const { return deviation_count_ > 0; }
+  /// Where this attempt aims beside the dock's axis (retry_lateral_step_m), m in the dock frame's y. O(1).
+  Real retry_lateral_offset_m() const;
   /// The current attempt is in its final push (ALIGN, see TaskParams::push_zone_m). O(1).
   bool in_final_push() const { return pushing_; }
   /// Odometry path length travelled in the final push so far, m; that of the last push once ALIGN has ended, 0
@@ -277,6 +290,7 @@ class TaskManager {
   CommandResult last_command_ = CommandResult::kNone;
   std::uint16_t dock_id_ = 0;
   std::uint8_t retries_ = 0;
+  std::uint8_t lateral_misses_ = 0;  ///< This task's attempts that reached the dock without contact (188, 190).
   std::uint8_t phase_ = 0;
 
   Twist2 want_{};              // the state's wanted twist for this tick; emit() decides what leaves
