@@ -161,6 +161,72 @@ TEST(SimRun, PushRaisesDeviationFault) {
   CHECK(has_fault(r2, 178, 3.0, 3.2));
 }
 
+// A push timed on the task's state (in_state): it lands in ALIGN whatever the approach took, t_s after ALIGN began.
+TEST(SimRun, APushTimedOnAlignLandsInAlignAndRaises178) {
+  docksim::Scenario sc = docksim::parse_scenario_toml(
+      "[[events]]\ntype = \"push\"\nin_state = \"ALIGN\"\nt_s = 1.5\ndy_m = 0.5\n", "push-in-align.toml");
+  CHECK(sc.events.size() == 1 && sc.events[0].after_state);
+  CHECK(sc.events[0].state == dockcore::TaskState::kAlign);
+  const docksim::StartPose start = docksim::start_from(sc, 2.0, 0, 0);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 5, opt);
+  double align_s = -1, push_s = -1;
+  for (const auto& e : r.timeline) {
+    if (align_s < 0 && e.kind == docksim::TimelineKind::kState &&
+        e.code == static_cast<int>(dockcore::TaskState::kAlign))
+      align_s = e.t_s;
+    if (push_s < 0 && e.kind == docksim::TimelineKind::kEvent && e.code == static_cast<int>(docksim::EventKind::kPush))
+      push_s = e.t_s;
+  }
+  CHECK(align_s > 0);
+  REAL_EQUAL(align_s + 1.5, push_s, 0.006);  // on the first 5 ms step at or after it
+  CHECK(has_fault(r, 178, push_s, push_s + 0.2));
+  CHECK(r.outcome.final_state == dockcore::TaskState::kFault);
+  // A state the run never reaches: the event never fires and the robot docks.
+  docksim::Scenario never = docksim::parse_scenario_toml(
+      "[[events]]\ntype = \"push\"\nin_state = \"UNDOCKING\"\nt_s = 0\ndy_m = 0.5\n", "push-in-undocking.toml");
+  check_docked(docksim::run_docking(never, "smooth", 5, opt));
+  // An unknown state is refused with its place.
+  CHECK_THROWS(docksim::ScenarioError,
+               docksim::parse_scenario_toml("[[events]]\ntype = \"push\"\nin_state = \"ALIGNING\"\nt_s = 1\n", "x"));
+}
+
+// A lidar 16 mm beside where its configuration says (a calibration error dockcore is not told) puts the attempts
+// about 16 mm beside the ±10 mm contacts. The task manager's lateral search aims the next attempts beside the axis
+// and finds them; without it every attempt misses the same way.
+TEST(SimRun, AnUntoldLidarCalibrationErrorIsFoundByTheLateralSearch) {
+  docksim::Scenario sc = docksim::parse_scenario_toml("[robot.lidar]\nerror_y_m = 0.016\n", "calibration.toml");
+  REAL_EQUAL(0.016, static_cast<double>(sc.true_lidar_mount().y_m), 1e-12);
+  REAL_EQUAL(0.0, static_cast<double>(sc.lidar_mount.y_m), 0);
+  const docksim::StartPose start = docksim::start_from(sc, 1.5, 0, 0);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 7, opt);
+  check_docked(r);
+  CHECK(r.outcome.retries >= 2);  // the first retry aims on the axis again
+  sc.task.retry_lateral_step_m = 0;
+  const docksim::SimRun off = docksim::run_docking(sc, "smooth", 7, opt);
+  CHECK_FALSE(off.outcome.charging_confirmed);
+  CHECK(off.outcome.faults.count(static_cast<int>(dockcore::FaultCode::kAlignFailed)) +
+            off.outcome.faults.count(static_cast<int>(dockcore::FaultCode::kContactsNotReached)) >
+        0);
+}
+
+// A robot with rear pads backs off from the dock by driving forwards: after a missed attempt it reaches the staging
+// distance and tries again, instead of pressing its pads into the dock until the back-off times out.
+TEST(SimRun, ARearPadRobotBacksOffForwardsOnARetry) {
+  docksim::Scenario sc = docksim::parse_scenario_toml(
+      "[robot.footprint]\npads = \"rear\"\n[robot.lidar]\nerror_y_m = 0.016\n", "rear-retry.toml");
+  CHECK_TRUE(sc.task.pads_rear);
+  const docksim::StartPose start = docksim::start_from(sc, 1.5, 0, 0);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 7, opt);
+  check_docked(r);
+  CHECK(r.outcome.retries >= 1);
+}
+
 TEST(SimRun, PushThenHostRedockRecovers) {
   docksim::Scenario sc = default_scenario();
   docksim::ScenarioEvent push;

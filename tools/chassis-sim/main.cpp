@@ -121,6 +121,12 @@ int run(const Options& opt) {
                    opt.scenario_path.c_str(), ev.t_s);
       return 2;
     }
+    if (ev.after_state) {
+      // The task state is dockd's: this program sees only wheel commands, so it cannot time an event on it.
+      std::fprintf(stderr, "chassis-sim: %s: an event with in_state at %.2f s is dock-sim only\n",
+                   opt.scenario_path.c_str(), ev.t_s);
+      return 2;
+    }
   }
   const bool agilex = *proto == dockcore::drivers::ChassisProtocol::kAgilexV2;
   v1::Ids ids;
@@ -494,7 +500,7 @@ int run(const Options& opt) {
         const bool occluded = motion_t0 >= 0 && mt < occluded_until;
         docksim::World w = occluded ? world_no_dock : world_with_dock;
         for (const auto& d : discs) w.add_circle(d.c, d.r);
-        const Pose2 lidar_world = cs.true_pose.compose(sc.lidar_mount);
+        const Pose2 lidar_world = cs.true_pose.compose(sc.true_lidar_mount());
         docksim::simulate_scan(w, lidar_world, sc.lidar, lidar_rng, &scan, now_us);
         if (lidar->emit_scan(scan.view())) ++scans_sent;
       }

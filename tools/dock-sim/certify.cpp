@@ -46,8 +46,9 @@ struct Factor {
   double p_second = 0;
 };
 
-// The family. Ranges follow the bases, drives and mounts robot builders have (docs/scenarios.md lists them); the dock,
-// the room and the start envelope are the base scenario's.
+// The family. Ranges follow the bases, drives, mounts and dock installations robot builders have (docs/scenarios.md
+// lists them); the dock's profile, where it stands and the start envelope are the base scenario's. The "events"
+// factors are no TOML keys: they make one [[events]] push, timed on the task's ALIGN state.
 const Factor kFactors[] = {
     {"robot", "kinematics", 0, 1, "", "drive: differential or mecanum", "diff", "mecanum", 0.3},
     {"robot.footprint", "pads", 0, 1, "", "charging pads: front or rear (docking backwards)", "front", "rear", 0.5},
@@ -67,6 +68,17 @@ const Factor kFactors[] = {
     {"robot.lidar", "yaw_deg", -10.0, 10.0, "deg", "lidar mount yaw (configured)"},
     {"lidar", "rate_hz", 5.0, 15.0, "Hz", "lidar scan rate"},
     {"lidar", "latency_s", 0.0, 0.10, "s", "lidar latency"},
+    {"robot.lidar", "error_x_m", -0.01, 0.01, "m", "lidar calibration error x (not told)"},
+    {"robot.lidar", "error_y_m", -0.01, 0.01, "m", "lidar calibration error y (not told)"},
+    {"robot.lidar", "error_yaw_deg", -1.0, 1.0, "deg", "lidar calibration error yaw (not told)"},
+    {"dock", "wall", 0, 1, "", "behind the dock: a wall, or nothing (free-standing)", "wall", "none", 0.15},
+    {"dock", "wall_glass", 0, 1, "", "the wall: opaque or glass (the lidar sees through)", "opaque", "glass", 0.15},
+    {"dock", "wall_gap_m", 0.0, 0.10, "m", "gap between the dock's back and its wall"},
+    {"events", "push", 0, 1, "", "a push in ALIGN (must end in fault 178/179)", "none", "push", 0.10},
+    {"events", "push_t_s", 0.5, 2.0, "s", "push time after ALIGN began"},
+    {"events", "push_side", 0, 1, "", "push to the dock's left or right", "left", "right", 0.5},
+    {"events", "push_lateral_m", 0.4, 0.6, "m", "push across the dock's axis"},
+    {"events", "push_yaw_deg", -10.0, 10.0, "deg", "push rotation"},
 };
 constexpr std::size_t kFactorCount = sizeof(kFactors) / sizeof(kFactors[0]);
 constexpr std::uint64_t kFamilySalt = 0x63657274696679ull;  // the family's own stream, apart from the run's noise
@@ -101,29 +113,80 @@ toml::table& table_at(toml::table& root, const std::string& dotted) {
 
 /// Trial `index`'s world: the base scenario with every factor drawn. `values` receives each factor's value (a
 /// discrete factor: 0 or 1; a factor its drive does not have: NaN). Deterministic in (base_seed, index).
-toml::table draw_world(const toml::table& base, std::uint64_t base_seed, std::size_t index,
+toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64_t base_seed, std::size_t index,
                        std::vector<double>* values) {
   toml::table w = base;
   docksim::Rng rng(docksim::trial_seed(base_seed ^ kFamilySalt, index));
   values->assign(kFactorCount, std::nan(""));
-  bool mecanum = false;
+  bool mecanum = false, wall = true, push = false;
+  double push_t_s = 0, push_lateral_m = 0, push_side = 1;
   for (std::size_t i = 0; i < kFactorCount; ++i) {
     const Factor& f = kFactors[i];
     const double u = rng.uniform();  // drawn for every factor, used or not: each keeps its own place in the stream
     const std::string key = f.key;
     if (f.first != nullptr) {
       const bool second = u < f.p_second;
+      if ((key == "wall_glass" && !wall) || (key == "push_side" && !push)) continue;
       (*values)[i] = second ? 1 : 0;
-      table_at(w, f.table).insert_or_assign(key, std::string(second ? f.second : f.first));
       if (key == "kinematics") mecanum = second;
+      if (key == "wall") {
+        wall = !second;
+        table_at(w, f.table).insert_or_assign(key, wall);
+      } else if (key == "wall_glass") {
+        table_at(w, f.table).insert_or_assign(key, second);
+      } else if (key == "push") {
+        push = second;
+      } else if (key == "push_side") {
+        push_side = second ? -1 : 1;
+      } else {
+        table_at(w, f.table).insert_or_assign(key, std::string(second ? f.second : f.first));
+      }
       continue;
     }
     if ((key == "wheel_base_m" && mecanum) || ((key == "lx_m" || key == "ly_m") && !mecanum)) continue;
+    if (key == "wall_gap_m" && !wall) continue;
+    if (key.rfind("push_", 0) == 0 && !push) continue;
     const double v = f.lo + (f.hi - f.lo) * u;
     (*values)[i] = v;
-    table_at(w, f.table).insert_or_assign(key, v);
+    if (key == "push_t_s") {
+      push_t_s = v;
+    } else if (key == "push_lateral_m") {
+      push_lateral_m = push_side * v;
+    } else if (key == "push_yaw_deg") {
+      // Across the dock's axis, in the world frame the event takes.
+      toml::table ev;
+      ev.insert_or_assign("type", "push");
+      ev.insert_or_assign("in_state", "ALIGN");
+      ev.insert_or_assign("t_s", push_t_s);
+      ev.insert_or_assign("dx_m", -std::sin(dock_yaw_rad) * push_lateral_m);
+      ev.insert_or_assign("dy_m", std::cos(dock_yaw_rad) * push_lateral_m);
+      ev.insert_or_assign("dyaw_deg", v);
+      if (!w.contains("events") || !w["events"].is_array()) w.insert_or_assign("events", toml::array{});
+      w["events"].as_array()->push_back(std::move(ev));
+    } else {
+      table_at(w, f.table).insert_or_assign(key, v);
+    }
   }
   return w;
+}
+
+/// True when trial t's world has the push: its run is right when it ends in fault 178 or 179 (the push seen), not
+/// when it docks.
+bool pushed(const std::vector<double>& values) {
+  for (std::size_t i = 0; i < kFactorCount; ++i) {
+    if (std::string(kFactors[i].key) == "push") return values[i] > 0.5;
+  }
+  return false;
+}
+
+/// Whether trial's run is the right outcome: charging confirmed, or for a pushed robot, fault 178/179.
+bool correct(const docksim::SimRun& r, bool was_pushed) {
+  if (!was_pushed) return r.outcome.charging_confirmed;
+  const auto& o = r.outcome;
+  if (o.final_state != dockcore::TaskState::kFault || o.faults.empty()) return false;
+  const int last = o.faults.rbegin()->first;
+  return last == static_cast<int>(dockcore::FaultCode::kDistanceDeviation) ||
+         last == static_cast<int>(dockcore::FaultCode::kAngleDeviation);
 }
 
 std::string toml_text(const toml::table& t) {
@@ -188,7 +251,7 @@ void draw_envelope(const std::string& path, const std::string& title, const std:
       c.circle(Vec2(x, y + jitter), ok[t] ? 0.008 : 0.014, docksim::SvgStyle::filled(ok[t] ? "#1f77b4" : "#d62728"));
     }
   }
-  c.legend("charging confirmed", docksim::SvgStyle::filled("#1f77b4"), docksim::SvgLegendMark::kDot);
+  c.legend("right outcome", docksim::SvgStyle::filled("#1f77b4"), docksim::SvgLegendMark::kDot);
   c.legend("failed", docksim::SvgStyle::filled("#d62728"), docksim::SvgLegendMark::kDot);
   std::string error;
   if (!c.write(path, &error)) std::cerr << "dock-sim certify: " << error << "\n";
@@ -224,14 +287,15 @@ int run_certify(const CertifyOptions& o) {
   const std::uint64_t seed = o.seed_set ? o.seed : base_sc.seed;
   const std::size_t n = static_cast<std::size_t>(o.trials);
   auto load = [&](std::size_t t, std::vector<double>* values) {
-    const toml::table w = draw_world(base, seed, t, values);
+    const toml::table w = draw_world(base, static_cast<double>(base_sc.dock_pose.yaw_rad), seed, t, values);
     return docksim::parse_scenario_toml(toml_text(w), o.scenario + " (trial " + std::to_string(t) + ")");
   };
 
   if (o.trial >= 0) {  // one trial: its world, written for `dock-sim run`
     std::vector<double> values;
     const std::size_t t = static_cast<std::size_t>(o.trial);
-    const std::string text = toml_text(draw_world(base, seed, t, &values));
+    const std::string text =
+        toml_text(draw_world(base, static_cast<double>(base_sc.dock_pose.yaw_rad), seed, t, &values));
     if (!o.write.empty()) {
       std::ofstream out(o.write, std::ios::binary);
       out << "# dock-sim certify " << o.scenario << " --seed " << seed << ", trial " << t
@@ -270,9 +334,17 @@ int run_certify(const CertifyOptions& o) {
   }
   const Summary s = summarise(ctl, runs);
   std::vector<bool> ok(n);
-  for (std::size_t t = 0; t < n; ++t) ok[t] = runs[t].outcome.charging_confirmed;
-  const double rate = static_cast<double>(s.successes) / static_cast<double>(n);
-  const double lower = clopper_pearson_lower(o.trials, s.successes, 0.05);
+  int successes = 0, pushes = 0, pushes_seen = 0, docked_unpushed = 0;
+  for (std::size_t t = 0; t < n; ++t) {
+    const bool p = pushed(values[t]);
+    ok[t] = correct(runs[t], p);
+    successes += ok[t] ? 1 : 0;
+    pushes += p ? 1 : 0;
+    pushes_seen += p && ok[t] ? 1 : 0;
+    docked_unpushed += !p && ok[t] ? 1 : 0;
+  }
+  const double rate = static_cast<double>(successes) / static_cast<double>(n);
+  const double lower = clopper_pearson_lower(o.trials, successes, 0.05);
 
   // Success by quartile of each continuous factor (discrete: by choice).
   struct Bin {
@@ -291,6 +363,10 @@ int run_certify(const CertifyOptions& o) {
       bins[i][q].ok += ok[t] ? 1 : 0;
     }
   }
+  auto cause = [&](std::size_t t) {
+    if (pushed(values[t]) && runs[t].outcome.charging_confirmed) return std::string("docked, push not seen");
+    return cause_of(runs[t]);
+  };
   auto replay = [&](std::size_t t) {
     return "dock-sim certify " + o.scenario + " --seed " + std::to_string(seed) + " --trial " + std::to_string(t) +
            " --write trial.toml && dock-sim run trial.toml --seed " + std::to_string(docksim::trial_seed(seed, t)) +
@@ -303,7 +379,10 @@ int run_certify(const CertifyOptions& o) {
     j["controller"] = ctl;
     j["seed"] = seed;
     j["trials"] = o.trials;
-    j["successes"] = s.successes;
+    j["successes"] = successes;
+    j["charging_confirmed"] = docked_unpushed;
+    j["pushes"] = pushes;
+    j["pushes_seen"] = pushes_seen;
     j["success_rate"] = rate;
     j["lower_bound_95"] = lower;
     auto stats = [](const std::vector<double>& v) {
@@ -322,7 +401,7 @@ int run_certify(const CertifyOptions& o) {
     nlohmann::ordered_json fails = nlohmann::ordered_json::array();
     for (std::size_t t = 0; t < n; ++t) {
       if (ok[t]) continue;
-      fails.push_back({{"trial", t}, {"cause", cause_of(runs[t])}, {"replay", replay(t)}});
+      fails.push_back({{"trial", t}, {"cause", cause(t)}, {"replay", replay(t)}});
     }
     j["failures"] = fails;
     nlohmann::ordered_json fac = nlohmann::ordered_json::array();
@@ -336,7 +415,10 @@ int run_certify(const CertifyOptions& o) {
   } else {
     std::printf("certify %s, controller %s: %d trials, each its own robot drawn from the family (base seed %llu)\n",
                 base_sc.name.c_str(), ctl.c_str(), o.trials, static_cast<unsigned long long>(seed));
-    std::printf("charging confirmed  %d / %d = %.1f %%\n", s.successes, o.trials, 100 * rate);
+    std::printf("right outcome       %d / %d = %.1f %% (charging confirmed, or fault 178/179 after a push)\n",
+                successes, o.trials, 100 * rate);
+    std::printf("charging confirmed  %d of the %d robots not pushed\n", docked_unpushed, o.trials - pushes);
+    std::printf("pushed in ALIGN     %d, seen (fault 178/179) %d\n", pushes, pushes_seen);
     std::printf("demonstrated        success rate >= %.2f %% at 95 %% confidence (one-sided Clopper-Pearson)\n",
                 100 * lower);
     auto triple = [](const std::vector<double>& v, const char* f) {
@@ -353,7 +435,7 @@ int run_certify(const CertifyOptions& o) {
     int shown = 0;
     for (std::size_t t = 0; t < n; ++t) {
       if (ok[t]) continue;
-      std::printf("  trial %-5zu %-24s %s\n", t, cause_of(runs[t]).c_str(), replay(t).c_str());
+      std::printf("  trial %-5zu %-24s %s\n", t, cause(t).c_str(), replay(t).c_str());
       ++shown;
     }
     if (shown == 0) std::printf("  none\n");
@@ -375,7 +457,7 @@ int run_certify(const CertifyOptions& o) {
   }
   if (!o.svg.empty()) {
     draw_envelope(
-        o.svg, base_sc.name + " / " + ctl + " / " + std::to_string(n) + " robots: " + fmt("%.1f %% docked", 100 * rate),
+        o.svg, base_sc.name + " / " + ctl + " / " + std::to_string(n) + " robots: " + fmt("%.1f %% right", 100 * rate),
         values, ok);
   }
   return 0;

@@ -182,7 +182,8 @@ class SoakWorld {
       next_scan_t_ += 1.0 / sc_.lidar.rate_hz;
       if (count_ < ring_.size()) {
         Pending& p = *ring_[(head_ + count_) % ring_.size()];
-        docksim::simulate_scan(world_, cs.true_pose.compose(sc_.lidar_mount), sc_.lidar, lidar_rng_, &p.scan, now_us);
+        docksim::simulate_scan(world_, cs.true_pose.compose(sc_.true_lidar_mount()), sc_.lidar, lidar_rng_, &p.scan,
+                               now_us);
         p.stamp_us = now_us;
         ++count_;
       } else {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <memory>
 
 #include "dockcore/control/controllers.hpp"
@@ -379,6 +380,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   double occluded_until = -1, dropout_until = -1, silent_until = -1, host_stalled_until = -1;
   bool silent = false, host_stalled = false;
   std::size_t next_event = 0;
+  std::vector<bool> state_event_fired(sc.events.size(), false);
+  double state_entered_s[static_cast<std::size_t>(dockcore::TaskState::kTestMode) + 1];
+  std::fill(std::begin(state_entered_s), std::end(state_entered_s), -1.0);
 
   // Lidar pipeline.
   const double scan_period = 1.0 / sc.lidar.rate_hz;
@@ -427,9 +431,8 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     const std::uint64_t now_us = static_cast<std::uint64_t>(std::llround(t * 1e6));
     if (end_at >= 0 && t >= end_at) break;
 
-    // 1. Events.
-    while (next_event < sc.events.size() && sc.events[next_event].t_s <= t + 1e-9) {
-      const ScenarioEvent& ev = sc.events[next_event++];
+    // 1. Events: on the run's clock, or (in_state) on the clock of the first tick in their state.
+    auto fire = [&](const ScenarioEvent& ev) {
       char buf[160];
       switch (ev.kind) {
         case EventKind::kPush:
@@ -468,6 +471,18 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
           break;
       }
       add(t, TimelineKind::kEvent, static_cast<int>(ev.kind), buf);
+    };
+    while (next_event < sc.events.size() && sc.events[next_event].t_s <= t + 1e-9) {
+      const ScenarioEvent& ev = sc.events[next_event++];
+      if (!ev.after_state) fire(ev);
+    }
+    for (std::size_t i = 0; i < sc.events.size(); ++i) {
+      const ScenarioEvent& ev = sc.events[i];
+      const double entered = state_entered_s[static_cast<std::size_t>(ev.state)];
+      if (ev.after_state && !state_event_fired[i] && entered >= 0 && entered + ev.t_s <= t + 1e-9) {
+        state_event_fired[i] = true;
+        fire(ev);
+      }
     }
     if (silent && t >= silent_until) {
       chassis.set_frozen(false);
@@ -496,7 +511,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       next_scan_t += scan_period;
       if (t >= dropout_until) {
         auto ps = std::make_unique<PendingScan>();
-        ps->lidar_world = cs.true_pose.compose(sc.lidar_mount);
+        ps->lidar_world = cs.true_pose.compose(sc.true_lidar_mount());
         World w = occluded ? world_no_dock : world_with_dock;
         for (const auto& o : active_obs) w.add_circle(o.c, o.r);
         simulate_scan(w, ps->lidar_world, sc.lidar, lidar_rng, &ps->scan, now_us);
@@ -566,6 +581,8 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       const dockcore::TaskStatus& s = o.status;
       if (s.state != prev_state) {
         add(t, TimelineKind::kState, static_cast<int>(s.state), dockcore::to_string(s.state));
+        double& entered = state_entered_s[static_cast<std::size_t>(s.state)];
+        if (entered < 0) entered = t;
         if (s.state == dockcore::TaskState::kFinishTasking && !out.charging_confirmed) {
           out.charging_confirmed = true;
           out.time_to_charging_s = t - dock_cmd_t;

@@ -66,6 +66,10 @@ struct ScenarioEvent {
   double duration_s = 0;                    ///< occlude_dock, obstacle, lidar_dropout, chassis_silent, host_stall.
   double x_m = 0, y_m = 0, r_m = 0.1;       ///< obstacle: centre (world) and radius.
   bool hold_last_command = false;           ///< chassis_silent: motors keep the last command (else they stop).
+  /// in_state: t_s counts from the first control tick on which the task is in this state (the event never fires
+  /// when the run never gets there); absent: from the start of the run. dock-sim run/montecarlo/certify only.
+  bool after_state = false;
+  dockcore::TaskState state = dockcore::TaskState::kNotTasking;
 };
 
 /// Simulated camera that sees one target point on the dock (seed 003's vision process).
@@ -182,7 +186,10 @@ struct Scenario {
   OdometrySource odometry_source = OdometrySource::kChassis;
   dockcore::DriveLimits limits{};      ///< Kinematics saturation and acceleration limits.
   dockcore::FootprintParams safety{};  ///< Obstacle check (derived from the footprint plus check areas).
-  Pose2 lidar_mount{};                 ///< Lidar in the robot frame.
+  Pose2 lidar_mount{};                 ///< Lidar in the robot frame, as configured (what dockcore is told).
+  /// [robot.lidar] error_*: where the lidar really sits relative to lidar_mount (a calibration error dockcore is not
+  /// told). The simulator casts rays from true_lidar_mount().
+  Pose2 lidar_mount_error{};
   CameraSpec camera{};
   DockTagSpec dock_tag{};
   dockcore::TagFusionParams tag_fusion{};  ///< [camera.fusion]: the tag covariance model (the parameter table).
@@ -226,6 +233,9 @@ struct Scenario {
   dockcore::Seed004Params seed004{};
   dockcore::Seed003Params seed003{};
   dockcore::SmoothParams smooth{};
+
+  /// Where the lidar really sits in the robot frame: lidar_mount ∘ lidar_mount_error. O(1).
+  Pose2 true_lidar_mount() const { return lidar_mount.compose(lidar_mount_error); }
 };
 
 /// Controller names in table order: seed000, seed004, seed003, smooth.
