@@ -423,9 +423,11 @@ ControlOutput SmoothController::step(const ControlInput& in) {
   const ControlStatus guard = common_guard(in, phase_ == SmoothPhase::kDocked, stall_s_, c, true);
   if (guard == ControlStatus::kArrived) phase_ = SmoothPhase::kDocked;
   if (guard != ControlStatus::kRunning) return stopped(guard, static_cast<std::uint8_t>(phase_));
+  // The dock as aimed at: beside its axis while the task manager searches for the contacts sideways.
+  Pose2 aside{};
+  aside.y_m = in.aim_lateral_m;
+  const Pose2 aim = in.aim_lateral_m == kZero ? in.dock_in_robot : in.dock_in_robot.compose(aside);
   // The law runs on the docking frame: the real body frame, or for rear pads the body frame turned by π.
-  const Pose2 aim = in.aim_lateral_m == Real(0) ? in.dock_in_robot
-                                                : in.dock_in_robot.compose(Pose2{Real(0), in.aim_lateral_m, Real(0)});
   Pose2 robot = aim.inverse();
   if (p_.backwards) robot.yaw_rad = wrap_angle(robot.yaw_rad + kPi);
   const Vec2 pad = robot.transform(Vec2(c.pad_reach_m, 0));

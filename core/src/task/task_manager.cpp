@@ -313,10 +313,11 @@ bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in)
 Real TaskManager::retry_lateral_offset_m() const {
   // The first miss is retried on the axis (a transient cause: a stall, a bump, a late estimate); misses 2, 3, 4, 5 ...
   // aim at +1, -1, +2, -2 ... steps beside it.
-  if (lateral_misses_ < 2) return Real(0);
+  if (lateral_misses_ < 2) return static_cast<Real>(0);
   const int j = lateral_misses_ - 1;
-  const Real steps = static_cast<Real>((j + 1) / 2);
-  return (j % 2 == 1 ? Real(1) : Real(-1)) * steps * params_.retry_lateral_step_m;
+  const int steps = (j + 1) / 2;  // 1, 1, 2, 2, ...
+  const Real offset_m = static_cast<Real>(steps) * params_.retry_lateral_step_m;
+  return j % 2 == 1 ? offset_m : -offset_m;
 }
 
 void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
