@@ -76,9 +76,11 @@ const Factor kFactors[] = {
     {"dock", "wall_gap_m", 0.0, 0.10, "m", "gap between the dock's back and its wall"},
     {"events", "push", 0, 1, "", "a push in ALIGN (must end in fault 178/179)", "none", "push", 0.10},
     {"events", "push_t_s", 0.5, 2.0, "s", "push time after ALIGN began"},
-    {"events", "push_side", 0, 1, "", "push to the dock's left or right", "left", "right", 0.5},
-    {"events", "push_lateral_m", 0.4, 0.6, "m", "push across the dock's axis"},
-    {"events", "push_yaw_deg", -10.0, 10.0, "deg", "push rotation"},
+    {"events", "push_side", 0, 1, "", "push to the dock's left or right (a turn: left is counter-clockwise)", "left",
+     "right", 0.5},
+    {"events", "push_kind", 0, 1, "", "a shove across the dock's axis or a turn on the spot", "shove", "turn", 0.5},
+    {"events", "push_lateral_m", 0.4, 0.6, "m", "shove across the dock's axis"},
+    {"events", "push_turn_deg", 35.0, 60.0, "deg", "turn on the spot"},
 };
 constexpr std::size_t kFactorCount = sizeof(kFactors) / sizeof(kFactors[0]);
 constexpr std::uint64_t kFamilySalt = 0x63657274696679ull;  // the family's own stream, apart from the run's noise
@@ -119,14 +121,15 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
   docksim::Rng rng(docksim::trial_seed(base_seed ^ kFamilySalt, index));
   values->assign(kFactorCount, std::nan(""));
   bool mecanum = false, wall = true, push = false;
-  double push_t_s = 0, push_lateral_m = 0, push_side = 1;
+  double push_t_s = 0, push_side = 1;
+  bool push_turn = false;
   for (std::size_t i = 0; i < kFactorCount; ++i) {
     const Factor& f = kFactors[i];
     const double u = rng.uniform();  // drawn for every factor, used or not: each keeps its own place in the stream
     const std::string key = f.key;
     if (f.first != nullptr) {
       const bool second = u < f.p_second;
-      if ((key == "wall_glass" && !wall) || (key == "push_side" && !push)) continue;
+      if ((key == "wall_glass" && !wall) || ((key == "push_side" || key == "push_kind") && !push)) continue;
       (*values)[i] = second ? 1 : 0;
       if (key == "kinematics") mecanum = second;
       if (key == "wall") {
@@ -138,6 +141,8 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
         push = second;
       } else if (key == "push_side") {
         push_side = second ? -1 : 1;
+      } else if (key == "push_kind") {
+        push_turn = second;
       } else {
         table_at(w, f.table).insert_or_assign(key, std::string(second ? f.second : f.first));
       }
@@ -146,21 +151,23 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
     if ((key == "wheel_base_m" && mecanum) || ((key == "lx_m" || key == "ly_m") && !mecanum)) continue;
     if (key == "wall_gap_m" && !wall) continue;
     if (key.rfind("push_", 0) == 0 && !push) continue;
+    if ((key == "push_lateral_m" && push_turn) || (key == "push_turn_deg" && !push_turn)) continue;
     const double v = f.lo + (f.hi - f.lo) * u;
     (*values)[i] = v;
     if (key == "push_t_s") {
       push_t_s = v;
-    } else if (key == "push_lateral_m") {
-      push_lateral_m = push_side * v;
-    } else if (key == "push_yaw_deg") {
-      // Across the dock's axis, in the world frame the event takes.
+    } else if (key == "push_lateral_m" || key == "push_turn_deg") {
+      // Each beyond what the push test tolerates (0.3 m, 30°) however the robot stands: a shove without a turn moves
+      // the dock seen by the lidar by the shove, and a turn on the spot of 35° or more turns it by as much. A shove
+      // with a turn can move the dock seen less than either (the turn about the robot undoing part of the shove).
       toml::table ev;
       ev.insert_or_assign("type", "push");
       ev.insert_or_assign("in_state", "ALIGN");
       ev.insert_or_assign("t_s", push_t_s);
-      ev.insert_or_assign("dx_m", -std::sin(dock_yaw_rad) * push_lateral_m);
-      ev.insert_or_assign("dy_m", std::cos(dock_yaw_rad) * push_lateral_m);
-      ev.insert_or_assign("dyaw_deg", v);
+      const double lateral_m = push_turn ? 0.0 : push_side * v;  // across the dock's axis, world frame
+      ev.insert_or_assign("dx_m", -std::sin(dock_yaw_rad) * lateral_m);
+      ev.insert_or_assign("dy_m", std::cos(dock_yaw_rad) * lateral_m);
+      ev.insert_or_assign("dyaw_deg", push_turn ? push_side * v : 0.0);
       if (!w.contains("events") || !w["events"].is_array()) w.insert_or_assign("events", toml::array{});
       w["events"].as_array()->push_back(std::move(ev));
     } else {
