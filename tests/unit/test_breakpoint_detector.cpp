@@ -10,9 +10,12 @@
 #include "dockcore/perception/breakpoint_detector.hpp"
 #include "dockcore/perception/dock_profile.hpp"
 
+#include "breakpoint_scene.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
+using namespace breakpoint_scene;
 
 namespace {
 
@@ -21,57 +24,9 @@ const Real kInf = std::numeric_limits<Real>::infinity();
 // Tolerance for values that are exact up to rounding: looser when core is built with float.
 const double kTight = sizeof(Real) == 4 ? 2e-5 : 1e-9;
 
-Real cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-struct Scene {
-  Vec2 a[64];
-  Vec2 b[64];
-  std::size_t n = 0;
-  void add(const Vec2& p, const Vec2& q) {
-    a[n] = p;
-    b[n] = q;
-    ++n;
-  }
-  /// Nearest hit of origin + t (cos, sin)(angle), t > 0, or inf.
-  Real cast(const Vec2& o, Real angle) const {
-    const Vec2 d(std::cos(angle), std::sin(angle));
-    Real best = kInf;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec2 e = b[i] - a[i];
-      const Real den = cross2(d, e);
-      if (std::fabs(den) < 1e-12) continue;
-      const Vec2 ao = a[i] - o;
-      const Real t = cross2(ao, e) / den;
-      const Real u = cross2(ao, d) / den;
-      if (t > 1e-9 && u >= 0 && u <= 1 && t < best) best = t;
-    }
-    return best;
-  }
-};
-
-/// The "breakpoint" profile at dock_pose (dock frame -> lidar frame) with its back (dock x = -0.10) flush against a
-/// wall running wall_half_m either side of the dock's axis.
-void add_dock_against_wall(Scene& s, const Pose2& dock_pose, Real wall_half_m = 3.0) {
-  DockProfile p;
-  CHECK_EQUAL(static_cast<int>(ProfileError::kOk), static_cast<int>(builtin_profile("breakpoint", p)));
-  for (std::size_t i = 0; i + 1 < p.vertex_count; ++i)
-    s.add(dock_pose.transform(p.vertices_m[i]), dock_pose.transform(p.vertices_m[i + 1]));
-  s.add(dock_pose.transform(Vec2(-0.10, -wall_half_m)), dock_pose.transform(Vec2(-0.10, wall_half_m)));
-}
-
 /// Dock at distance d_m and bearing bearing_rad from the lidar, its face turned towards the lidar.
 Pose2 facing_dock(Real d_m, Real bearing_rad) {
   return Pose2{d_m * std::cos(bearing_rad), d_m * std::sin(bearing_rad), wrap_angle(bearing_rad + kPi)};
-}
-
-/// Raycasts `count` beams from the lidar frame's origin. Misses are inf, like a ROS driver.
-template <std::size_t N>
-void render(const Scene& s, LaserScanN<N>& scan, std::size_t count, Real angle_min_rad, Real inc_rad) {
-  CHECK_TRUE(scan.reset(count, angle_min_rad, inc_rad, 0));
-  for (std::size_t i = 0; i < count; ++i) {
-    const Real r = s.cast(Vec2(0, 0), scan.angle_min_rad + static_cast<Real>(i) * inc_rad);
-    scan.ranges_m[i] = r > 12.0 ? kInf : r;
-  }
 }
 
 /// Range along `angle` to the infinite line x = x_dock_m of the dock frame (the face is x = 0, the slots' bottom

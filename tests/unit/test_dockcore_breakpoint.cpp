@@ -3,7 +3,6 @@
 // taught target's moved frame, and the configurations Dockcore refuses (wrong profile, free-standing, no detector).
 #include <cmath>
 #include <cstddef>
-#include <limits>
 #include <string>
 
 #include "dockcore/control/controllers.hpp"
@@ -14,43 +13,17 @@
 #include "dockcore/perception/breakpoint_measurement.hpp"
 #include "dockcore/perception/dock_profile.hpp"
 
+#include "breakpoint_scene.hpp"
+
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
+using breakpoint_scene::add_dock_against_wall;
+using breakpoint_scene::Scene;
 
 namespace {
 
 const Real kDeg = kPi / 180;
-const Real kInf = std::numeric_limits<Real>::infinity();
-
-Real cross2(const Vec2& a, const Vec2& b) {
-  return a.x() * b.y() - a.y() * b.x();
-}
-
-/// Segments and the nearest hit of a ray from the origin.
-struct Scene {
-  Vec2 a[32];
-  Vec2 b[32];
-  std::size_t n = 0;
-  void add(const Vec2& p, const Vec2& q) {
-    a[n] = p;
-    b[n] = q;
-    ++n;
-  }
-  Real cast(Real angle) const {
-    const Vec2 d(std::cos(angle), std::sin(angle));
-    Real best = kInf;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec2 e = b[i] - a[i];
-      const Real den = cross2(d, e);
-      if (std::fabs(den) < static_cast<Real>(1e-12)) continue;
-      const Real t = cross2(a[i], e) / den;
-      const Real u = cross2(a[i], d) / den;
-      if (t > static_cast<Real>(1e-9) && u >= 0 && u <= 1 && t < best) best = t;
-    }
-    return best;
-  }
-};
 
 // An LD06-like 0.5° full turn, index 0 at -180°.
 constexpr std::size_t kBeams = 720;
@@ -63,15 +36,9 @@ BreakpointDetector g_bp;          // static: ~37 KiB of working buffers
 
 /// The breakpoint dock at `dock` (dock frame in the lidar's) with its back flush against a wall, raycast into g_scan.
 void render(const Pose2& dock) {
-  DockProfile p;
-  CHECK(builtin_profile("breakpoint", p) == ProfileError::kOk);
   Scene s;
-  for (std::size_t i = 0; i + 1 < p.vertex_count; ++i) {
-    s.add(dock.transform(p.vertices_m[i]), dock.transform(p.vertices_m[i + 1]));
-  }
-  s.add(dock.transform(Vec2(static_cast<Real>(-0.10), -3)), dock.transform(Vec2(static_cast<Real>(-0.10), 3)));
-  CHECK(g_scan.reset(kBeams, -kPi, kInc, 0));
-  for (std::size_t i = 0; i < kBeams; ++i) g_scan.ranges_m[i] = s.cast(-kPi + static_cast<Real>(i) * kInc);
+  add_dock_against_wall(s, dock);
+  breakpoint_scene::render(s, g_scan, kBeams, -kPi, kInc);
 }
 
 /// A dock `d_m` ahead at bearing `bearing_rad`, its face turned by `turn_rad` from facing the lidar.
