@@ -237,6 +237,18 @@ std::unique_ptr<Sim> docked_sim() {
   return s;
 }
 
+// A final fault raised after backing off: at the staging distance, the contacts open, no charge request, and the
+// robot stays where it stopped for watch_s with every tick's command zero.
+void check_backed_off_and_standing(Sim& s, double watch_s) {
+  REAL_EQUAL(s.params.staging_distance_m, s.centre_to_dock(), 0.004);
+  CHECK(!s.contact);
+  CHECK(!s.out.status.charge_enable);
+  const Pose2 p = s.world;
+  s.run_for(watch_s);
+  REAL_EQUAL(p.x_m, s.world.x_m, 0);
+  LONGS_EQUAL(0, s.zero_violations);
+}
+
 }  // namespace
 
 TEST_GROUP(TaskManager){};
@@ -632,13 +644,7 @@ TEST(TaskManager, ChargingExhaustionBacksOffThenFault182) {
   LONGS_EQUAL(182, static_cast<int>(s->out.status.fault));
   LONGS_EQUAL(s->params.max_retries + 1, s->wait_entries);
   LONGS_EQUAL(s->params.max_retries, s->out.status.retries);
-  REAL_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.004);  // a clean end: backed off
-  CHECK(!s->contact);
-  CHECK(!s->out.status.charge_enable);
-  const Pose2 p = s->world;
-  s->run_for(3.0);
-  REAL_EQUAL(p.x_m, s->world.x_m, 0);
-  LONGS_EQUAL(0, s->zero_violations);
+  check_backed_off_and_standing(*s, 3.0);
 }
 
 TEST(TaskManager, ControllerFailureRetriesThenFault188) {
@@ -730,13 +736,7 @@ TEST(TaskManager, HeldShortOfTheContactsThePushEndsOnTimeThenFault190) {
   CHECK(is_zero_twist(cmd));
   LONGS_EQUAL(190, static_cast<int>(s->out.status.fault));
   LONGS_EQUAL(1, s->out.status.retries);
-  CHECK(!s->contact);
-  CHECK(!s->out.status.charge_enable);
-  REAL_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.004);  // a clean end: backed off
-  const Pose2 p = s->world;
-  s->run_for(2.0);
-  REAL_EQUAL(p.x_m, s->world.x_m, 0);
-  LONGS_EQUAL(0, s->zero_violations);
+  check_backed_off_and_standing(*s, 2.0);
 }
 
 // Held short while the wheels spin (slip): odometry runs on, the robot does not. The push ends on its distance,
