@@ -186,14 +186,18 @@ bool pushed(const std::vector<double>& values) {
   return false;
 }
 
+/// The fault a run ended in (the highest code raised), or 0 when it did not end in FAULT.
+int final_fault(const docksim::SimRun& r) {
+  const auto& o = r.outcome;
+  return o.final_state == dockcore::TaskState::kFault && !o.faults.empty() ? o.faults.rbegin()->first : 0;
+}
+
 /// Whether trial's run is the right outcome: charging confirmed, or for a pushed robot, fault 178/179.
 bool correct(const docksim::SimRun& r, bool was_pushed) {
   if (!was_pushed) return r.outcome.charging_confirmed;
-  const auto& o = r.outcome;
-  if (o.final_state != dockcore::TaskState::kFault || o.faults.empty()) return false;
-  const int last = o.faults.rbegin()->first;
-  return last == static_cast<int>(dockcore::FaultCode::kDistanceDeviation) ||
-         last == static_cast<int>(dockcore::FaultCode::kAngleDeviation);
+  const int f = final_fault(r);
+  return f == static_cast<int>(dockcore::FaultCode::kDistanceDeviation) ||
+         f == static_cast<int>(dockcore::FaultCode::kAngleDeviation);
 }
 
 std::string toml_text(const toml::table& t) {
@@ -226,10 +230,8 @@ double clopper_pearson_lower(int n, int k, double alpha) {
 /// Why a run did not confirm charging: its fault's name, "timeout", or the state it ended in.
 std::string cause_of(const docksim::SimRun& r) {
   const auto& o = r.outcome;
-  if (o.final_state == dockcore::TaskState::kFault && !o.faults.empty()) {
-    const int last = o.faults.rbegin()->first;  // the highest code raised
-    return std::to_string(last) + " " + dockcore::to_string(static_cast<dockcore::FaultCode>(last));
-  }
+  if (const int f = final_fault(r))
+    return std::to_string(f) + " " + dockcore::to_string(static_cast<dockcore::FaultCode>(f));
   if (o.timed_out) return "timeout";
   return std::string("ended in ") + dockcore::to_string(o.final_state);
 }
