@@ -503,6 +503,7 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   c.seed003.common.pad_reach_m = c.smooth.common.pad_reach_m = reach;
   c.smooth.backwards = c.pads_rear;
   c.task.pads_rear = c.pads_rear;
+  c.task.charger_switched = dockcore::drivers::switches_charger(c.can.protocol);
   c.seed003.holonomic = c.drive.kind == dockcore::DriveKind::kMecanum;
   c.task.max_vx_mps = c.limits.max_vx_mps > 0 ? c.limits.max_vx_mps : c.task.max_vx_mps;
   c.task.max_vy_mps = c.limits.max_vy_mps > 0 ? c.limits.max_vy_mps : c.task.max_vy_mps;

@@ -353,6 +353,10 @@ std::optional<ChassisProtocol> parse_chassis_protocol(std::string_view name) {
   return std::nullopt;
 }
 
+bool switches_charger(ChassisProtocol p) {
+  return p == ChassisProtocol::kDockcoreV1;
+}
+
 const char* to_string(ChassisProtocol p) {
   return p == ChassisProtocol::kAgilexV2 ? "agilex-v2" : "dockcore-v1";
 }

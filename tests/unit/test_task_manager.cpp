@@ -95,7 +95,8 @@ struct Sim {
   bool prev_contact = false;
   std::uint64_t contact_since_us = 0;
   bool charge_enable = false;
-  bool current_stays_on = false;  // undock-failure script
+  bool current_stays_on = false;  // undock-failure script; with TaskParams::charger_switched false, a live charger
+  bool current_reads_on = false;  // the current sensor reads a current with the contacts open (a stuck sensor)
   bool chassis_ok = true, lidar_ok = true;
   double stop_short_m = 0;       // > 0: something the lidar does not see holds the front edge this far before the dock
   bool wheels_spin = false;      // held there, the wheels keep turning: odometry goes on as commanded
@@ -169,7 +170,7 @@ struct Sim {
     in.contact = contact;
     const bool current = contact && charge_enable && charger_works && contacts_made > charger_fails_first &&
                          now_us - contact_since_us >= 500000;
-    in.charge_current_a = (current || (current_stays_on && contact)) ? 2.0 : 0.0;
+    in.charge_current_a = (current || (current_stays_on && contact) || current_reads_on) ? 2.0 : 0.0;
     in.chassis_ok = chassis_ok;
     in.lidar_ok = lidar_ok;
     out = tm.tick(in);
@@ -887,6 +888,41 @@ TEST(TaskManager, UndockWaitsForAnObstacleBehind) {
   CHECK(s->out.status.state == TaskState::kUndocking);
   s->obstacles.clear();
   CHECK(s->run_until(TaskState::kNotTasking, 20));
+}
+
+// A dock whose charger is live whenever the contacts touch (no relay the host switches): undocking cannot wait for the
+// current to stop; the robot backs off at once and the contacts opening end it.
+std::unique_ptr<Sim> docked_on_live_charger() {
+  auto s = std::make_unique<Sim>();
+  s->params.charger_switched = false;
+  s->reconfigure();
+  s->current_stays_on = true;
+  s->command(HostCommandType::kDock);
+  s->run_until(TaskState::kFinishTasking, 30);
+  return s;
+}
+
+TEST(TaskManager, UndockFromALiveChargerBacksOffWithCurrentFlowing) {
+  auto s = docked_on_live_charger();
+  CHECK(s->out.status.state == TaskState::kFinishTasking);
+  s->command(HostCommandType::kUndock);
+  s->run_for(0.5);
+  CHECK(s->out.status.state == TaskState::kUndocking);
+  CHECK_FALSE(s->contact);  // moving off well within charge_off_timeout_s
+  CHECK(s->run_until(TaskState::kNotTasking, 20));
+  CHECK(s->out.status.last_result == TaskResult::kUndocked);
+  CHECK_FALSE(s->saw(TaskState::kFault));
+  REAL_EQUAL(s->params.staging_distance_m, s->centre_to_dock(), 0.004);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
+TEST(TaskManager, UndockFromALiveChargerFails186WhenCurrentStillFlowsBackedOff) {
+  auto s = docked_on_live_charger();
+  s->current_reads_on = true;
+  s->command(HostCommandType::kUndock);
+  CHECK(s->run_until(TaskState::kFault, 20));
+  LONGS_EQUAL(186, static_cast<int>(s->out.status.fault));
+  check_backed_off_and_standing(*s, 1.0);
 }
 
 TEST(TaskManager, UndockFailsWhenCurrentDoesNotStop186) {

@@ -79,7 +79,6 @@ struct Options {
   double silent_at_s = -1, silent_for_s = 0;
   bool no_charge = false;
   double break_contact_after_s = -1;  ///< Contacts break (robot nudged 3 cm back) this long after charging began.
-  bool charge_needs_request = true;
   LidarOutOptions lidar;
 };
 
@@ -220,7 +219,10 @@ int run(const Options& opt) {
   bool have_cmd = false;
   bool cmd_timed_out = true;
   bool agx_can_mode = false;
-  bool relay = !opt.charge_needs_request;
+  // The charger relay follows dockd's ChargeRequest (v1) when the scenario's dock is switched; AgileX has no relay
+  // frame and an unswitched dock is live: its charger delivers whenever the contacts close.
+  const bool relay_switched = !agilex && cp.contact.switched;
+  bool relay = !relay_switched;
   std::uint64_t last_charge_req_us = 0;
   double motion_t0 = -1;  // scenario clock origin
   std::size_t next_event = 0;
@@ -331,7 +333,6 @@ int run(const Options& opt) {
         } else {
           ++bad_frames;
         }
-        relay = true;  // AgileX bases have no charge relay command: the charger is always live
         continue;
       }
       v1::WheelCommandFrame wc;
@@ -352,7 +353,7 @@ int run(const Options& opt) {
         last_cmd_counter = wc.counter;
         if (motion_t0 < 0 && wc.enable && (wc.wheel_mmps[0] != 0 || wc.wheel_mmps[1] != 0)) motion_t0 = t;
       } else if (v1::decode(ids, f, cr) == v1::CanV1Error::kOk) {
-        relay = cr.enable;
+        if (relay_switched) relay = cr.enable;
         last_charge_req_us = now_us;
       } else {
         ++bad_frames;
@@ -365,7 +366,7 @@ int run(const Options& opt) {
     // The moment the base's own protection stops the motors (the SIGKILL row of the fault matrix measures it).
     if (cmd_timed_out && !was_timed_out) write_truth(truth, t, mt, chassis.state(), relay, silent, "command_timeout");
     // The relay opens when its request stops coming (500 ms), as documented for the base.
-    if (!agilex && opt.charge_needs_request && relay && now_us - last_charge_req_us > 500000u) relay = false;
+    if (relay_switched && relay && now_us - last_charge_req_us > 500000u) relay = false;
     if (!opt.no_charge) chassis.set_charging_inhibited(!relay);
 
     // 3. Physics.

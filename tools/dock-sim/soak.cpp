@@ -218,8 +218,9 @@ class SoakWorld {
       for (std::size_t i = 0; i < w.count && i < docksim::kMaxWheels; ++i) wr[i] = static_cast<double>(w.radps[i]);
       chassis_.command_wheels(wr);
       // The charger relay follows the task manager's charge request, as dockd's ChassisLink::request_charging does
-      // (run_docking leaves it on: it never undocks, the undock waits for the current to stop).
-      chassis_.set_charging_inhibited(!last_.status.charge_enable);
+      // (run_docking leaves it on: it never undocks, the undock waits for the current to stop). An unswitched dock
+      // ([dock.contacts] switched = false) has no relay: it delivers whenever the contacts close.
+      chassis_.set_charging_inhibited(sc_.chassis.contact.switched && !last_.status.charge_enable);
       ticked = true;
     }
 

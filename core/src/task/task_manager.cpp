@@ -427,7 +427,7 @@ void TaskManager::run_retry(const TaskInput& in) {
 
 void TaskManager::run_undocking(const TaskInput& in) {
   if (!undock_backing_) {
-    if (in.charge_current_a < params_.charge_current_threshold_a) {
+    if (!params_.charger_switched || in.charge_current_a < params_.charge_current_threshold_a) {
       undock_backing_ = true;
       backoff_since_us_ = in.now_us;
       start_backoff(in);
@@ -438,6 +438,10 @@ void TaskManager::run_undocking(const TaskInput& in) {
   }
   if (run_backoff(in)) {
     want_ = Twist2{};
+    if (in.charge_current_a >= params_.charge_current_threshold_a) {
+      raise(FaultCode::kUndockFailed, in);  // backed off, yet current flows: the robot is not where it thinks
+      return;
+    }
     last_result_ = TaskResult::kUndocked;
     enter(TaskState::kNotTasking, in);
     return;

@@ -393,7 +393,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
                                              {"min_press_m", p.num(&k.min_press_m, 0, 0.1)},
                                              {"press_limit_m", p.num(&k.press_limit_m, 0, 0.1)},
                                              {"charge_delay_s", p.num(&k.charge_delay_s, 0, 60)},
-                                             {"charge_current_a", p.num(&k.charge_current_a, 0, 1000)}};
+                                             {"charge_current_a", p.num(&k.charge_current_a, 0, 1000)},
+                                             {"switched", p.flag(&k.switched)}};
                            })},
     };
   };
@@ -670,6 +671,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   if (!p.given("controller.seed003.holonomic")) sc.seed003.holonomic = mecanum;
   if (!p.given("controller.smooth.backwards")) sc.smooth.backwards = rear;
   sc.task.pads_rear = rear;
+  sc.task.charger_switched = c.contact.switched;
   sc.seed003.camera = sc.camera.model;
   sc.task.max_vx_mps = sc.limits.max_vx_mps > 0 ? sc.limits.max_vx_mps : sc.task.max_vx_mps;
   sc.task.max_vy_mps = sc.limits.max_vy_mps > 0 ? sc.limits.max_vy_mps : sc.task.max_vy_mps;

@@ -132,6 +132,13 @@ struct TaskParams {
   bool pads_rear = false;
   Real backoff_timeout_s = static_cast<Real>(20.0);   ///< Back-off not done in this time: fault (186 undocking).
   Real charge_off_timeout_s = static_cast<Real>(2.0); ///< Undock: current must stop within this, else fault 186.
+  /// The host switches the charging current (a relay the chassis closes on request: dockcore CAN v1's
+  /// ChargeRequest). Undocking then waits for the current to stop before the robot moves. When false (bases with no
+  /// relay frame, e.g. AgileX: the dock's charger is live whenever the contacts touch) it cannot be stopped from the
+  /// robot: undocking backs off at once, the contacts opening ends the current, and fault 186 is raised when current
+  /// still flows after the back-off. Not a key of its own: dockd derives it from the chassis profile, the scenarios
+  /// from `[dock.contacts] switched`.
+  bool charger_switched = true;
   // Limits and timing.
   Real task_timeout_s = static_cast<Real>(180.0);     ///< Docking (GET_TASKING_CMD..WAIT_FOR_CHARGE) longer: fault 189.
   Real max_vx_mps = static_cast<Real>(0.5);           ///< Final clamp on |vx| (the controller's limits come first).

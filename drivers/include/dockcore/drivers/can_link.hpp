@@ -24,6 +24,9 @@ enum class ChassisProtocol : std::uint8_t {
 /// "dockcore-v1" | "agilex-v2" → protocol; nullopt otherwise.
 std::optional<ChassisProtocol> parse_chassis_protocol(std::string_view name);
 const char* to_string(ChassisProtocol p);
+/// Whether the chassis profile lets the host switch the charging current: dockcore v1 has the ChargeRequest relay
+/// frame; AgileX has none (the dock's charger is live whenever the contacts touch). TaskParams::charger_switched.
+bool switches_charger(ChassisProtocol p);
 
 /// SocketCAN raw socket bound to one interface: filters for the given ids, error frames counted, SO_RXQ_OVFL,
 /// receive timestamps, non-blocking writes (ENOBUFS counted), reopened when the interface goes down and up.

@@ -134,6 +134,9 @@ struct ContactParams {
   double press_limit_m = 0.008;        ///< Spring travel: hard stop this far past the contact plane.
   double charge_delay_s = 0.5;         ///< Charger switches on after the contacts stay closed this long.
   double charge_current_a = 5.0;       ///< Constant-current charge.
+  /// The charger delivers only while the robot requests it (a relay the host switches, dockcore CAN v1's
+  /// ChargeRequest); false: live whenever the contacts close (AgileX bases have no relay frame).
+  bool switched = true;
   double taper_start_soc = 0.95;       ///< Above this SOC the charge current falls linearly to 0 at SOC 1.
 };
 
