@@ -2,7 +2,8 @@
 """HIL log analysis (standard library only): reads dock-decode --json output and chassis-sim's truth log.
 
   analyze.py states DECODE.json             -> the DockStatus state sequence, deduplicated, e.g. "0 1 2 3 5 4"
-  analyze.py last-wheels DECODE.json        -> "0 0" when the last WheelCmdA commands zero (enable or not)
+  analyze.py last-wheels DECODE.json        -> "0 0" when the last wheel command commands zero: WheelCmdA (enable or
+                                               not), or AgileX's MotionCommand (linear, angular)
   analyze.py nonzero-wheels DECODE.json T0 T1 -> count of non-zero WheelCmdA frames with T0 <= t < T1 (log time)
   analyze.py first-zero-after DECODE.json T -> log time of the first zero WheelCmdA at or after T
   analyze.py final-error TRUTH.jsonl        -> "contact lateral_mm yaw_deg" at the last truth line with contact
@@ -39,11 +40,15 @@ def main(argv):
         print(" ".join(map(str, seq)))
     elif cmd == "last-wheels":
         w = frames(argv[2], "WheelCmdA")
+        keys = ("wheel0", "wheel1")
+        if not w:
+            w = frames(argv[2], "MotionCommand")
+            keys = ("linear", "angular")
         if not w:
             print("none")
             return 1
         s = w[-1]["signals"]
-        print(f'{s["wheel0"]:g} {s["wheel1"]:g}')
+        print(f'{s[keys[0]]:g} {s[keys[1]]:g}')
     elif cmd == "nonzero-wheels":
         t0, t1 = float(argv[3]), float(argv[4])
         n = 0
