@@ -498,16 +498,12 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
                         ? static_cast<double>(c.footprint.radius_m)
                         : static_cast<double>(c.footprint.half_length_m);
   }
-  const Real reach = static_cast<Real>(c.pad_reach_m);
-  c.seed000.common.pad_reach_m = c.seed004.common.pad_reach_m = reach;
-  c.seed003.common.pad_reach_m = c.smooth.common.pad_reach_m = reach;
-  c.smooth.backwards = c.pads_rear;
-  c.task.pads_rear = c.pads_rear;
-  c.task.charger_switched = dockcore::drivers::switches_charger(c.can.protocol);
-  c.seed003.holonomic = c.drive.kind == dockcore::DriveKind::kMecanum;
-  c.task.max_vx_mps = c.limits.max_vx_mps > 0 ? c.limits.max_vx_mps : c.task.max_vx_mps;
-  c.task.max_vy_mps = c.limits.max_vy_mps > 0 ? c.limits.max_vy_mps : c.task.max_vy_mps;
-  c.task.max_wz_radps = c.limits.max_wz_radps > 0 ? c.limits.max_wz_radps : c.task.max_wz_radps;
+  params::RobotFacts facts;
+  facts.pads_rear = c.pads_rear;
+  facts.mecanum = c.drive.kind == dockcore::DriveKind::kMecanum;
+  facts.charger_switched = dockcore::drivers::switches_charger(c.can.protocol);
+  facts.pad_reach_m = c.pad_reach_m;
+  params::derive_from_robot(facts, targets);
   if (!c.host_enabled && c.host.allowlist.size() > 0) p.fail(p.where("host.allowlist", root.source()), "host.allowlist given but host.enabled = false");
   if (c.camera_enabled && c.host_enabled && c.camera.port == c.host.port && c.camera.bind_address == c.host.bind_address) {
     p.fail(p.where("camera.port", root.source()), "camera.port must differ from host.port");

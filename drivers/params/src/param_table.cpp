@@ -647,4 +647,20 @@ std::string update_param_blocks(const std::string& text, std::string& error) {
   return out;
 }
 
+void derive_from_robot(const RobotFacts& r, const ParamTargets& t) {
+  if (r.pad_reach_m >= 0) {
+    const Real reach = static_cast<Real>(r.pad_reach_m);
+    t.seed000->common.pad_reach_m = t.seed004->common.pad_reach_m = reach;
+    t.seed003->common.pad_reach_m = t.smooth->common.pad_reach_m = reach;
+  }
+  if (!r.holonomic_given) t.seed003->holonomic = r.mecanum;
+  if (!r.backwards_given) t.smooth->backwards = r.pads_rear;
+  t.task->pads_rear = r.pads_rear;
+  t.task->charger_switched = r.charger_switched;
+  const DriveLimits& l = *t.limits;
+  if (l.max_vx_mps > 0) t.task->max_vx_mps = l.max_vx_mps;
+  if (l.max_vy_mps > 0) t.task->max_vy_mps = l.max_vy_mps;
+  if (l.max_wz_radps > 0) t.task->max_wz_radps = l.max_wz_radps;
+}
+
 }  // namespace dockcore::params

@@ -659,23 +659,17 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         static_cast<Real>(std::hypot(static_cast<double>(f.half_length_m), c.footprint.width_m / 2));
   }
 
-  const bool mecanum = c.geometry.kind == DriveKind::kMecanum;
-  const bool rear = c.footprint.pad_side == PadSide::kRear;
+  params::RobotFacts robot;
+  robot.pads_rear = c.footprint.pad_side == PadSide::kRear;
+  robot.mecanum = c.geometry.kind == DriveKind::kMecanum;
+  robot.charger_switched = c.contact.switched;
   bool pad_reach_set = p.given("controller.pad_reach_m");
   for (const std::string& name : controller_names()) pad_reach_set |= p.given("controller." + name + ".pad_reach_m");
-  if (!pad_reach_set) {
-    const Real reach = static_cast<Real>(pad_reach_of(c));
-    sc.seed000.common.pad_reach_m = sc.seed004.common.pad_reach_m = reach;
-    sc.seed003.common.pad_reach_m = sc.smooth.common.pad_reach_m = reach;
-  }
-  if (!p.given("controller.seed003.holonomic")) sc.seed003.holonomic = mecanum;
-  if (!p.given("controller.smooth.backwards")) sc.smooth.backwards = rear;
-  sc.task.pads_rear = rear;
-  sc.task.charger_switched = c.contact.switched;
+  if (!pad_reach_set) robot.pad_reach_m = pad_reach_of(c);
+  robot.holonomic_given = p.given("controller.seed003.holonomic");
+  robot.backwards_given = p.given("controller.smooth.backwards");
+  params::derive_from_robot(robot, targets);
   sc.seed003.camera = sc.camera.model;
-  sc.task.max_vx_mps = sc.limits.max_vx_mps > 0 ? sc.limits.max_vx_mps : sc.task.max_vx_mps;
-  sc.task.max_vy_mps = sc.limits.max_vy_mps > 0 ? sc.limits.max_vy_mps : sc.task.max_vy_mps;
-  sc.task.max_wz_radps = sc.limits.max_wz_radps > 0 ? sc.limits.max_wz_radps : sc.task.max_wz_radps;
 
   std::stable_sort(sc.events.begin(), sc.events.end(),
                    [](const ScenarioEvent& a, const ScenarioEvent& b) { return a.t_s < b.t_s; });

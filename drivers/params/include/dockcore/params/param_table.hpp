@@ -108,4 +108,21 @@ std::string markdown_table(const std::string& table, ParamUse use);
 /// returns the text unchanged) for a malformed marker or an unknown table. O(text size + table size).
 std::string update_param_blocks(const std::string& text, std::string& error);
 
+/// What the robot's description decides for the parameters, rather than keys of their own. dockd's config reads it
+/// from [robot] and [can], a scenario from its chassis and dock; both hand it to derive_from_robot.
+struct RobotFacts {
+  bool pads_rear = false;        ///< The charging pads are on the robot's rear: it docks backwards.
+  bool mecanum = false;          ///< The base moves sideways (a mecanum drive).
+  bool charger_switched = true;  ///< The robot switches the dock's charging current (TaskParams::charger_switched).
+  double pad_reach_m = -1;       ///< Rotation centre to the pads, m; < 0: each controller keeps its own.
+  bool holonomic_given = false;  ///< Seed003Params::holonomic was set by a key: kept.
+  bool backwards_given = false;  ///< SmoothParams::backwards was set by a key: kept.
+};
+
+/// Writes the facts into the structs of `t` that take them: every controller's pad reach, smooth's `backwards` and
+/// seed 003's `holonomic` (unless given), the task manager's pad side and charger, and caps the task manager's
+/// final clamps at the drive limits that are set (> 0). Every pointer of `t` it writes must be non-null: task,
+/// limits, seed000, seed004, seed003, smooth. O(1).
+void derive_from_robot(const RobotFacts& r, const ParamTargets& t);
+
 }  // namespace dockcore::params
