@@ -462,6 +462,8 @@ void Daemon::on_tick(std::uint64_t now_us) {
           .str("phase", prev_status_.state == TaskState::kAlign ? controller_->phase_name(prev_status_.phase)
                                                                 : dockcore::to_string(prev_status_.state));
     }
+    // Where each attempt aims beside the dock's axis: the remembered aim plus the retries' search.
+    if (s.state == TaskState::kAlign) e.w.real("aim_lateral_m", static_cast<double>(s.aim_lateral_m), 4);
     log_event(e);
   }
   if (s.state == TaskState::kAlign &&

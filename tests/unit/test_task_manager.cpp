@@ -33,6 +33,7 @@ class FakeController : public DockingController {
   void reset() override { ++resets; }
   ControlOutput step(const ControlInput& in) override {
     ++steps;
+    last_aim_m = in.aim_lateral_m;
     ControlOutput o;
     if (in.contact) {
       o.status = ControlStatus::kArrived;
@@ -59,6 +60,7 @@ class FakeController : public DockingController {
     return o;
   }
   bool fail = false;
+  double last_aim_m = 0;        // ControlInput::aim_lateral_m of the last step
   double arrive_at_gap_m = -1;  // >= 0: also kArrived when the estimate puts the front edge this close to the dock
   int resets = 0;
   int steps = 0;
@@ -738,6 +740,77 @@ TEST(TaskManager, HeldShortOfTheContactsThePushEndsOnTimeThenFault190) {
   LONGS_EQUAL(190, static_cast<int>(s->out.status.fault));
   LONGS_EQUAL(1, s->out.status.retries);
   check_backed_off_and_standing(*s, 2.0);
+}
+
+// The aim that closed the contacts is the next docking's first aim (remember_aim); a docking that misses the contacts
+// to its last attempt forgets it.
+TEST(TaskManager, TheAimThatClosedTheContactsIsTheNextDockingsFirstAim) {
+  auto s = std::make_unique<Sim>();
+  s->stop_short_m = 0.02;  // attempts miss until it is lifted
+  s->params.max_push_s = 2.0;
+  s->reconfigure();
+  const double step_m = static_cast<double>(s->params.retry_lateral_step_m);
+  s->command(HostCommandType::kDock, 3);
+  CHECK(s->run_until(TaskState::kAlign, 10));
+  REAL_EQUAL(0.0, s->ctrl.last_aim_m, 0);
+  for (int miss = 0; miss < 2; ++miss) {
+    CHECK(s->run_until(TaskState::kRetry, 30));
+    CHECK(s->run_until(TaskState::kAlign, 30));
+  }
+  s->stop_short_m = 0;  // the third attempt, aimed one step to the side, closes the contacts
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  REAL_EQUAL(step_m, s->ctrl.last_aim_m, 1e-9);
+  REAL_EQUAL(step_m, static_cast<double>(s->out.status.aim_lateral_m), 1e-9);
+  s->command(HostCommandType::kUndock);
+  CHECK(s->run_until(TaskState::kNotTasking, 20));
+
+  s->command(HostCommandType::kDock, 3);
+  CHECK(s->run_until(TaskState::kAlign, 10));
+  s->step();
+  REAL_EQUAL(step_m, s->ctrl.last_aim_m, 1e-9);  // the first attempt starts where the last one closed them
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  LONGS_EQUAL(0, s->out.status.retries);
+  s->command(HostCommandType::kUndock);
+  CHECK(s->run_until(TaskState::kNotTasking, 20));
+
+  s->command(HostCommandType::kDock, 4);  // another dock has no remembered aim
+  CHECK(s->run_until(TaskState::kAlign, 10));
+  s->step();
+  REAL_EQUAL(0.0, s->ctrl.last_aim_m, 0);
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  s->command(HostCommandType::kUndock);
+  CHECK(s->run_until(TaskState::kNotTasking, 20));
+
+  s->stop_short_m = 0.02;  // dock 3 now misses to the end: fault 190, and its aim is forgotten
+  s->command(HostCommandType::kDock, 3);
+  CHECK(s->run_until(TaskState::kFault, 200));
+  LONGS_EQUAL(190, static_cast<int>(s->out.status.fault));
+  s->stop_short_m = 0;
+  s->command(HostCommandType::kDock, 3);
+  CHECK(s->run_until(TaskState::kAlign, 10));
+  s->step();
+  REAL_EQUAL(0.0, s->ctrl.last_aim_m, 0);
+}
+
+TEST(TaskManager, WithoutRememberAimEveryDockingStartsOnTheAxis) {
+  auto s = std::make_unique<Sim>();
+  s->stop_short_m = 0.02;
+  s->params.max_push_s = 2.0;
+  s->params.remember_aim = false;
+  s->reconfigure();
+  s->command(HostCommandType::kDock);
+  for (int miss = 0; miss < 2; ++miss) {
+    CHECK(s->run_until(TaskState::kRetry, 40));
+    CHECK(s->run_until(TaskState::kAlign, 30));
+  }
+  s->stop_short_m = 0;
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  s->command(HostCommandType::kUndock);
+  CHECK(s->run_until(TaskState::kNotTasking, 20));
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 10));
+  s->step();
+  REAL_EQUAL(0.0, s->ctrl.last_aim_m, 0);
 }
 
 // Held short while the wheels spin (slip): odometry runs on, the robot does not. The push ends on its distance,

@@ -64,6 +64,7 @@ void TaskManager::configure(const TaskParams& params, const FootprintParams& foo
   last_command_ = CommandResult::kNone;
   retries_ = 0;
   lateral_misses_ = 0;
+  for (Real& a : remembered_aim_m_) a = 0;
   phase_ = 0;
   have_prev_tick_ = false;
 }
@@ -107,6 +108,7 @@ bool TaskManager::push_exhausted(const TaskInput& in) {
 }
 
 void TaskManager::enter(TaskState s, const TaskInput& in) {
+  if (s == TaskState::kWaitForCharge) waiting_after_align_ = state_ == TaskState::kAlign;
   state_ = s;
   state_since_us_ = in.now_us;
   blocked_ = false;
@@ -320,6 +322,11 @@ Real TaskManager::retry_lateral_offset_m() const {
   return j % 2 == 1 ? offset_m : -offset_m;
 }
 
+Real TaskManager::attempt_aim_m() const {
+  const Real base_m = dock_id_ < kAimMemory ? remembered_aim_m_[dock_id_] : static_cast<Real>(0);
+  return base_m + retry_lateral_offset_m();
+}
+
 void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
   // Every detection since the last tick, in order: a push followed by a stall shows only in the first scans of the
   // backlog (the later ones may already have restarted the filter at the pushed pose).
@@ -332,7 +339,7 @@ void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
   ci.dt_s = dt_s_;
   ci.dock_valid = in.dock.valid;
   ci.dock_in_robot = in.dock.pose;
-  ci.aim_lateral_m = retry_lateral_offset_m();
+  ci.aim_lateral_m = attempt_aim_m();
   ci.dock_covariance = in.dock.covariance;
   ci.dock_stamp_us = in.dock.stamp_us;
   ci.odom_pose = in.odom_pose;
@@ -384,6 +391,11 @@ void TaskManager::run_wait_for_charge(const TaskInput& in) {
       charge_ok_since_us_ = in.now_us;
     }
     if (since_s(charge_ok_since_us_, in) >= params_.charge_confirm_hold_s) {
+      // Only an attempt that drove onto the contacts says where they are (not a docking that began on them).
+      if (params_.remember_aim && waiting_after_align_ && dock_id_ < kAimMemory) {
+        remembered_aim_m_[dock_id_] = attempt_aim_m();
+        lateral_misses_ = 0;  // the aim that closed them is now the dock's aim, not an offset from it
+      }
       last_result_ = TaskResult::kDocked;
       enter(TaskState::kFinishTasking, in);
       return;
@@ -414,6 +426,9 @@ void TaskManager::run_retry(const TaskInput& in) {
   if (run_backoff(in)) {
     want_ = Twist2{};
     if (pending_fault_ != FaultCode::kNone) {
+      // The search around the remembered aim did not find the contacts: the next docking starts on the axis again.
+      const bool missed = pending_fault_ == FaultCode::kAlignFailed || pending_fault_ == FaultCode::kContactsNotReached;
+      if (missed && dock_id_ < kAimMemory) remembered_aim_m_[dock_id_] = 0;
       raise(pending_fault_, in);
       return;
     }
@@ -529,6 +544,7 @@ void TaskManager::emit(const TaskInput& in, TaskOutput& out) {
   s.dock_valid = dock_fresh(in);
   s.dock_pose = in.dock.pose;
   s.charge_enable = state_ == TaskState::kWaitForCharge || state_ == TaskState::kFinishTasking;
+  s.aim_lateral_m = attempt_aim_m();
   s.last_command = last_command_;
   s.last_result = last_result_;
   s.dock_id = dock_id_;

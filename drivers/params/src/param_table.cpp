@@ -308,6 +308,9 @@ const ParamSpec kTable[] = {
     DC_REAL("task", "retry_lateral_step_m", "m", 0, 0.1, kBoth, task, retry_lateral_step_m,
             "After two attempts that missed the contacts (188, 190), the next aim this much to one side, then the "
             "other, then twice as far; 0: off."),
+    DC_BOOL("task", "remember_aim", kBoth, task, remember_aim,
+            "The aim that closed the contacts is the next docking's first aim at that dock (the search runs around "
+            "it); a docking that misses them to the end forgets it."),
     DC_REAL("task", "obstacle_timeout_s", "s", 0.1, 600, kBoth, task, obstacle_timeout_s,
             "Blocked this long: fault 180."),
     DC_REAL("task", "charge_current_threshold_a", "A", 0, 200, kBoth, task, charge_current_threshold_a,

@@ -123,6 +123,12 @@ struct TaskParams {
   /// Neighbouring aims overlap when the step is at most the contacts' lateral window (±tolerance) less twice the
   /// docking's own lateral error: 2 × (10 − 4) mm for the simulated ±10 mm contacts.
   Real retry_lateral_step_m = static_cast<Real>(0.012);
+  /// Remember the aim that closed the contacts. When charging is confirmed, the lateral aim of that attempt (the
+  /// search's offset, plus the aim it started from) becomes the first aim of the next docking at the same dock
+  /// (ids 0-31), and the search runs around it: a lidar calibration error is then searched for once, not on every
+  /// docking. A docking that ends in 188/190 after missing the contacts forgets its dock's aim. Kept until
+  /// configure().
+  bool remember_aim = true;
   // Backing off (RETRY, UNDOCKING).
   Real staging_distance_m = static_cast<Real>(0.6);   ///< Back off until the robot centre is this far from the dock.
   Real fallback_backoff_m = static_cast<Real>(0.3);   ///< Without a dock estimate: back off this far on odometry.
@@ -217,6 +223,9 @@ struct TaskStatus {
   CommandResult last_command = CommandResult::kNone;  ///< Result of the most recent command.
   TaskResult last_result = TaskResult::kNone;
   std::uint16_t dock_id = 0;       ///< Dock of the current/last task.
+  /// Lateral aim of the current/last attempt, m: beside the dock's axis, the remembered aim plus the search's
+  /// offset (TaskParams::retry_lateral_step_m, remember_aim).
+  Real aim_lateral_m = 0;
 };
 
 /// One tick's result.
@@ -247,6 +256,8 @@ class TaskManager {
   bool push_suspected() const { return deviation_count_ > 0; }
   /// Where this attempt aims beside the dock's axis (retry_lateral_step_m), m in the dock frame's y. O(1).
   Real retry_lateral_offset_m() const;
+  /// The lateral aim of the current attempt: the dock's remembered aim plus the search's offset, m.
+  Real attempt_aim_m() const;
   /// The current attempt is in its final push (ALIGN, see TaskParams::push_zone_m). O(1).
   bool in_final_push() const { return pushing_; }
   /// Odometry path length travelled in the final push so far, m; that of the last push once ALIGN has ended, 0
@@ -298,6 +309,9 @@ class TaskManager {
   std::uint16_t dock_id_ = 0;
   std::uint8_t retries_ = 0;
   std::uint8_t lateral_misses_ = 0;  ///< This task's attempts that reached the dock without contact (188, 190).
+  static constexpr std::size_t kAimMemory = 32;  ///< Dock ids 0-31 (TaskParams::accepted_dock_ids).
+  Real remembered_aim_m_[kAimMemory] = {};       ///< Per dock id: the aim that last closed the contacts (remember_aim).
+  bool waiting_after_align_ = false;  ///< WAIT_FOR_CHARGE was entered from ALIGN (the robot drove onto the contacts).
   std::uint8_t phase_ = 0;
 
   Twist2 want_{};              // the state's wanted twist for this tick; emit() decides what leaves

@@ -1,0 +1,45 @@
+# dock-sim soak on tools/scenarios/lidar-miscalibrated.toml: the lidar sits 1 cm / 1 cm / 1° off its configured mount,
+# so the first docking finds the contacts only by the retries' sideways search (well over 40 s). With [task]
+# remember_aim (the default) every later docking starts from the aim that closed them and docks at once; with it off,
+# every docking searches again. Inputs: -DDOCKSIM=<dock-sim> -DSCENARIO=<lidar-miscalibrated.toml> -DWORK=<dir>.
+file(MAKE_DIRECTORY ${WORK})
+set(slow_s 40)
+
+function(soak_times file out_var)
+  execute_process(COMMAND ${DOCKSIM} soak ${file} --cycles 4 --json RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                  ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "soak ${file}: exit ${rc} (every cycle must dock)\n${out}\n${err}")
+  endif()
+  set(times "")
+  foreach(i RANGE 3)
+    string(JSON t ERROR_VARIABLE jerr GET "${out}" per_cycle ${i} dock_time_s)
+    if(jerr)
+      message(FATAL_ERROR "soak ${file}: no per_cycle ${i} dock_time_s (${jerr})")
+    endif()
+    list(APPEND times ${t})
+  endforeach()
+  set(${out_var} "${times}" PARENT_SCOPE)
+endfunction()
+
+soak_times(${SCENARIO} on)
+message(STATUS "remember_aim on: dock times ${on} s")
+list(GET on 0 first)
+if(first LESS ${slow_s})
+  message(FATAL_ERROR "the first docking took ${first} s: the scenario no longer needs the search")
+endif()
+foreach(i 1 2 3)
+  list(GET on ${i} t)
+  if(NOT t LESS ${slow_s})
+    message(FATAL_ERROR "docking ${i} took ${t} s: it searched again instead of starting from the remembered aim")
+  endif()
+endforeach()
+
+file(READ ${SCENARIO} text)
+file(WRITE ${WORK}/forget.toml "${text}\n[task]\nremember_aim = false\n")
+soak_times(${WORK}/forget.toml off)
+message(STATUS "remember_aim off: dock times ${off} s")
+list(GET off 1 t)
+if(t LESS ${slow_s})
+  message(FATAL_ERROR "without remember_aim docking 1 took ${t} s: the check above cannot fail")
+endif()
