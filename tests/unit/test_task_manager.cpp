@@ -742,75 +742,74 @@ TEST(TaskManager, HeldShortOfTheContactsThePushEndsOnTimeThenFault190) {
   check_backed_off_and_standing(*s, 2.0);
 }
 
+// A Sim whose attempts miss the contacts (held 2 cm short) until lifted, with a short final push.
+std::unique_ptr<Sim> missing_sim(bool remember_aim) {
+  auto s = std::make_unique<Sim>();
+  s->stop_short_m = 0.02;
+  s->params.max_push_s = 2.0;
+  s->params.remember_aim = remember_aim;
+  s->reconfigure();
+  return s;
+}
+
+// Docks at `id`: the first two attempts miss, the third (aimed one search step to the side) reaches the contacts;
+// then undocks.
+void dock_on_the_third_attempt(Sim& s, std::uint16_t id) {
+  s.command(HostCommandType::kDock, id);
+  for (int miss = 0; miss < 2; ++miss) {
+    CHECK(s.run_until(TaskState::kRetry, 40));
+    CHECK(s.run_until(TaskState::kAlign, 30));
+  }
+  s.stop_short_m = 0;
+  CHECK(s.run_until(TaskState::kFinishTasking, 30));
+}
+
+void undock(Sim& s) {
+  s.command(HostCommandType::kUndock);
+  CHECK(s.run_until(TaskState::kNotTasking, 20));
+}
+
+// Starts a docking at `id` and returns the aim its first attempt gives the controller.
+double first_aim(Sim& s, std::uint16_t id) {
+  s.command(HostCommandType::kDock, id);
+  CHECK(s.run_until(TaskState::kAlign, 10));
+  s.step();
+  return s.ctrl.last_aim_m;
+}
+
 // The aim that closed the contacts is the next docking's first aim (remember_aim); a docking that misses the contacts
 // to its last attempt forgets it.
 TEST(TaskManager, TheAimThatClosedTheContactsIsTheNextDockingsFirstAim) {
-  auto s = std::make_unique<Sim>();
-  s->stop_short_m = 0.02;  // attempts miss until it is lifted
-  s->params.max_push_s = 2.0;
-  s->reconfigure();
+  auto s = missing_sim(true);
   const double step_m = static_cast<double>(s->params.retry_lateral_step_m);
-  s->command(HostCommandType::kDock, 3);
-  CHECK(s->run_until(TaskState::kAlign, 10));
-  REAL_EQUAL(0.0, s->ctrl.last_aim_m, 0);
-  for (int miss = 0; miss < 2; ++miss) {
-    CHECK(s->run_until(TaskState::kRetry, 30));
-    CHECK(s->run_until(TaskState::kAlign, 30));
-  }
-  s->stop_short_m = 0;  // the third attempt, aimed one step to the side, closes the contacts
-  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  dock_on_the_third_attempt(*s, 3);
   REAL_EQUAL(step_m, s->ctrl.last_aim_m, 1e-9);
   REAL_EQUAL(step_m, static_cast<double>(s->out.status.aim_lateral_m), 1e-9);
-  s->command(HostCommandType::kUndock);
-  CHECK(s->run_until(TaskState::kNotTasking, 20));
+  undock(*s);
 
-  s->command(HostCommandType::kDock, 3);
-  CHECK(s->run_until(TaskState::kAlign, 10));
-  s->step();
-  REAL_EQUAL(step_m, s->ctrl.last_aim_m, 1e-9);  // the first attempt starts where the last one closed them
+  REAL_EQUAL(step_m, first_aim(*s, 3), 1e-9);  // the first attempt starts where the last one closed them
   CHECK(s->run_until(TaskState::kFinishTasking, 30));
   LONGS_EQUAL(0, s->out.status.retries);
-  s->command(HostCommandType::kUndock);
-  CHECK(s->run_until(TaskState::kNotTasking, 20));
+  undock(*s);
 
-  s->command(HostCommandType::kDock, 4);  // another dock has no remembered aim
-  CHECK(s->run_until(TaskState::kAlign, 10));
-  s->step();
-  REAL_EQUAL(0.0, s->ctrl.last_aim_m, 0);
+  REAL_EQUAL(0.0, first_aim(*s, 4), 0);  // another dock has no remembered aim
   CHECK(s->run_until(TaskState::kFinishTasking, 30));
-  s->command(HostCommandType::kUndock);
-  CHECK(s->run_until(TaskState::kNotTasking, 20));
+  undock(*s);
 
   s->stop_short_m = 0.02;  // dock 3 now misses to the end: fault 190, and its aim is forgotten
   s->command(HostCommandType::kDock, 3);
   CHECK(s->run_until(TaskState::kFault, 200));
   LONGS_EQUAL(190, static_cast<int>(s->out.status.fault));
   s->stop_short_m = 0;
-  s->command(HostCommandType::kDock, 3);
-  CHECK(s->run_until(TaskState::kAlign, 10));
-  s->step();
-  REAL_EQUAL(0.0, s->ctrl.last_aim_m, 0);
+  REAL_EQUAL(0.0, first_aim(*s, 3), 0);
 }
 
 TEST(TaskManager, WithoutRememberAimEveryDockingStartsOnTheAxis) {
-  auto s = std::make_unique<Sim>();
-  s->stop_short_m = 0.02;
-  s->params.max_push_s = 2.0;
-  s->params.remember_aim = false;
-  s->reconfigure();
-  s->command(HostCommandType::kDock);
-  for (int miss = 0; miss < 2; ++miss) {
-    CHECK(s->run_until(TaskState::kRetry, 40));
-    CHECK(s->run_until(TaskState::kAlign, 30));
-  }
-  s->stop_short_m = 0;
-  CHECK(s->run_until(TaskState::kFinishTasking, 30));
-  s->command(HostCommandType::kUndock);
-  CHECK(s->run_until(TaskState::kNotTasking, 20));
-  s->command(HostCommandType::kDock);
-  CHECK(s->run_until(TaskState::kAlign, 10));
-  s->step();
-  REAL_EQUAL(0.0, s->ctrl.last_aim_m, 0);
+  auto s = missing_sim(false);
+  dock_on_the_third_attempt(*s, 0);
+  REAL_EQUAL(static_cast<double>(s->params.retry_lateral_step_m), s->ctrl.last_aim_m, 1e-9);
+  undock(*s);
+  REAL_EQUAL(0.0, first_aim(*s, 0), 0);
 }
 
 // Held short while the wheels spin (slip): odometry runs on, the robot does not. The push ends on its distance,
