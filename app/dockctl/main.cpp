@@ -94,6 +94,12 @@ int main(int argc, char** argv) {
   std::vector<std::string> fields;
   status->add_option("--field", fields, "print only this field's value (repeatable: one line each, in order)")
       ->excludes(follow_opt);
+  std::string part;
+  status
+      ->add_option("--part", part,
+                   "camera: the camera's and the tag fusion's fields, which the status leaves out when full")
+      ->check(CLI::IsMember({"main", "camera"}))
+      ->excludes(follow_opt);
   auto* test =
       app.add_subcommand("test", "recognition-only test mode: report the dock estimate, never move ('stop' ends it)");
   test->add_option("--dock", dock_id, "dock id (default: dockd's default dock)")->check(CLI::Range(0, 65535));
@@ -123,6 +129,7 @@ int main(int argc, char** argv) {
   std::string req = "{\"cmd\":\"" + name + "\",\"seq\":" + std::to_string(seq);
   if (dock_id >= 0) req += ",\"dock_id\":" + std::to_string(dock_id);
   if (scans > 0) req += ",\"scans\":" + std::to_string(scans);
+  if (!part.empty()) req += ",\"part\":\"" + part + "\"";
   req += "}";
   const int timeout_ms = static_cast<int>(timeout_s * 1000);
 

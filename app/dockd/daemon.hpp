@@ -144,12 +144,17 @@ class Daemon final : private HostActions, private TeachHooks {
   /// The status's fields, written into `w` (status_json and the status reply); optional groups (tag fusion, camera)
   /// only when they fit.
   void status_fields(JsonWriter& w, std::uint64_t now_us) const override;
+  /// The camera part of the status (`"part":"camera"`): the groups status_fields drops when full, always whole.
+  void camera_fields(JsonWriter& w) const override;
   /// Every host command refused, whatever refused it: dockd and the task manager (counters().commands_rejected)
   /// plus the UDP datagrams that did not parse (malformed, unknown command, bad field, too long). The status field
   /// `commands_rejected`. O(1).
   std::uint32_t commands_rejected_total() const { return host_.commands_rejected_total(); }
 
  private:
+  /// The tag fusion's, the stall flag's and the own camera's groups; with only_if_fits each is left out whole when
+  /// `w` has no room for it.
+  void camera_groups(JsonWriter& w, bool only_if_fits) const;
   void poll_chassis(std::uint64_t now_us);
   void poll_lidar(std::uint64_t now_us);
   void poll_camera(std::uint64_t now_us);

@@ -115,25 +115,33 @@ void Daemon::status_fields(JsonWriter& w, std::uint64_t now_us) const {
       .str("det_reject", e.found ? "none" : dockcore::to_string(e.reject))
       .real("dock_evidence_nats", static_cast<double>(core_->filter().evidence_nats()), 1)
       .boolean("dock_confirmed", core_->filter().confirmed());
-  // The optional groups go in only when they fit (the status must stay one datagram); each is dropped whole.
-  const auto optional = [&w](auto&& write) {
+  // The camera's groups go in only when they fit (the status must stay one datagram); each is dropped whole. The
+  // camera part of the status (camera_fields) always has them.
+  camera_groups(w, true);
+}
+
+void Daemon::camera_fields(JsonWriter& w) const {
+  camera_groups(w, false);
+}
+
+void Daemon::camera_groups(JsonWriter& w, bool only_if_fits) const {
+  const auto group = [&w, only_if_fits](auto&& write) {
     const std::size_t m = w.mark();
     write();
-    if (!w.ok()) w.rollback(m);
+    if (only_if_fits && !w.ok()) w.rollback(m);
   };
   // The tag fusion's counters (docs/camera.md, "Status").
   if (io_.tags != nullptr) {
-    optional([&] {
+    group([&] {
       w.uint("tag_fused", counters_.tags[0]).uints("tag_refused", counters_.tags + 1, dockcore::kTagStatusCount - 1);
     });
   }
   // The stall watchdog's flag only, as for the lidar: the count is in the watchdog event.
-  if (io_.camera_frames != nullptr) optional([&] { w.boolean("camera_stalled", camera_stalled_); });
-  // The own camera's fields. Compact: the status is about 1.2 kB of the 1400-byte reply (kMaxHostReply);
-  // camera-check reports the rest.
+  if (io_.camera_frames != nullptr) group([&] { w.boolean("camera_stalled", camera_stalled_); });
+  // The own camera's fields (camera-check reports the rest).
   if (io_.camera_status != nullptr) {
     const dockcore::hal::CameraStatus c = io_.camera_status->camera_status();
-    optional([&] {
+    group([&] {
       w.boolean("camera_connected", c.connected)
           .uint("camera_frames", c.capture.frames)
           .uint("camera_dropped", c.capture.dropped)

@@ -120,8 +120,8 @@ HostErrorCode parse_host_request(const char* data, std::size_t len, HostRequest&
   for (std::size_t i = 0; i < j.size(); ++i) {
     const char* k = j.key(i);
     if (std::strcmp(k, "cmd") != 0 && std::strcmp(k, "seq") != 0 && std::strcmp(k, "dock_id") != 0 &&
-        std::strcmp(k, "scans") != 0) {
-      detail = "unknown field (expected cmd, seq, dock_id, scans)";
+        std::strcmp(k, "scans") != 0 && std::strcmp(k, "part") != 0) {
+      detail = "unknown field (expected cmd, seq, dock_id, scans, part)";
       return HostErrorCode::kBadField;
     }
   }
@@ -139,6 +139,16 @@ HostErrorCode parse_host_request(const char* data, std::size_t len, HostRequest&
       return HostErrorCode::kBadField;
     }
     r.scans = static_cast<std::uint16_t>(v);
+  }
+  if (j.has("part")) {
+    const char* part = nullptr;
+    const bool main = j.get_string("part", part) && std::strcmp(part, "main") == 0;
+    const bool camera = part != nullptr && std::strcmp(part, "camera") == 0;
+    if (r.kind != HostRequestKind::kStatus || (!main && !camera)) {
+      detail = "part must be \"main\" or \"camera\" and only with status";
+      return HostErrorCode::kBadField;
+    }
+    r.part = camera ? StatusPart::kCamera : StatusPart::kMain;
   }
   out = r;
   return HostErrorCode::kNone;
@@ -272,11 +282,17 @@ void HostProtocol::handle_subscription(const HostRequest& r, std::uint64_t now_u
 void HostProtocol::handle_udp(const HostRequest& r, std::uint64_t now_us) {
   switch (r.kind) {
     case HostRequestKind::kStatus: {
-      // The reply is the status object with {"ok":true,"cmd":"status","seq":N} in front.
+      // The reply is the status object (or the camera part, after "part") with {"ok":true,"cmd":"status","seq":N}
+      // in front.
       char out[dockcore::hal::kMaxHostReply];
       JsonWriter w(out, sizeof out);
       w.boolean("ok", true).str("cmd", "status").uint("seq", r.seq);
-      actions_.status_fields(w, now_us);
+      if (r.part == StatusPart::kCamera) {
+        w.str("part", "camera");
+        actions_.camera_fields(w);
+      } else {
+        actions_.status_fields(w, now_us);
+      }
       reply(r, out, w.finish());
       return;
     }

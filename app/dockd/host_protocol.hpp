@@ -35,6 +35,12 @@ enum class HostRequestKind : std::uint8_t {
 /// Stable wire name ("dock", "stop", ...). Never null. O(1).
 const char* to_string(HostRequestKind k);
 
+/// Which part of the status a status request asks for.
+enum class StatusPart : std::uint8_t {
+  kMain = 0,    ///< The status object (task, inputs, counters, detection), as the stream carries it.
+  kCamera = 1,  ///< The camera's and the tag fusion's fields, always whole (the main status drops them when full).
+};
+
 /// One parsed UDP request.
 struct HostRequest {
   HostRequestKind kind = HostRequestKind::kStatus;
@@ -43,6 +49,7 @@ struct HostRequest {
   bool has_seq = false;
   std::uint32_t seq = 0;           ///< Echoed in the reply; 0..2^32-1.
   std::uint16_t scans = 0;         ///< teach: scans to average (0 = teach_scans).
+  StatusPart part = StatusPart::kMain;  ///< status: "part" ("main" when absent).
   dockcore::hal::HostPeer peer{};  ///< Who sent it (replies go there).
   std::uint64_t stamp_us = 0;      ///< Receive time, CLOCK_MONOTONIC µs.
 };
@@ -80,6 +87,9 @@ class HostActions {
  public:
   /// The status object's fields (the status reply and the stream).
   virtual void status_fields(JsonWriter& w, std::uint64_t now_us) const = 0;
+  /// The camera part's fields: the tag fusion's counters, the stall flag and the capture counters, each group only
+  /// when dockd has that input (none without a camera).
+  virtual void camera_fields(JsonWriter& w) const = 0;
   /// The running configuration: the dock database and the default dock.
   virtual const DockdConfig& config() const = 0;
   /// The dock the core is configured for: undock and stop go to it.

@@ -94,6 +94,11 @@ out=$("$DOCKCTL" --port $PORT status --field no_such_key 2>&1); rc=$?
 [ $rc -eq 1 ] && grep -q 'no field "no_such_key"' <<<"$out" || { kill $pid; fail "status --field no_such_key: exit $rc: $out"; }
 out=$("$DOCKCTL" --port $PORT status --follow --field state 2>&1); rc=$?
 [ $rc -eq 2 ] || { kill $pid; fail "status --follow --field: exit $rc (want 2): $out"; }
+# The camera part: named, and empty without a camera (no status fields in it).
+out=$("$DOCKCTL" --port $PORT status --part camera); rc=$?
+[ $rc -eq 0 ] && grep -q '"part":"camera"}$' <<<"$out" || { kill $pid; fail "status --part camera: exit $rc: $out"; }
+out=$("$DOCKCTL" --port $PORT status --part lidar 2>&1); rc=$?
+[ $rc -eq 2 ] || { kill $pid; fail "status --part lidar: exit $rc (want 2): $out"; }
 "$DOCKCTL" --port $PORT stop >/dev/null || { kill $pid; fail "stop after test"; }
 "$DOCKCTL" --port $PORT status >"$WORK/status4.json" || { kill $pid; fail "status after stop"; }
 grep -q '"state":"NOT_TASKING"' "$WORK/status4.json" || { kill $pid; fail "stop must end the test: $(cat "$WORK/status4.json")"; }

@@ -89,6 +89,7 @@ struct FakeActions final : dockd::HostActions {
   void status_fields(dockd::JsonWriter& w, std::uint64_t now_us) const override {
     w.str("type", "status").uint("stamp_us", now_us);
   }
+  void camera_fields(dockd::JsonWriter& w) const override { w.uint("camera_frames", 42); }
   const dockd::DockdConfig& config() const override { return cfg; }
   std::uint16_t active_dock_id() const override { return 3; }
   dockcore::SubmitResult submit(dockcore::HostCommandType type, std::uint16_t dock_id, std::uint32_t token,
@@ -246,6 +247,15 @@ TEST(DockdHostProtocol, StatusGoesToSubscribersOnlyWhenThereAreAny) {
   CHECK_EQUAL(1u, link.replies.size());
   STRCMP_EQUAL("{\"ok\":true,\"cmd\":\"status\",\"seq\":4,\"type\":\"status\",\"stamp_us\":7}",
                link.replies[0].c_str());
+  // The camera part: its own fields, named, instead of the status object.
+  link.pending.push_back("{\"cmd\":\"status\",\"seq\":5,\"part\":\"camera\"}");
+  link.pending.push_back("{\"cmd\":\"status\",\"seq\":6,\"part\":\"main\"}");
+  p.poll(8);
+  CHECK_EQUAL(3u, link.replies.size());
+  STRCMP_EQUAL("{\"ok\":true,\"cmd\":\"status\",\"seq\":5,\"part\":\"camera\",\"camera_frames\":42}",
+               link.replies[1].c_str());
+  STRCMP_EQUAL("{\"ok\":true,\"cmd\":\"status\",\"seq\":6,\"type\":\"status\",\"stamp_us\":8}",
+               link.replies[2].c_str());
 }
 
 TEST(DockdHostProtocol, DatagramsThatDoNotParseAreAnsweredWithTheirCodeAndCounted) {
@@ -353,6 +363,9 @@ TEST(DockdHostRequestParser, ReadsEveryFieldAndRefusesWhatIsNotInTheProtocol) {
              {"{\"cmd\":\"teach\",\"scans\":1001,\"seq\":3}", dockd::HostErrorCode::kBadField},
              {"{\"cmd\":\"dock\",\"speed\":1,\"seq\":4}", dockd::HostErrorCode::kBadField},
              {"{\"cmd\":\"dock\",\"seq\":-1}", dockd::HostErrorCode::kBadField},
+             {"{\"cmd\":\"dock\",\"part\":\"camera\",\"seq\":5}", dockd::HostErrorCode::kBadField},
+             {"{\"cmd\":\"status\",\"part\":\"lidar\",\"seq\":6}", dockd::HostErrorCode::kBadField},
+             {"{\"cmd\":\"status\",\"part\":1,\"seq\":7}", dockd::HostErrorCode::kBadField},
              {"[1]", dockd::HostErrorCode::kMalformed}};
   for (const Bad& b : bad) {
     HostRequest out;
