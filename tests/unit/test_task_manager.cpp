@@ -804,6 +804,28 @@ TEST(TaskManager, TheAimThatClosedTheContactsIsTheNextDockingsFirstAim) {
   REAL_EQUAL(0.0, first_aim(*s, 3), 0);
 }
 
+// Contacts that close and open again before the charge is confirmed (the pads at the edge of the contacts' window):
+// retried as 182, and counted as a miss by the sideways search, so after one more miss the third attempt aims beside
+// the axis instead of on it again.
+TEST(TaskManager, ContactsThatDidNotStayClosedAreAMissForTheSidewaysSearch) {
+  auto s = missing_sim(true);
+  s->stop_short_m = 0;
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kWaitForCharge, 30));
+  s->world.x_m += 0.05;  // off the contacts before any current came
+  s->step();
+  CHECK_FALSE(s->contact);
+  CHECK(s->run_until(TaskState::kRetry, 10));
+  LONGS_EQUAL(182, static_cast<int>(s->out.status.retry_reason));
+  s->stop_short_m = 0.02;  // the second attempt misses
+  CHECK(s->run_until(TaskState::kAlign, 30));
+  REAL_EQUAL(0.0, s->ctrl.last_aim_m, 0);
+  CHECK(s->run_until(TaskState::kRetry, 40));
+  CHECK(s->run_until(TaskState::kAlign, 30));
+  s->step();
+  REAL_EQUAL(static_cast<double>(s->params.retry_lateral_step_m), s->ctrl.last_aim_m, 1e-9);
+}
+
 TEST(TaskManager, WithoutRememberAimEveryDockingStartsOnTheAxis) {
   auto s = missing_sim(false);
   dock_on_the_third_attempt(*s, 0);

@@ -233,10 +233,11 @@ bool TaskManager::run_backoff(const TaskInput& in) {
   return false;
 }
 
-void TaskManager::fail_attempt(FaultCode final_fault, const TaskInput& in) {
+void TaskManager::fail_attempt(FaultCode final_fault, const TaskInput& in, bool lateral_miss) {
   retry_reason_ = final_fault;
-  if ((final_fault == FaultCode::kAlignFailed || final_fault == FaultCode::kContactsNotReached) &&
-      lateral_misses_ < 255) {
+  lateral_miss =
+      lateral_miss || final_fault == FaultCode::kAlignFailed || final_fault == FaultCode::kContactsNotReached;
+  if (lateral_miss && lateral_misses_ < 255) {
     ++lateral_misses_;
   }
   pending_fault_ = retries_ >= params_.max_retries ? final_fault : FaultCode::kNone;
@@ -405,8 +406,10 @@ void TaskManager::run_wait_for_charge(const TaskInput& in) {
   }
   if (since_s(state_since_us_, in) > params_.charge_confirm_timeout_s) {
     // Contacts closed without a charge held: the charger (dead, unpowered, or a poor contact). Contacts that never
-    // closed (a controller arriving by its own test alone): the robot is not on them.
-    fail_attempt(contact_seen_ ? FaultCode::kChargeNotConfirmed : FaultCode::kContactsNotReached, in);
+    // closed (a controller arriving by its own test alone): the robot is not on them. Contacts that closed and did
+    // not stay closed: the pads at the edge of the contacts' window, a miss the sideways search counts.
+    fail_attempt(contact_seen_ ? FaultCode::kChargeNotConfirmed : FaultCode::kContactsNotReached, in,
+                 contact_seen_ && !in.contact);
   }
 }
 

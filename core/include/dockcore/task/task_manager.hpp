@@ -286,8 +286,9 @@ class TaskManager {
   void run_retry(const TaskInput& in);
   void run_undocking(const TaskInput& in);
   /// Attempt failed (charge not confirmed, contacts not reached, controller failure): back off, then retry or fault
-  /// with `final_fault`.
-  void fail_attempt(FaultCode final_fault, const TaskInput& in);
+  /// with `final_fault`. A miss of the contacts (188, 190, or `lateral_miss`: they closed and did not stay closed)
+  /// moves the next attempt's aim (retry_lateral_step_m).
+  void fail_attempt(FaultCode final_fault, const TaskInput& in, bool lateral_miss = false);
   bool dock_fresh(const TaskInput& in) const;
   /// The estimate puts the robot in the final push's zone (TaskParams::push_zone_m).
   bool in_push_zone(const TaskInput& in) const;
