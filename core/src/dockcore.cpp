@@ -370,10 +370,12 @@ void DockcoreBase::resume_policy(TaskState before, bool have_cmd, const QueuedCo
 
 void DockcoreBase::observe_drive(const TickInput& in, TaskState state, const TaskInput& t) {
   // A stall may be the drive's deadband only while the robot moves freely: not on the contacts, not with stale
-  // feedback, not in a state that stands still, and not with its edge at the dock's face (pressing a misaligned dock
-  // is no deadband).
-  const bool at_dock =
-      t.dock.valid && std::fabs(t.dock.pose.x_m) - body_front_m(config_.footprint) < kDeadbandDockClearanceM;
+  // feedback, not in a state that stands still, and not with its front (or rear) edge at the dock's face (pressing
+  // a misaligned dock is no deadband). A dock beside the robot is not pressed: a robot turned across its face still
+  // learns.
+  const bool at_dock = t.dock.valid &&
+                       std::fabs(t.dock.pose.x_m) - body_front_m(config_.footprint) < kDeadbandDockClearanceM &&
+                       std::fabs(t.dock.pose.y_m) < body_half_width_m(config_.footprint);
   const bool learn = is_moving_state(state) && !in.contact && !watch_.hold() && !at_dock;
   deadband_.observe(sent_wheels_, twist_to_wheels(config_.drive, odometry_.twist()), in.now_us, learn);
 }

@@ -213,6 +213,22 @@ TEST(SimRun, AnUntoldLidarCalibrationErrorIsFoundByTheLateralSearch) {
         0);
 }
 
+// A rear-pad robot that starts beside the dock turns across its face and reverses at a creep its wheels' deadband
+// (0.8 rad/s, not told) swallows. The dock is then near but beside the robot, not at its edge: the stall is the
+// drive's and the deadband is learned, instead of the robot standing still until the task timeout.
+TEST(SimRun, ARobotTurnedAcrossTheDockFaceStillLearnsTheDeadband) {
+  const docksim::Scenario sc = docksim::parse_scenario_toml(
+      "[robot]\nwheel_radius_m = 0.075\n[robot.footprint]\npads = \"rear\"\n[robot.motor]\ndeadband_radps = 0.8\n",
+      "across.toml");
+  const docksim::StartPose start = docksim::start_from(sc, 0.6, 39 * kDeg, -2 * kDeg);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 1, opt);
+  CHECK_TEXT(r.outcome.charging_confirmed, "timed out standing beside the dock");
+  CHECK(std::fabs(r.outcome.lateral_m) <= 0.010);
+  CHECK(r.outcome.time_to_charging_s < 30);
+}
+
 // A robot with rear pads backs off from the dock by driving forwards: after a missed attempt it reaches the staging
 // distance and tries again, instead of pressing its pads into the dock until the back-off times out.
 TEST(SimRun, ARearPadRobotBacksOffForwardsOnARetry) {

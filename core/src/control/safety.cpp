@@ -65,6 +65,10 @@ Real body_front_m(const FootprintParams& fp) {
   return fp.shape == FootprintShape::kCircular ? fp.radius_m : fp.half_length_m;
 }
 
+Real body_half_width_m(const FootprintParams& fp) {
+  return fp.shape == FootprintShape::kCircular ? fp.radius_m : fp.half_width_m;
+}
+
 namespace {
 
 bool in_sector(const AngleSector& s, Real a) {

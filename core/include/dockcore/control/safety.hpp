@@ -83,6 +83,8 @@ FootprintParams square_footprint();
 FootprintParams circular_footprint();
 /// Distance from the rotation centre to the body's front (and rear) edge: half-length, or radius. O(1).
 Real body_front_m(const FootprintParams& fp);
+/// Distance from the rotation centre to the body's side edges: half-width, or radius. O(1).
+Real body_half_width_m(const FootprintParams& fp);
 
 /// Result of one obstacle check.
 struct ObstacleFlags {
