@@ -108,7 +108,6 @@ bool TaskManager::push_exhausted(const TaskInput& in) {
 }
 
 void TaskManager::enter(TaskState s, const TaskInput& in) {
-  if (s == TaskState::kWaitForCharge) waiting_after_align_ = state_ == TaskState::kAlign;
   state_ = s;
   state_since_us_ = in.now_us;
   blocked_ = false;
@@ -140,7 +139,7 @@ void TaskManager::handle_command(const TaskInput& in, TaskOutput& out) {
       return;
     case HostCommandType::kDock: {
       const std::uint16_t id = in.command.dock_id;
-      if (id >= 32 || ((params_.accepted_dock_ids >> id) & 1u) == 0) {
+      if (id >= kDockIds || ((params_.accepted_dock_ids >> id) & 1u) == 0) {
         r = CommandResult::kRejectedDockId;
       } else if (state_ == TaskState::kWaitForCharge || state_ == TaskState::kFinishTasking) {
         r = CommandResult::kAlreadyDocked;
@@ -193,7 +192,7 @@ void TaskManager::handle_command(const TaskInput& in, TaskOutput& out) {
     case HostCommandType::kTestMode: {
       // The test runs on the dock it names: the status reports that id, like a docking's.
       const std::uint16_t id = in.command.dock_id;
-      if (id >= 32 || ((params_.accepted_dock_ids >> id) & 1u) == 0) {
+      if (id >= kDockIds || ((params_.accepted_dock_ids >> id) & 1u) == 0) {
         r = CommandResult::kRejectedDockId;
       } else if (state_ == TaskState::kTestMode && id == dock_id_) {
         r = CommandResult::kAccepted;
@@ -235,9 +234,7 @@ bool TaskManager::run_backoff(const TaskInput& in) {
 
 void TaskManager::fail_attempt(FaultCode final_fault, const TaskInput& in, bool lateral_miss) {
   retry_reason_ = final_fault;
-  lateral_miss =
-      lateral_miss || final_fault == FaultCode::kAlignFailed || final_fault == FaultCode::kContactsNotReached;
-  if (lateral_miss && lateral_misses_ < 255) {
+  if ((lateral_miss || missed_contacts(final_fault)) && lateral_misses_ < 255) {
     ++lateral_misses_;
   }
   pending_fault_ = retries_ >= params_.max_retries ? final_fault : FaultCode::kNone;
@@ -324,8 +321,7 @@ Real TaskManager::retry_lateral_offset_m() const {
 }
 
 Real TaskManager::attempt_aim_m() const {
-  const Real base_m = dock_id_ < kAimMemory ? remembered_aim_m_[dock_id_] : static_cast<Real>(0);
-  return base_m + retry_lateral_offset_m();
+  return remembered_aim_m_[dock_id_] + retry_lateral_offset_m();  // dock_id_ < kDockIds: only accepted ids run
 }
 
 void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
@@ -392,8 +388,8 @@ void TaskManager::run_wait_for_charge(const TaskInput& in) {
       charge_ok_since_us_ = in.now_us;
     }
     if (since_s(charge_ok_since_us_, in) >= params_.charge_confirm_hold_s) {
-      // Only an attempt that drove onto the contacts says where they are (not a docking that began on them).
-      if (params_.remember_aim && waiting_after_align_ && dock_id_ < kAimMemory) {
+      // A docking that began on the contacts (no attempt, no search) stores the aim it already had.
+      if (params_.remember_aim) {
         remembered_aim_m_[dock_id_] = attempt_aim_m();
         lateral_misses_ = 0;  // the aim that closed them is now the dock's aim, not an offset from it
       }
@@ -430,8 +426,7 @@ void TaskManager::run_retry(const TaskInput& in) {
     want_ = Twist2{};
     if (pending_fault_ != FaultCode::kNone) {
       // The search around the remembered aim did not find the contacts: the next docking starts on the axis again.
-      const bool missed = pending_fault_ == FaultCode::kAlignFailed || pending_fault_ == FaultCode::kContactsNotReached;
-      if (missed && dock_id_ < kAimMemory) remembered_aim_m_[dock_id_] = 0;
+      if (missed_contacts(pending_fault_)) remembered_aim_m_[dock_id_] = 0;
       raise(pending_fault_, in);
       return;
     }

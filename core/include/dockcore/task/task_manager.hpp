@@ -79,6 +79,9 @@ enum class TaskResult : std::uint8_t {
   kFaulted = 4,
 };
 
+/// Dock ids a task can run for: 0..31, one bit each in TaskParams::accepted_dock_ids.
+constexpr std::uint16_t kDockIds = 32;
+
 /// Task manager parameters. Times in seconds, distances in metres, angles in radians.
 struct TaskParams {
   // Detection search (REACH_TASKING_POINT).
@@ -289,6 +292,10 @@ class TaskManager {
   /// with `final_fault`. A miss of the contacts (188, 190, or `lateral_miss`: they closed and did not stay closed)
   /// moves the next attempt's aim (retry_lateral_step_m).
   void fail_attempt(FaultCode final_fault, const TaskInput& in, bool lateral_miss = false);
+  /// An attempt that ended this way reached the dock without the contacts closing (188, 190).
+  static bool missed_contacts(FaultCode f) {
+    return f == FaultCode::kAlignFailed || f == FaultCode::kContactsNotReached;
+  }
   bool dock_fresh(const TaskInput& in) const;
   /// The estimate puts the robot in the final push's zone (TaskParams::push_zone_m).
   bool in_push_zone(const TaskInput& in) const;
@@ -310,9 +317,7 @@ class TaskManager {
   std::uint16_t dock_id_ = 0;
   std::uint8_t retries_ = 0;
   std::uint8_t lateral_misses_ = 0;  ///< This task's attempts that reached the dock without contact (188, 190).
-  static constexpr std::size_t kAimMemory = 32;  ///< Dock ids 0-31 (TaskParams::accepted_dock_ids).
-  Real remembered_aim_m_[kAimMemory] = {};       ///< Per dock id: the aim that last closed the contacts (remember_aim).
-  bool waiting_after_align_ = false;  ///< WAIT_FOR_CHARGE was entered from ALIGN (the robot drove onto the contacts).
+  Real remembered_aim_m_[kDockIds] = {};  ///< Per dock id: the aim that last closed the contacts (remember_aim).
   std::uint8_t phase_ = 0;
 
   Twist2 want_{};              // the state's wanted twist for this tick; emit() decides what leaves
