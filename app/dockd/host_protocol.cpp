@@ -141,10 +141,9 @@ HostErrorCode parse_host_request(const char* data, std::size_t len, HostRequest&
     r.scans = static_cast<std::uint16_t>(v);
   }
   if (j.has("part")) {
-    const char* part = nullptr;
-    const bool main = j.get_string("part", part) && std::strcmp(part, "main") == 0;
-    const bool camera = part != nullptr && std::strcmp(part, "camera") == 0;
-    if (r.kind != HostRequestKind::kStatus || (!main && !camera)) {
+    const char* part = "";
+    const bool camera = j.get_string("part", part) && std::strcmp(part, "camera") == 0;
+    if (r.kind != HostRequestKind::kStatus || (!camera && std::strcmp(part, "main") != 0)) {
       detail = "part must be \"main\" or \"camera\" and only with status";
       return HostErrorCode::kBadField;
     }
