@@ -546,11 +546,71 @@ TEST(TaskManager, TheLastCentimetresRunOnTheOdometryCarriedEstimate) {
       LONGS_EQUAL(0, lost_ticks);
       CHECK(s->run_until(TaskState::kFinishTasking, 10));
     } else {
+      // Lost in the final push for the loss timeout: the robot is at the face without the contacts, an attempt that
+      // missed them (retried), not a dock that is gone (181).
       CHECK(lost_ticks > 0);
-      LONGS_EQUAL(181, static_cast<int>(s->out.status.fault));
+      CHECK(s->out.status.state == TaskState::kRetry);
+      LONGS_EQUAL(0, static_cast<int>(s->out.status.fault));
+      CHECK(s->saw(TaskState::kRetry));
     }
     LONGS_EQUAL(0, s->zero_violations);
   }
+}
+
+// Far from the dock a loss does not stop the robot: the estimate, carried by odometry, keeps the approach going for
+// blind_approach_max_s (a standing robot would keep the view that lost the dock); then it holds and faults 181 after
+// the loss timeout. With blind_approach_max_s 0 it holds at once.
+TEST(TaskManager, FarFromTheDockALossKeepsTheApproachGoingForAWhile) {
+  for (const bool carry : {true, false}) {
+    auto s = std::make_unique<Sim>();
+    s->world = s->odom = Pose2{2.4, 0.1, kPi};
+    if (!carry) {
+      s->params.blind_approach_max_s = 0;
+      s->reconfigure();
+    }
+    s->command(HostCommandType::kDock);
+    CHECK(s->run_until(TaskState::kAlign, 5));
+    s->occluded = true;
+    const double x0 = s->world.x_m;
+    const std::uint64_t lost_from_us = s->dock_stamp_us;
+    std::uint64_t held_at_us = 0;
+    for (int i = 0; i < 1000 && s->out.status.state == TaskState::kAlign; ++i) {
+      s->step();
+      if (s->out.target_lost && held_at_us == 0) held_at_us = s->now_us;
+    }
+    const double held_after_s = static_cast<double>(held_at_us - lost_from_us) * 1e-6;
+    const double travelled_m = x0 - s->world.x_m;
+    if (carry) {
+      CHECK(held_after_s > 2.95 && held_after_s < 3.1);  // blind_approach_max_s
+      CHECK(travelled_m > 0.4);
+      CHECK(s->centre_to_dock() - kHalfLength > s->params.blind_approach_m);
+    } else {
+      CHECK(held_after_s > 0.45 && held_after_s < 0.6);  // target_lost_after_s
+      CHECK(travelled_m < 0.12);
+    }
+    LONGS_EQUAL(181, static_cast<int>(s->out.status.fault));
+    LONGS_EQUAL(0, s->zero_violations);
+  }
+}
+
+// The carry ends where the approach stops being far: a loss with the dock within blind_approach_m holds the robot.
+TEST(TaskManager, ALossNearTheDockHoldsTheRobot) {
+  auto s = std::make_unique<Sim>();
+  s->world = s->odom = Pose2{2.4, 0.1, kPi};
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  for (int i = 0; i < 3000 && s->centre_to_dock() - kHalfLength > 1.05; ++i) s->step();
+  s->occluded = true;
+  std::uint64_t held_at_us = 0;
+  const std::uint64_t lost_from_us = s->dock_stamp_us;
+  for (int i = 0; i < 500 && held_at_us == 0; ++i) {
+    s->step();
+    if (s->out.target_lost) held_at_us = s->now_us;
+  }
+  CHECK(held_at_us != 0);
+  CHECK(static_cast<double>(held_at_us - lost_from_us) * 1e-6 < 1.0);
+  CHECK(s->centre_to_dock() - kHalfLength < s->params.blind_approach_m);
+  LONGS_EQUAL(0, s->zero_violations);
 }
 
 TEST(TaskManager, ObstacleStopsAndResumes) {

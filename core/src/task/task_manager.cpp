@@ -78,10 +78,20 @@ bool TaskManager::dock_fresh(const TaskInput& in) const {
   if (!in.dock.valid) return false;
   const Real age_s = since_s(in.dock.stamp_us, in);
   if (age_s <= params_.target_lost_after_s) return true;
+  if (state_ != TaskState::kAlign) return false;
+  const Real front_m = obstacles_.body_front_m();
   // The last stretch: odometry carries a confirmed estimate over a few centimetres with sub-millimetre error, while
   // the lidar may see only the dock's face from there.
-  return state_ == TaskState::kAlign && in.dock.confirmed && age_s <= params_.blind_finish_max_s &&
-         std::fabs(in.dock.pose.x_m) - obstacles_.body_front_m() <= params_.blind_finish_m;
+  if (in.dock.confirmed && age_s <= params_.blind_finish_max_s &&
+      std::fabs(in.dock.pose.x_m) - front_m <= params_.blind_finish_m) {
+    return true;
+  }
+  // Far away, odometry carries an estimate over a metre with centimetres of error, less than the lidar's own there,
+  // and the next detection on the way in corrects it. ALIGN starts on one detection, confirmed or not: holding still
+  // on the view that lost it would not find it again.
+  return age_s <= params_.blind_approach_max_s &&
+         std::sqrt(in.dock.pose.x_m * in.dock.pose.x_m + in.dock.pose.y_m * in.dock.pose.y_m) - front_m >=
+             params_.blind_approach_m;
 }
 
 bool TaskManager::in_push_zone(const TaskInput& in) const {
@@ -369,7 +379,13 @@ void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
       lost_since_us_ = in.now_us;
     }
     if (since_s(lost_since_us_, in) > params_.target_lost_timeout_s) {
-      raise(FaultCode::kTargetLost, in);
+      // Lost in the final push: the robot stands at the dock's face without the contacts, a miss the retry's
+      // sideways search answers; lost anywhere else, the dock is gone.
+      if (pushing_) {
+        fail_attempt(FaultCode::kContactsNotReached, in);
+      } else {
+        raise(FaultCode::kTargetLost, in);
+      }
       return;
     }
     hold_ = true;

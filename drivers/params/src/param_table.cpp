@@ -299,6 +299,11 @@ const ParamSpec kTable[] = {
             "The robot's edge this close to the dock's face: a confirmed estimate carried by odometry stays current."),
     DC_REAL("task", "blind_finish_max_s", "s", 0, 120, kBoth, task, blind_finish_max_s,
             "Longest the last stretch runs on odometry alone."),
+    DC_REAL("task", "blind_approach_m", "m", 0.1, 10, kBoth, task, blind_approach_m,
+            "The dock at least this far from the robot's edge: the estimate carried by odometry stays current for up "
+            "to blind_approach_max_s."),
+    DC_REAL("task", "blind_approach_max_s", "s", 0, 60, kBoth, task, blind_approach_max_s,
+            "Longest the approach from afar runs on odometry alone; 0: off."),
     DC_REAL("task", "push_zone_m", "m", 0.01, 1, kBoth, task, push_zone_m,
             "The final push starts when the robot, lined up with the dock, has its edge this close to the face."),
     DC_REAL("task", "max_push_m", "m", 0.01, 5, kBoth, task, max_push_m,

@@ -98,6 +98,13 @@ struct TaskParams {
   /// robot's front comes too close to see more than the dock's flat face, which fixes no lateral position.
   Real blind_finish_m = static_cast<Real>(0.10);
   Real blind_finish_max_s = static_cast<Real>(10.0);  ///< Longest the last stretch runs on odometry alone, s.
+  /// The approach from afar: with the dock at least this far from the robot's edge (footprint half-length or
+  /// radius), the estimate carried by odometry stays current for up to blind_approach_max_s, m (> 0). At range a lidar
+  /// puts few beams on the dock and a steep view loses it from scan to scan; a robot that stood still for each loss
+  /// would keep the view that lost it, while a metre of odometry moves the dock by centimetres, which the next
+  /// detection on the way in corrects.
+  Real blind_approach_m = static_cast<Real>(1.0);
+  Real blind_approach_max_s = static_cast<Real>(3.0);  ///< Longest the approach runs on odometry alone, s (0: off).
   /// The final push: it starts on the first ALIGN tick on which the estimate puts the robot lined up with the dock
   /// (its axis within 45° of the dock's, pads fore or aft) with its edge (footprint half-length or radius) this close
   /// to the dock's face, m (> 0), and lasts until ALIGN ends. Within it the robot may travel at most max_push_m on
