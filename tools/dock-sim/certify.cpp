@@ -48,7 +48,8 @@ struct Factor {
 
 // The family. Ranges follow the bases, drives, mounts and dock installations robot builders have (docs/scenarios.md
 // lists them); the dock's profile, where it stands and the start envelope are the base scenario's. The "events"
-// factors are no TOML keys: they make one [[events]] push, timed on the task's ALIGN state.
+// factors are no TOML keys: they make one [[events]] push and one occlusion, each timed on the task's ALIGN state.
+// New factors go at the end: each factor keeps its place in the trial's stream, so earlier draws stay the same.
 const Factor kFactors[] = {
     {"robot", "kinematics", 0, 1, "", "drive: differential or mecanum", "diff", "mecanum", 0.3},
     {"robot.footprint", "pads", 0, 1, "", "charging pads: front or rear (docking backwards)", "front", "rear", 0.5},
@@ -81,6 +82,10 @@ const Factor kFactors[] = {
     {"events", "push_kind", 0, 1, "", "a shove across the dock's axis or a turn on the spot", "shove", "turn", 0.5},
     {"events", "push_lateral_m", 0.4, 0.6, "m", "shove across the dock's axis"},
     {"events", "push_turn_deg", 35.0, 60.0, "deg", "turn on the spot"},
+    {"events", "occlusion", 0, 1, "", "the dock hidden from the lidar in ALIGN (someone standing in front of it)",
+     "none", "hidden", 0.20},
+    {"events", "occlusion_t_s", 0.5, 5.0, "s", "occlusion start after ALIGN began"},
+    {"events", "occlusion_s", 0.5, 3.0, "s", "occlusion length"},
 };
 constexpr std::size_t kFactorCount = sizeof(kFactors) / sizeof(kFactors[0]);
 constexpr std::uint64_t kFamilySalt = 0x63657274696679ull;  // the family's own stream, apart from the run's noise
@@ -123,6 +128,8 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
   bool mecanum = false, wall = true, push = false;
   double push_t_s = 0, push_side = 1;
   bool push_turn = false;
+  bool occluded = false;
+  double occlusion_t_s = 0;
   for (std::size_t i = 0; i < kFactorCount; ++i) {
     const Factor& f = kFactors[i];
     const double u = rng.uniform();  // drawn for every factor, used or not: each keeps its own place in the stream
@@ -130,6 +137,11 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
     if (f.first != nullptr) {
       const bool second = u < f.p_second;
       if ((key == "wall_glass" && !wall) || ((key == "push_side" || key == "push_kind") && !push)) continue;
+      if (key == "occlusion") {
+        occluded = second;
+        (*values)[i] = second ? 1 : 0;
+        continue;
+      }
       (*values)[i] = second ? 1 : 0;
       if (key == "kinematics") mecanum = second;
       if (key == "wall") {
@@ -151,11 +163,22 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
     if ((key == "wheel_base_m" && mecanum) || ((key == "lx_m" || key == "ly_m") && !mecanum)) continue;
     if (key == "wall_gap_m" && !wall) continue;
     if (key.rfind("push_", 0) == 0 && !push) continue;
+    if (key.rfind("occlusion_", 0) == 0 && !occluded) continue;
     if ((key == "push_lateral_m" && push_turn) || (key == "push_turn_deg" && !push_turn)) continue;
     const double v = f.lo + (f.hi - f.lo) * u;
     (*values)[i] = v;
     if (key == "push_t_s") {
       push_t_s = v;
+    } else if (key == "occlusion_t_s") {
+      occlusion_t_s = v;
+    } else if (key == "occlusion_s") {
+      toml::table ev;
+      ev.insert_or_assign("type", "occlude_dock");
+      ev.insert_or_assign("in_state", "ALIGN");
+      ev.insert_or_assign("t_s", occlusion_t_s);
+      ev.insert_or_assign("duration_s", v);
+      if (!w.contains("events") || !w["events"].is_array()) w.insert_or_assign("events", toml::array{});
+      w["events"].as_array()->push_back(std::move(ev));
     } else if (key == "push_lateral_m" || key == "push_turn_deg") {
       // Each beyond what the push test tolerates (0.3 m, 30°) however the robot stands: a shove without a turn moves
       // the dock seen by the lidar by the shove, and a turn on the spot of 35° or more turns it by as much. A shove
