@@ -95,7 +95,8 @@ TEST(WheelDeadband, AStalledWheelRaisesItsOwnFloorForItsOwnDirectionOnly) {
   d.configure(WheelDeadbandParams{});
   const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
   // The left wheel stands, the right one follows.
-  const std::uint64_t t = hold(d, cmd, wheels(0, static_cast<Real>(0.58)), 0, 480);
+  const std::uint64_t stall_ms = WheelDeadbandParams{}.stall_ms;
+  const std::uint64_t t = hold(d, cmd, wheels(0, static_cast<Real>(0.58)), 0, stall_ms - 20);
   DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(0, false)), kTol);  // not yet stall_ms
   hold(d, cmd, wheels(0, static_cast<Real>(0.58)), t, 40);
   DOUBLES_EQUAL(0.75, static_cast<double>(d.floor_radps(0, false)), kTol);  // 1.25 × 0.6
@@ -108,8 +109,8 @@ TEST(WheelDeadband, AWheelSlowToFollowOrToldNotToLearnIsNoStall) {
   WheelDeadband d;
   d.configure(WheelDeadbandParams{});
   const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
-  // Standing for 300 ms (latency and motor lag), then following: the stall never lasts stall_ms.
-  std::uint64_t t = hold(d, cmd, wheels(0, 0), 0, 300);
+  // Standing for most of stall_ms (latency and motor lag), then following: the stall never lasts stall_ms.
+  std::uint64_t t = hold(d, cmd, wheels(0, 0), 0, WheelDeadbandParams{}.stall_ms - 60);
   t = hold(d, cmd, wheels(static_cast<Real>(0.5), static_cast<Real>(0.5)), t, 2000);
   // Held by something the caller knows of (the dock, an obstacle): nothing is learned however long.
   hold(d, cmd, wheels(0, 0), t, 5000, false);
@@ -154,4 +155,58 @@ TEST(WheelDeadband, ACommandAtItsFloorUpToRoundingStillStalls) {
   e.configure(p);
   hold(e, wheels(static_cast<Real>(0.5), static_cast<Real>(0.5)), wheels(0, 0), 0, 520);
   LONGS_EQUAL(0, e.raises());
+}
+
+// A wheel whose deadband lies inside the range the controller's corrections sweep stands, turns and stands again;
+// no stand lasts stall_ms, but they add up.
+TEST(WheelDeadband, StandsInterruptedByShortTurnsAddUpToAStall) {
+  WheelDeadbandParams p;
+  p.stall_ms = 250;
+  WheelDeadband d;
+  d.configure(p);
+  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  const WheelSpeeds turning = wheels(static_cast<Real>(0.55), static_cast<Real>(0.55));
+  std::uint64_t t = 0;
+  for (int k = 0; k < 2; ++k) {
+    t = hold(d, cmd, wheels(0, static_cast<Real>(0.55)), t, 100);  // the left wheel stands ~100 ms
+    t = hold(d, cmd, turning, t, 60);                              // and turns for a moment
+  }
+  LONGS_EQUAL(0, d.raises());  // about 200 ms stood in all
+  hold(d, cmd, wheels(0, static_cast<Real>(0.55)), t, 100);
+  LONGS_EQUAL(1, d.raises());
+  DOUBLES_EQUAL(0.75, static_cast<double>(d.floor_radps(0, false)), kTol);
+  DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(1, false)), kTol);
+}
+
+// A stand that ends in stall_ms of following was the drive being slow, and a command that stops or turns round
+// starts afresh: neither lets two stands add up.
+TEST(WheelDeadband, FollowingForStallMsOrAStoppedCommandForgetsTheStands) {
+  WheelDeadbandParams p;
+  p.stall_ms = 250;
+  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  const WheelSpeeds standing = wheels(0, 0);
+  {
+    WheelDeadband d;
+    d.configure(p);
+    std::uint64_t t = hold(d, cmd, standing, 0, 200);
+    t = hold(d, cmd, wheels(static_cast<Real>(0.55), static_cast<Real>(0.55)), t, 260);
+    hold(d, cmd, standing, t, 200);
+    LONGS_EQUAL(0, d.raises());
+  }
+  {
+    WheelDeadband d;
+    d.configure(p);
+    std::uint64_t t = hold(d, cmd, standing, 0, 200);
+    t = hold(d, wheels(0, 0), standing, t, 20);
+    hold(d, cmd, standing, t, 200);
+    LONGS_EQUAL(0, d.raises());
+  }
+  {
+    WheelDeadband d;
+    d.configure(p);
+    std::uint64_t t = hold(d, cmd, standing, 0, 200);
+    t = hold(d, wheels(static_cast<Real>(-0.6), static_cast<Real>(-0.6)), standing, t, 20);
+    hold(d, cmd, standing, t, 200);
+    LONGS_EQUAL(0, d.raises());
+  }
 }

@@ -86,6 +86,7 @@ const Factor kFactors[] = {
      "none", "hidden", 0.20},
     {"events", "occlusion_t_s", 0.5, 5.0, "s", "occlusion start after ALIGN began"},
     {"events", "occlusion_s", 0.5, 3.0, "s", "occlusion length"},
+    {"robot.motor", "deadband_diff_radps", -0.4, 0.4, "rad/s", "left minus right wheel deadband (not told)"},
 };
 constexpr std::size_t kFactorCount = sizeof(kFactors) / sizeof(kFactors[0]);
 constexpr std::uint64_t kFamilySalt = 0x63657274696679ull;  // the family's own stream, apart from the run's noise

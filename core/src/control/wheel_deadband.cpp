@@ -42,20 +42,35 @@ void WheelDeadband::observe(const WheelSpeeds& commanded, const WheelSpeeds& mea
     const bool reverse = c < 0;
     // Along the command: a wheel turning the wrong way follows it even less than one standing still.
     const Real along = i < n ? (reverse ? -measured.radps[i] : measured.radps[i]) : 0;
-    // A command scale() raised to the floor equals it only up to rounding: a part in a thousand below still counts.
-    const bool stalled = learn && params_.adapt && a > 0 && a >= kAtFloor * floor_radps_[i][reverse ? 1 : 0] &&
-                         along < kStallShare * a && floor_radps_[i][reverse ? 1 : 0] < params_.max_radps;
-    if (!stalled) {
+    Real& f = floor_radps_[i][reverse ? 1 : 0];
+    if (!learn || !params_.adapt || !(a > 0) || !(f < params_.max_radps) || (s.active && s.reverse != reverse) ||
+        now_us < s.last_us) {
       s.active = false;
       continue;
     }
-    if (!s.active || s.reverse != reverse || now_us < s.since_us) {
-      s = Stall{true, reverse, now_us, a};
+    // A command scale() raised to the floor equals it only up to rounding: a part in a thousand below still counts.
+    // A command under its floor (a wheel meant to stand nearly still in a pivot) says nothing either way.
+    if (a < kAtFloor * f) {
+      s.last_us = now_us;
       continue;
     }
+    const bool stalled = along < kStallShare * a;
+    if (!s.active) {
+      if (stalled) s = Stall{true, reverse, now_us, 0, 0, a};
+      continue;
+    }
+    const std::uint64_t dt_us = now_us - s.last_us;
+    s.last_us = now_us;
+    const std::uint64_t stall_us = static_cast<std::uint64_t>(params_.stall_ms) * 1000u;
+    if (!stalled) {
+      s.following_us += dt_us;
+      if (s.following_us >= stall_us) s.active = false;  // it follows: that stand was the drive being slow
+      continue;
+    }
+    s.following_us = 0;
+    s.stalled_us += dt_us;
     s.min_command_radps = a < s.min_command_radps ? a : s.min_command_radps;
-    if (now_us - s.since_us < static_cast<std::uint64_t>(params_.stall_ms) * 1000u) continue;
-    Real& f = floor_radps_[i][reverse ? 1 : 0];
+    if (s.stalled_us < stall_us) continue;
     const Real grown = kGrowth * (s.min_command_radps > f ? s.min_command_radps : f);
     f = grown < params_.max_radps ? grown : params_.max_radps;
     ++raises_;

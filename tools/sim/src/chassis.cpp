@@ -123,6 +123,7 @@ const char* check_chassis_params(const ChassisParams& p) {
   if (p.motor.latency_steps > kMaxLatencySteps) return "motor.latency_steps exceeds kMaxLatencySteps";
   if (p.motor.time_constant_s < 0) return "motor.time_constant_s must be >= 0";
   if (p.motor.deadband_radps < 0) return "motor.deadband_radps must be >= 0";
+  if (!std::isfinite(p.motor.deadband_diff_radps)) return "motor.deadband_diff_radps must be finite";
   if (p.noise.slip_sigma < 0) return "noise.slip_sigma must be >= 0";
   if (p.noise.encoder_cpr <= 0) return "noise.encoder_cpr must be > 0";
   if (p.noise.speed_window_steps < 1 || p.noise.speed_window_steps > kMaxSpeedWindowSteps)
@@ -207,7 +208,8 @@ void Chassis::step() {
   WheelRadps w_end{};
   for (std::size_t i = 0; i < n_; ++i) {
     double t = target[i];
-    if (std::fabs(t) < m.deadband_radps) t = 0;
+    const double side = is_left_wheel(p_.geometry.kind, i) ? 0.5 : -0.5;
+    if (std::fabs(t) < std::max(0.0, m.deadband_radps + side * m.deadband_diff_radps)) t = 0;
     if (m.max_speed_radps > 0) t = std::clamp(t, -m.max_speed_radps, m.max_speed_radps);
     target[i] = t;
     const double w0 = omega_[i];

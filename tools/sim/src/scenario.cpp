@@ -270,6 +270,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
                       {"max_accel_radps2", p.num(&m.max_accel_radps2, 0, 1e4)},
                       {"max_speed_radps", p.num(&m.max_speed_radps, 0, 1e4)},
                       {"deadband_radps", p.num(&m.deadband_radps, 0, 100)},
+                      {"deadband_diff_radps", p.num(&m.deadband_diff_radps, -100, 100)},
                       {"command_timeout_s", p.num(&m.command_timeout_s, 0, 60)}};
     }));
     h.emplace_back("odometry", p.sub("robot.odometry.", [&]() {

@@ -6,9 +6,12 @@
 /// Each wheel and direction has a floor, rad/s: the slowest command it is known to execute. A command whose turning
 /// wheels sit below their floors is scaled up as a whole, so the path's curvature is kept and the robot still moves
 /// along it, faster. The floors start at the configured deadband and, when adapting, grow from what the drive does:
-/// a wheel commanded at or above its floor that keeps turning at under a quarter of the command for `stall_ms` is
-/// stalled, and its floor becomes 1.25 × the smallest command of that stall, never more than `max_radps`. The caller
-/// judges when a stall may be the drive's (not the dock or an obstacle holding the robot). No heap; O(wheels) per call.
+/// a wheel commanded at or above its floor that turns at under a quarter of the command for `stall_ms` in all is
+/// stalled, and its floor becomes 1.25 × the smallest command of that stall, never more than `max_radps`. The stalled
+/// time adds up over interruptions: a wheel whose deadband sits inside the range the controller's corrections sweep
+/// stands, turns, stands again, and no single stand lasts long. A stall ends without learning when the wheel follows
+/// its command for `stall_ms` without a break, or the command stops or turns round. The caller judges when a stall may
+/// be the drive's (not the dock or an obstacle holding the robot). No heap; O(wheels) per call.
 
 #include <cstdint>
 
@@ -25,9 +28,9 @@ struct WheelDeadbandParams {
   bool adapt = true;
   /// Largest floor learned, rad/s: bounds how fast the slowest creep can become (floor × wheel radius).
   Real max_radps = static_cast<Real>(1.5);
-  /// How long a wheel must be stalled before its floor grows, ms. Longer than the drive's latency plus its motors'
-  /// rise time, so a drive that is only slow to follow is not taken for a stalled one.
-  std::uint16_t stall_ms = 500;
+  /// How long in all a wheel must be stalled before its floor grows, ms. Longer than the drive's latency plus its
+  /// motors' rise time, so a drive that is only slow to follow is not taken for a stalled one.
+  std::uint16_t stall_ms = 250;
 };
 
 class WheelDeadband {
@@ -53,7 +56,8 @@ class WheelDeadband {
 
   /// One control tick's observation, at `now_us`: the wheel speeds the drive was last commanded and those it
   /// measured since (same order and count). `learn` false (the robot may be held by the dock, an obstacle, a
-  /// push; the feedback is stale) ends any stall in progress without learning. O(wheels).
+  /// push; the feedback is stale) ends any stall in progress without learning, and so does a zero or reversed
+  /// command. O(wheels).
   void observe(const WheelSpeeds& commanded, const WheelSpeeds& measured, std::uint64_t now_us, bool learn);
 
   /// The floor of `wheel` (< kMaxDriveWheels) for forward (`reverse` false) or backward rotation, rad/s. O(1).
@@ -65,8 +69,10 @@ class WheelDeadband {
   struct Stall {
     bool active = false;
     bool reverse = false;
-    std::uint64_t since_us = 0;
-    Real min_command_radps = 0;
+    std::uint64_t last_us = 0;       ///< The stall's last observation.
+    std::uint64_t stalled_us = 0;    ///< Time spent not following since the stall began.
+    std::uint64_t following_us = 0;  ///< Time spent following since the last tick that did not.
+    Real min_command_radps = 0;      ///< Smallest command on a stalled tick.
   };
   WheelDeadbandParams params_{};
   Real floor_radps_[kMaxDriveWheels][2] = {};

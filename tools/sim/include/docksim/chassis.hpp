@@ -83,6 +83,9 @@ struct MotorParams {
   double max_speed_radps = 30.0;      ///< Commands are saturated to ±this; <= 0 = unlimited.
   /// Commands with |ω| below this produce no motion (PWM drives do not overcome static friction). 0 = none.
   double deadband_radps = 0.3;
+  /// Left wheels' deadband minus the right ones': they get deadband_radps ± this/2 (each at least 0). Two motors of
+  /// one model rarely stick alike.
+  double deadband_diff_radps = 0.0;
   /// Stop the motors when no command_wheels() arrived for this long (AgileX "communication protection": 0.5 s).
   /// <= 0 = never.
   double command_timeout_s = 0.0;
