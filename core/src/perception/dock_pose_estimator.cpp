@@ -831,12 +831,35 @@ void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
   }
   const Real gate = R(1.5) * params_.range_sigma_m;       // a dock surface is flat to the noise level
   const Real break_m = R(2.5) * params_.range_sigma_m;    // a neighbour this far off the line ends the surface
-  for (std::size_t j = 0; j < profile_.segment_count(); ++j) {
+  // Segments of the same length (a symmetric dock's wings) find the same windows: the first one's kept windows are
+  // staged in the unused tail of hyps_ and pushed again for the others, in the order a pass would find them.
+  const std::size_t segments = profile_.segment_count();
+  auto length_of = [this](std::size_t j) { return (profile_.vertices_m[j + 1] - profile_.vertices_m[j]).norm(); };
+  Real staged_len = -1;
+  std::size_t staged = 0;
+  bool staging = false;
+  for (std::size_t j = 0; j < segments; ++j) {
     const Vec2& a_j = profile_.vertices_m[j];
     const Vec2& b_j = profile_.vertices_m[j + 1];
-    const Real len_j = (b_j - a_j).norm();
+    const Real len_j = length_of(j);
     if (len_j < params_.min_feature_length_m) continue;
     const Vec2 mid_j = (a_j + b_j) * R(0.5);
+    // The staged windows are intact while the hypotheses pushed since have stayed below them; replaying pushes
+    // `staged` more, which must stay below them too.
+    if (staging && len_j == staged_len && *n + 2 * staged <= kMaxHypotheses) {
+      for (std::size_t w = 0; w < staged; ++w) {
+        const Hypothesis h = hyps_[kMaxHypotheses - 1 - w];
+        push_hypothesis(Vec2(h.pose.yaw_rad, h.prescore), Vec2(h.pose.x_m, h.pose.y_m), mid_j, j, n);
+      }
+      continue;
+    }
+    bool stage = false;
+    for (std::size_t k = j + 1; k < segments && !stage; ++k) stage = length_of(k) == len_j;
+    if (stage) {
+      staged_len = len_j;
+      staged = 0;
+      staging = true;
+    }
     const Real half = len_j * R(0.5);
     const Real half_sq = half * half;
     const Real min_span_sq = R(0.49) * len_j * len_j;     // the window spans 70 % of the segment at least
@@ -871,6 +894,13 @@ void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
         if ((centroid - last_kept).squaredNorm() < min_apart_sq) continue;  // neighbours of a kept window add nothing
         last_kept = centroid;
         if (normal.dot(centroid) > 0) normal = -normal;  // face the lidar
+        if (stage && staging) {
+          // A window, not a hypothesis: centroid in the position, normal in the yaw and the prescore.
+          staging = *n + staged + 2 <= kMaxHypotheses;
+          if (staging)
+            hyps_[kMaxHypotheses - 1 - staged++] =
+                Hypothesis{Pose2{centroid.x(), centroid.y(), normal.x()}, normal.y()};
+        }
         push_hypothesis(normal, centroid, mid_j, j, n);
       }
       run_lo = run_hi + 1;
