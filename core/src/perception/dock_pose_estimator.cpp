@@ -383,7 +383,7 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
     // wall points beside the dock left out (the wall explains them, not the dock's sides).
     const bool reuse = last_step_m <= kReuseStepM && n_assoc > 0 && !coarse;
     if (!reuse) {
-      n_assoc = span_beams(dist_m, t, nd);
+      n_assoc = span_beams(dist_m, t, nd, gate);
       // While the steps are large, a sample of a dense span moves the pose as well as every beam would: every
       // stride-th beam, at most kCoarseBeams. Once the steps are small the full span is taken.
       coarse = rough && last_step_m > kReuseStepM && n_assoc > 2 * kCoarseBeams;
@@ -494,11 +494,11 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
   return out;
 }
 
-std::size_t DockPoseEstimatorBase::span_beams(Real dist_m, const Vec2& t, const Vec2& nd) {
+std::size_t DockPoseEstimatorBase::span_beams(Real dist_m, const Vec2& t, const Vec2& nd, Real gate_m) {
   Real lo = 0;
   Real hi = 0;
   placed_.angular_span(&lo, &hi);
-  const Real margin = std::atan2(params_.association_gate_m, dist_m);
+  const Real margin = std::atan2(gate_m, dist_m);
   lo -= margin;
   hi += margin;
   const std::size_t n_beams = static_cast<std::size_t>((hi - lo) / angle_inc_rad_) + 2;

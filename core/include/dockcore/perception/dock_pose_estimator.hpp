@@ -270,9 +270,10 @@ class DockPoseEstimatorBase {
   /// start. O(I · W · S) for I iterations over the W beams of the dock's span and S profile segments.
   Refined refine(const Pose2& initial, bool rough);
   /// Fills the association list (assoc_beam_, no segment yet) with the returns in placed_'s angular span plus the
-  /// association gate's margin, leaving out wall points beside a mounted dock. `t`, `nd`: the dock's position and
-  /// x axis in the lidar frame, `dist_m` = |t|. Returns how many. O(beams in the span).
-  std::size_t span_beams(Real dist_m, const Vec2& t, const Vec2& nd);
+  /// margin that `gate_m` (the iteration's association gate) subtends at the dock, leaving out wall points beside a
+  /// mounted dock. `t`, `nd`: the dock's position and x axis in the lidar frame, `dist_m` = |t|. Returns how many.
+  /// O(beams in the span).
+  std::size_t span_beams(Real dist_m, const Vec2& t, const Vec2& nd, Real gate_m);
   /// Scores a refined candidate (its evidence and counts) and decides. `hint` is the hint in the lidar frame or null.
   void verify(Refined& r, const Pose2* hint);
   /// verify(), then the hint radius: the whole accept decision for one candidate, no counters touched.
