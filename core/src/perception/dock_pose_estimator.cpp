@@ -30,6 +30,13 @@ constexpr std::size_t kPrescoreRays = 32;
 // Beams registration fits at most while its steps are large (above kReuseStepM).
 constexpr std::size_t kCoarseBeams = 64;
 
+// A rough fit is compared with the verified poses after this many iterations and dropped when it lies within
+// kConvergedDuplicateM and kConvergedDuplicateRad of one. Earlier, fits that pass close to a pose can still leave
+// for another; later saves less.
+constexpr std::uint8_t kDuplicateCheckIterations = 2;
+constexpr Real kConvergedDuplicateM = static_cast<Real>(0.005);
+constexpr Real kConvergedDuplicateRad = static_cast<Real>(0.01);
+
 // Association with no segment yet (assoc_seg_).
 constexpr std::uint8_t kNoSegment = 0xFF;
 
@@ -117,6 +124,11 @@ Real dist2(const Pose2& a, const Pose2& b) {
   const Real dx = a.x_m - b.x_m;
   const Real dy = a.y_m - b.y_m;
   return dx * dx + dy * dy;
+}
+
+// Poses within d_m of each other and yaw_rad in heading.
+bool near_pose(const Pose2& a, const Pose2& b, Real d_m, Real yaw_rad) {
+  return dist2(a, b) < d_m * d_m && std::fabs(wrap_angle(a.yaw_rad - b.yaw_rad)) < yaw_rad;
 }
 
 }  // namespace
@@ -356,10 +368,12 @@ long DockPoseEstimatorBase::first_beam(Real angle_rad) const {
   return static_cast<long>(std::floor(rel / angle_inc_rad_ + R(0.5)));
 }
 
-DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initial, bool rough) {
+DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initial, bool rough, const Pose2* verified,
+                                                             std::size_t n_verified) {
   Refined out{};
   out.pose = initial;
   out.ok = false;
+  out.duplicate = false;
   const Real k_huber = params_.huber_k * params_.range_sigma_m;
   const Real c_tukey = params_.tukey_c * params_.range_sigma_m;
   Pose2 pose = initial;
@@ -488,6 +502,16 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
     // metres would spend most iterations on digits below the noise.
     const Real step_sq = delta.dot(h * delta);
     if (!coarse && step_sq < kStopSigmas * kStopSigmas * params_.range_sigma_m * params_.range_sigma_m) break;
+    // A fit that has come this close to a verified pose after a few steps converges onto it: the rest of its
+    // iterations and its verification would only repeat that candidate's.
+    if (it + 1 == kDuplicateCheckIterations) {
+      for (std::size_t q = 0; q < n_verified; ++q) {
+        if (near_pose(pose, verified[q], kConvergedDuplicateM, kConvergedDuplicateRad)) {
+          out.duplicate = true;
+          return out;
+        }
+      }
+    }
   }
   out.pose = pose;
   out.ok = out.iterations > 0;
@@ -1054,11 +1078,11 @@ DockEstimate DockPoseEstimatorBase::estimate(const ScanView& scan, const Pose2& 
       // Hypotheses from the face and the wings of one dock converge to the same pose: refine each dock once.
       bool duplicate = false;
       for (std::size_t q = 0; q < done; ++q) {
-        duplicate = duplicate || (dist2(hyps_[k].pose, verified_poses[q]) < R(0.03 * 0.03) &&
-                                  std::fabs(wrap_angle(hyps_[k].pose.yaw_rad - verified_poses[q].yaw_rad)) < R(0.1));
+        duplicate = duplicate || near_pose(hyps_[k].pose, verified_poses[q], R(0.03), R(0.1));
       }
       if (duplicate) continue;
-      Refined r = refine(hyps_[k].pose, true);
+      Refined r = refine(hyps_[k].pose, true, verified_poses, done);
+      if (r.duplicate) continue;
       decide(r, hint != nullptr ? &hint_lidar : nullptr);
       consider(r, false);
       if (r.ok && done < 8) verified_poses[done++] = r.pose;

@@ -249,6 +249,7 @@ class DockPoseEstimatorBase {
     std::uint8_t iterations;
     DockEvidence evidence;
     bool ok;
+    bool duplicate;  // dropped by refine(): converging onto a verified pose
     RejectReason reject;
   };
   /// Copies a candidate's beam counts and evidence into an estimate (accepted or best refused). O(1).
@@ -267,8 +268,9 @@ class DockPoseEstimatorBase {
   void build_points();
   /// Gauss-Newton registration from `initial` (dock in lidar frame). `rough`: the start may be centimetres off (a
   /// global-search hypothesis), so large steps fit a sample of a dense span; a hint refines on every beam from the
-  /// start. O(I · W · S) for I iterations over the W beams of the dock's span and S profile segments.
-  Refined refine(const Pose2& initial, bool rough);
+  /// start. O(I · W · S) for I iterations over the W beams of the dock's span and S profile segments. A fit that
+  /// comes close to one of the `n_verified` poses in `verified` after a few iterations is abandoned (duplicate set).
+  Refined refine(const Pose2& initial, bool rough, const Pose2* verified = nullptr, std::size_t n_verified = 0);
   /// Fills the association list (assoc_beam_, no segment yet) with the returns in placed_'s angular span plus the
   /// margin that `gate_m` (the iteration's association gate) subtends at the dock, leaving out wall points beside a
   /// mounted dock. `t`, `nd`: the dock's position and x axis in the lidar frame, `dist_m` = |t|. Returns how many.
