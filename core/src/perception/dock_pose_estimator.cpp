@@ -338,13 +338,16 @@ void DockPoseEstimatorBase::wall_behind(const Pose2& pose, long first, std::size
   }
 }
 
-int DockPoseEstimatorBase::continues_past_end(const Vec2& p) const {
+int DockPoseEstimatorBase::continues_past_end(const Vec2& p, const Vec2& box_lo, const Vec2& box_hi) const {
   // A point on the dock itself (e.g. the breakpoint dock's end blocks, in line with its face) is not an extension.
+  // Outside the box it cannot be.
+  const bool in_box = p.x() >= box_lo.x() && p.y() >= box_lo.y() && p.x() <= box_hi.x() && p.y() <= box_hi.y();
   std::size_t near_seg = 0;
   Real near_dist = 0;
   Real line_dist = 0;
   Real overhang_m = 0;
-  if (placed_.nearest(p, &near_seg, &near_dist, &line_dist, &overhang_m) && near_dist <= params_.inlier_gate_m) {
+  if (in_box && placed_.nearest(p, &near_seg, &near_dist, &line_dist, &overhang_m) &&
+      near_dist <= params_.inlier_gate_m) {
     return 0;
   }
   int result = 0;
@@ -393,6 +396,18 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
                                                                                    : params_.inlier_gate_m;
     const Vec2 t(pose.x_m, pose.y_m);
     const Vec2& nd = placed_.x_axis;
+    // A point further than the gate outside the dock's bounding box (grown by a hair, so rounding cannot refuse a
+    // beam the gate would keep) is further than the gate from every segment: no nearest-segment search settles it.
+    // Worth it in a global search, whose rough fits take the beams of clutter beside the dock; a hint's fit sits on
+    // the dock from the start.
+    Vec2 box_lo(-std::numeric_limits<Real>::infinity(), -std::numeric_limits<Real>::infinity());
+    Vec2 box_hi(std::numeric_limits<Real>::infinity(), std::numeric_limits<Real>::infinity());
+    if (rough) {
+      placed_.bounding_box(&box_lo, &box_hi);
+      const Real box_margin = gate * (1 + R(1e-6));
+      box_lo -= Vec2(box_margin, box_margin);
+      box_hi += Vec2(box_margin, box_margin);
+    }
     // The beams to fit: every return in the dock's span plus a margin, taken again early on and kept later, with
     // wall points beside the dock left out (the wall explains them, not the dock's sides).
     const bool reuse = last_step_m <= kReuseStepM && n_assoc > 0 && !coarse;
@@ -435,7 +450,8 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
       // the segments it does not join), its distance is the line distance.
       if (seg != kNoSegment && placed_.visible[seg] && placed_.projects_well_inside(p, seg, shortcut_max_m_[seg], &e)) {
         dist = std::fabs(e);
-      } else if (!placed_.nearest(p, &seg, &dist, &e, &overhang)) {
+      } else if (p.x() < box_lo.x() || p.y() < box_lo.y() || p.x() > box_hi.x() || p.y() > box_hi.y() ||
+                 !placed_.nearest(p, &seg, &dist, &e, &overhang)) {
         continue;
       }
       // Remembered even when refused now: a beam just outside the gate may come in at the next pose.
@@ -597,6 +613,14 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     return x < back_x_m_ + gate && x > back_x_m_ - wall_gap_max_m_ - gate;
   };
   const bool check_band = mount != DockMountKind::kFreeStanding;
+  // The dock's bounding box grown by the inlier gate (and a hair, so rounding cannot move a point off the dock):
+  // a return outside it is not on the dock.
+  Vec2 box_lo;
+  Vec2 box_hi;
+  placed_.bounding_box(&box_lo, &box_hi);
+  const Real box_margin = gate * (1 + R(1e-6));
+  box_lo -= Vec2(box_margin, box_margin);
+  box_hi += Vec2(box_margin, box_margin);
   for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
     std::size_t i = 0;
     if (!beam_at(first, k, &i)) continue;
@@ -641,7 +665,7 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     }
     // An inlier lies on the dock (within the gate along its beam, so within it of the surface): no extension.
     if (m != 0 && !on_dock && !(check_band && wall_band(m * dir_[i]))) {
-      const int ext = continues_past_end(m * dir_[i]);
+      const int ext = continues_past_end(m * dir_[i], box_lo, box_hi);
       if (ext == 1) f.stops += weight(m);
       if (ext == 2) {
         ++r.extensions;

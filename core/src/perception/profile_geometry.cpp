@@ -11,6 +11,7 @@ void PlacedProfile::place(const DockProfile& profile, const Pose2& dock_in_senso
     const Vec2& p = profile.vertices_m[i];
     v_m[i] = Vec2(dock_in_sensor.x_m + c * p.x() - s * p.y(), dock_in_sensor.y_m + s * p.x() + c * p.y());
   }
+
   segments = profile.segment_count();
   for (std::size_t i = 0; i < segments; ++i) {
     const Vec2 d = v_m[i + 1] - v_m[i];
@@ -87,6 +88,17 @@ bool PlacedProfile::nearest(const Vec2& p, std::size_t* segment, Real* distance_
     *signed_line_distance_m = n[best_seg].dot(p) - c_m[best_seg];
   }
   return any;
+}
+
+void PlacedProfile::bounding_box(Vec2* lo_m, Vec2* hi_m) const {
+  Vec2 lo = v_m[0];
+  Vec2 hi = v_m[0];
+  for (std::size_t i = 1; i <= segments; ++i) {
+    lo = lo.cwiseMin(v_m[i]);
+    hi = hi.cwiseMax(v_m[i]);
+  }
+  *lo_m = lo;
+  *hi_m = hi;
 }
 
 void PlacedProfile::angular_span(Real* lo_rad, Real* hi_rad) const {

@@ -319,8 +319,9 @@ class DockPoseEstimatorBase {
   void wall_behind(const Pose2& pose, long first, std::size_t k_first_hit, std::size_t k_last_hit,
                    std::uint16_t* seen, std::uint16_t* looked) const;
   /// For a return p: 0 when it is not 4-12 cm past the end of a long visible segment of placed_ (or lies on the
-  /// dock), 1 when it is but off that segment's line, 2 when it continues the segment's line.
-  int continues_past_end(const Vec2& p) const;
+  /// dock), 1 when it is but off that segment's line, 2 when it continues the segment's line. [box_lo, box_hi]:
+  /// placed_'s bounding box grown by the inlier gate (p outside it is off the dock).
+  int continues_past_end(const Vec2& p, const Vec2& box_lo, const Vec2& box_hi) const;
 
   /// Hypotheses collected per scan before ranking; beyond this they are counted as truncated.
   static constexpr std::size_t kMaxHypotheses = 128;

@@ -37,6 +37,10 @@ struct PlacedProfile {
   bool nearest(const Vec2& p, std::size_t* segment, Real* distance_m, Real* signed_line_distance_m,
                Real* overhang_m) const;
 
+  /// Bounding box of the vertices: a point further than d outside [lo_m, hi_m] is further than d from every
+  /// segment. Cost O(vertices).
+  void bounding_box(Vec2* lo_m, Vec2* hi_m) const;
+
   /// Angular interval [lo, hi] (lo may be < -pi, hi may exceed pi; hi - lo < 2pi) in which the profile's vertices lie
   /// as seen from the sensor origin, relative to no wrap: centre + half widths. Cost O(vertices) atan2 calls.
   void angular_span(Real* lo_rad, Real* hi_rad) const;
