@@ -119,6 +119,12 @@ toml::table& table_at(toml::table& root, const std::string& dotted) {
   return *t;
 }
 
+/// Appends `ev` to the world's [[events]], creating the array when missing.
+void append_event(toml::table& w, toml::table ev) {
+  if (!w.contains("events") || !w["events"].is_array()) w.insert_or_assign("events", toml::array{});
+  w["events"].as_array()->push_back(std::move(ev));
+}
+
 /// Trial `index`'s world: the base scenario with every factor drawn. `values` receives each factor's value (a
 /// discrete factor: 0 or 1; a factor its drive does not have: NaN). Deterministic in (base_seed, index).
 toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64_t base_seed, std::size_t index,
@@ -138,11 +144,6 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
     if (f.first != nullptr) {
       const bool second = u < f.p_second;
       if ((key == "wall_glass" && !wall) || ((key == "push_side" || key == "push_kind") && !push)) continue;
-      if (key == "occlusion") {
-        occluded = second;
-        (*values)[i] = second ? 1 : 0;
-        continue;
-      }
       (*values)[i] = second ? 1 : 0;
       if (key == "kinematics") mecanum = second;
       if (key == "wall") {
@@ -152,6 +153,8 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
         table_at(w, f.table).insert_or_assign(key, second);
       } else if (key == "push") {
         push = second;
+      } else if (key == "occlusion") {
+        occluded = second;
       } else if (key == "push_side") {
         push_side = second ? -1 : 1;
       } else if (key == "push_kind") {
@@ -178,8 +181,7 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
       ev.insert_or_assign("in_state", "ALIGN");
       ev.insert_or_assign("t_s", occlusion_t_s);
       ev.insert_or_assign("duration_s", v);
-      if (!w.contains("events") || !w["events"].is_array()) w.insert_or_assign("events", toml::array{});
-      w["events"].as_array()->push_back(std::move(ev));
+      append_event(w, std::move(ev));
     } else if (key == "push_lateral_m" || key == "push_turn_deg") {
       // Each beyond what the push test tolerates (0.3 m, 30°) however the robot stands: a shove without a turn moves
       // the dock seen by the lidar by the shove, and a turn on the spot of 35° or more turns it by as much. A shove
@@ -192,8 +194,7 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
       ev.insert_or_assign("dx_m", -std::sin(dock_yaw_rad) * lateral_m);
       ev.insert_or_assign("dy_m", std::cos(dock_yaw_rad) * lateral_m);
       ev.insert_or_assign("dyaw_deg", push_turn ? push_side * v : 0.0);
-      if (!w.contains("events") || !w["events"].is_array()) w.insert_or_assign("events", toml::array{});
-      w["events"].as_array()->push_back(std::move(ev));
+      append_event(w, std::move(ev));
     } else {
       table_at(w, f.table).insert_or_assign(key, v);
     }

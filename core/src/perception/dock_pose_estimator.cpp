@@ -126,6 +126,19 @@ Real dist2(const Pose2& a, const Pose2& b) {
   return dx * dx + dy * dy;
 }
 
+// The placed dock's bounding box grown by `gate_m` and a hair, so that rounding cannot refuse a point the gate keeps:
+// a point outside it is further than the gate from every segment.
+void gated_box(const PlacedProfile& placed, Real gate_m, Vec2* lo, Vec2* hi) {
+  placed.bounding_box(lo, hi);
+  const Real margin = gate_m * (1 + R(1e-6));
+  *lo -= Vec2(margin, margin);
+  *hi += Vec2(margin, margin);
+}
+
+bool in_box(const Vec2& p, const Vec2& lo, const Vec2& hi) {
+  return p.x() >= lo.x() && p.y() >= lo.y() && p.x() <= hi.x() && p.y() <= hi.y();
+}
+
 // Poses within d_m of each other and yaw_rad in heading.
 bool near_pose(const Pose2& a, const Pose2& b, Real d_m, Real yaw_rad) {
   return dist2(a, b) < d_m * d_m && std::fabs(wrap_angle(a.yaw_rad - b.yaw_rad)) < yaw_rad;
@@ -341,12 +354,11 @@ void DockPoseEstimatorBase::wall_behind(const Pose2& pose, long first, std::size
 int DockPoseEstimatorBase::continues_past_end(const Vec2& p, const Vec2& box_lo, const Vec2& box_hi) const {
   // A point on the dock itself (e.g. the breakpoint dock's end blocks, in line with its face) is not an extension.
   // Outside the box it cannot be.
-  const bool in_box = p.x() >= box_lo.x() && p.y() >= box_lo.y() && p.x() <= box_hi.x() && p.y() <= box_hi.y();
   std::size_t near_seg = 0;
   Real near_dist = 0;
   Real line_dist = 0;
   Real overhang_m = 0;
-  if (in_box && placed_.nearest(p, &near_seg, &near_dist, &line_dist, &overhang_m) &&
+  if (in_box(p, box_lo, box_hi) && placed_.nearest(p, &near_seg, &near_dist, &line_dist, &overhang_m) &&
       near_dist <= params_.inlier_gate_m) {
     return 0;
   }
@@ -396,18 +408,11 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
                                                                                    : params_.inlier_gate_m;
     const Vec2 t(pose.x_m, pose.y_m);
     const Vec2& nd = placed_.x_axis;
-    // A point further than the gate outside the dock's bounding box (grown by a hair, so rounding cannot refuse a
-    // beam the gate would keep) is further than the gate from every segment: no nearest-segment search settles it.
-    // Worth it in a global search, whose rough fits take the beams of clutter beside the dock; a hint's fit sits on
-    // the dock from the start.
+    // A point outside the gated box needs no nearest-segment search. Worth it in a global search, whose rough fits take
+    // the beams of clutter beside the dock; a hint's fit sits on the dock from the start.
     Vec2 box_lo(-std::numeric_limits<Real>::infinity(), -std::numeric_limits<Real>::infinity());
     Vec2 box_hi(std::numeric_limits<Real>::infinity(), std::numeric_limits<Real>::infinity());
-    if (rough) {
-      placed_.bounding_box(&box_lo, &box_hi);
-      const Real box_margin = gate * (1 + R(1e-6));
-      box_lo -= Vec2(box_margin, box_margin);
-      box_hi += Vec2(box_margin, box_margin);
-    }
+    if (rough) gated_box(placed_, gate, &box_lo, &box_hi);
     // The beams to fit: every return in the dock's span plus a margin, taken again early on and kept later, with
     // wall points beside the dock left out (the wall explains them, not the dock's sides).
     const bool reuse = last_step_m <= kReuseStepM && n_assoc > 0 && !coarse;
@@ -450,8 +455,7 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
       // the segments it does not join), its distance is the line distance.
       if (seg != kNoSegment && placed_.visible[seg] && placed_.projects_well_inside(p, seg, shortcut_max_m_[seg], &e)) {
         dist = std::fabs(e);
-      } else if (p.x() < box_lo.x() || p.y() < box_lo.y() || p.x() > box_hi.x() || p.y() > box_hi.y() ||
-                 !placed_.nearest(p, &seg, &dist, &e, &overhang)) {
+      } else if (!in_box(p, box_lo, box_hi) || !placed_.nearest(p, &seg, &dist, &e, &overhang)) {
         continue;
       }
       // Remembered even when refused now: a beam just outside the gate may come in at the next pose.
@@ -613,14 +617,10 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     return x < back_x_m_ + gate && x > back_x_m_ - wall_gap_max_m_ - gate;
   };
   const bool check_band = mount != DockMountKind::kFreeStanding;
-  // The dock's bounding box grown by the inlier gate (and a hair, so rounding cannot move a point off the dock):
-  // a return outside it is not on the dock.
+  // A return outside the dock's box grown by the inlier gate is not on the dock.
   Vec2 box_lo;
   Vec2 box_hi;
-  placed_.bounding_box(&box_lo, &box_hi);
-  const Real box_margin = gate * (1 + R(1e-6));
-  box_lo -= Vec2(box_margin, box_margin);
-  box_hi += Vec2(box_margin, box_margin);
+  gated_box(placed_, gate, &box_lo, &box_hi);
   for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
     std::size_t i = 0;
     if (!beam_at(first, k, &i)) continue;

@@ -52,6 +52,11 @@ bool is_active_state(TaskState s) {
 
 bool is_zero(const Twist2& t) { return t.vx_mps == 0 && t.vy_mps == 0 && t.wz_radps == 0; }
 
+/// Distance of a pose's origin from the robot's centre (a dock pose in the robot frame), m.
+Real distance_m(const Pose2& p) {
+  return std::sqrt(p.x_m * p.x_m + p.y_m * p.y_m);
+}
+
 }  // namespace
 
 void TaskManager::configure(const TaskParams& params, const FootprintParams& footprint, const DockProfile& profile) {
@@ -89,9 +94,7 @@ bool TaskManager::dock_fresh(const TaskInput& in) const {
   // Far away, odometry carries an estimate over a metre with centimetres of error, less than the lidar's own there,
   // and the next detection on the way in corrects it. ALIGN starts on one detection, confirmed or not: holding still
   // on the view that lost it would not find it again.
-  return age_s <= params_.blind_approach_max_s &&
-         std::sqrt(in.dock.pose.x_m * in.dock.pose.x_m + in.dock.pose.y_m * in.dock.pose.y_m) - front_m >=
-             params_.blind_approach_m;
+  return age_s <= params_.blind_approach_max_s && distance_m(in.dock.pose) - front_m >= params_.blind_approach_m;
 }
 
 bool TaskManager::in_push_zone(const TaskInput& in) const {
@@ -227,7 +230,7 @@ void TaskManager::handle_command(const TaskInput& in, TaskOutput& out) {
 void TaskManager::start_backoff(const TaskInput& in) {
   backoff_start_ = in.odom_pose;
   if (in.dock.valid) {
-    const Real d = std::sqrt(in.dock.pose.x_m * in.dock.pose.x_m + in.dock.pose.y_m * in.dock.pose.y_m);
+    const Real d = distance_m(in.dock.pose);
     backoff_needed_m_ = params_.staging_distance_m > d ? params_.staging_distance_m - d : static_cast<Real>(0);
   } else {
     backoff_needed_m_ = params_.fallback_backoff_m;
@@ -254,7 +257,7 @@ void TaskManager::fail_attempt(FaultCode final_fault, const TaskInput& in, bool 
 
 void TaskManager::run_reach(const TaskInput& in) {
   if (dock_fresh(in)) {
-    start_distance_m_ = std::sqrt(in.dock.pose.x_m * in.dock.pose.x_m + in.dock.pose.y_m * in.dock.pose.y_m);
+    start_distance_m_ = distance_m(in.dock.pose);
     deviation_count_ = 0;
     pushing_ = false;
     push_travel_m_ = 0;
@@ -300,7 +303,7 @@ bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in)
     return false;
   }
   const Pose2& d = det.dock_in_robot;
-  const Real dist = std::sqrt(d.x_m * d.x_m + d.y_m * d.y_m);
+  const Real dist = distance_m(d);
   const FaultCode f = check_pose_deviation(detected, expected, dist, start_distance_m_, params_.deviation);
   if (f == FaultCode::kNone) {
     deviation_count_ = 0;

@@ -159,6 +159,7 @@ Chassis::Chassis(const ChassisParams& params, std::uint64_t seed) : p_(params), 
   for (std::size_t i = 0; i < n_; ++i) {
     const double side = is_left_wheel(p_.geometry.kind, i) ? 0.5 : -0.5;
     odom_radius_m_[i] = p_.geometry.wheel_radius_m * (1.0 + p_.noise.odom_radius_error + side * p_.noise.odom_radius_diff);
+    deadband_radps_[i] = std::max(0.0, p_.motor.deadband_radps + side * p_.motor.deadband_diff_radps);
   }
 
   // Start the slip processes in their stationary distribution so early steps are statistically like late ones.
@@ -208,8 +209,7 @@ void Chassis::step() {
   WheelRadps w_end{};
   for (std::size_t i = 0; i < n_; ++i) {
     double t = target[i];
-    const double side = is_left_wheel(p_.geometry.kind, i) ? 0.5 : -0.5;
-    if (std::fabs(t) < std::max(0.0, m.deadband_radps + side * m.deadband_diff_radps)) t = 0;
+    if (std::fabs(t) < deadband_radps_[i]) t = 0;
     if (m.max_speed_radps > 0) t = std::clamp(t, -m.max_speed_radps, m.max_speed_radps);
     target[i] = t;
     const double w0 = omega_[i];

@@ -298,6 +298,7 @@ class Chassis {
   double ox_ = 0, oy_ = 0, oyaw_ = 0;
   DriveGeometry odom_geom_;
   std::array<double, kMaxWheels> odom_radius_m_{};
+  std::array<double, kMaxWheels> deadband_radps_{};  ///< Each wheel's: deadband_radps ± deadband_diff_radps / 2.
 
   // Dock and charger.
   bool has_dock_ = false;
