@@ -171,8 +171,9 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
   const toml::node* lidar_protocol_node = nullptr;
   // The core structs' keys, with their bounds, come from the parameter table (the same as dock-sim's scenarios).
   namespace params = dockcore::params;
-  const params::ParamTargets targets{&c.drive,   &c.limits,  &c.footprint, &c.task,       &c.estimator, &c.seed000,
-                                     &c.seed004, &c.seed003, &c.smooth,    &c.tag_fusion, &c.watchdog,  &c.deadband};
+  const params::ParamTargets targets{&c.drive,    &c.limits,   &c.footprint, &c.task,     &c.estimator,
+                                     &c.seed000,  &c.seed004,  &c.seed003,   &c.smooth,   &c.tag_fusion,
+                                     &c.watchdog, &c.deadband, nullptr,      &c.intensity};
   auto table_keys = [&](const std::string& table, Handlers h) {
     params::add_params(p, h, table, targets, params::kDockd);
     return h;
@@ -411,7 +412,8 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
       {"lidar", p.sub("lidar.", lidar)},
       {"can", p.sub("can.", can)},
       {"robot", p.sub("robot.", robot)},
-      {"dock", [&](const toml::node& n) {
+      {"dock",
+       [&](const toml::node& n) {
          // [dock] is the single-dock shorthand of [[docks]], plus default_id.
          const toml::table& t = p.table(n);
          DockEntry d;
@@ -451,23 +453,27 @@ DockdConfig parse_config_toml(const std::string& text, const std::string& source
            dock_mountings.push_back(mounting);
          }
        }},
-      {"docks", [&](const toml::node& n) {
+      {"docks",
+       [&](const toml::node& n) {
          const toml::array* a = n.as_array();
          if (a == nullptr) p.fail(n.source(), "docks must be an array of tables ([[docks]])");
          docks_node = &n;
          for (const toml::node& e : *a) dock_entry(e);
        }},
-      {"estimator", p.sub("estimator.", [&]() {
-         // The estimator's tuning; its range keys are in [lidar].
-         return table_keys("estimator", Handlers{
-             {"segments", params::param_sub(p, "estimator.segments", targets, params::kDockd)}});
-       })},
+      {"estimator", p.sub("estimator.",
+                          [&]() {
+                            // The estimator's tuning; its range keys are in [lidar].
+                            return table_keys("estimator",
+                                              Handlers{{"segments", params::param_sub(p, "estimator.segments", targets,
+                                                                                      params::kDockd)}});
+                          })},
       {"controller", p.sub("controller.", controller)},
       {"task", params::param_sub(p, "task", targets, params::kDockd)},
       {"host", p.sub("host.", host)},
       {"camera", p.sub("camera.", camera)},
       {"record", p.sub("record.", record)},
       {"watchdog", p.sub("watchdog.", watchdog)},
+      {"intensity", params::param_sub(p, "intensity", targets, params::kDockd)},
       {"state", p.sub("state.", state)},
       {"log", p.sub("log.", log)},
   };

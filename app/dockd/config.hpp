@@ -122,6 +122,7 @@ struct DockdConfig {
   // [watchdog]
   dockcore::WatchdogParams watchdog{};         ///< [watchdog]: the core's input watch (the parameter table).
   dockcore::WheelDeadbandParams deadband{};    ///< [robot.deadband]: the drive's wheel deadband (the parameter table).
+  dockcore::IntensityCheckParams intensity{};  ///< [intensity]: the lidar intensity check (the parameter table).
   std::uint32_t systemd_watchdog_divider = 2;  ///< WATCHDOG=1 every WatchdogSec / this.
 
   // [state]

@@ -67,6 +67,7 @@ void Daemon::build_core() {
   core_cfg_.control_period_s = static_cast<Real>(kNominalTickUs) * static_cast<Real>(1e-6);
   core_cfg_.watchdog = cfg_.watchdog;
   core_cfg_.deadband = cfg_.deadband;
+  core_cfg_.intensity = cfg_.intensity;
   // The tag fusion: the model's keys, and the camera's mount, focal length and tag size (configure_core adds the
   // active dock's tag).
   core_cfg_.tag = cfg_.tag_fusion;

@@ -99,6 +99,7 @@ void Daemon::status_fields(JsonWriter& w, std::uint64_t now_us) const {
       .uint("lidar_foreign_datagrams", lc.foreign_datagrams)
       .uint("lidar_reconnects", lc.reconnects)
       .uint("lidar_late_scans", core_->inputs().late_scans())
+      .str("lidar_intensity", dockcore::to_string(core_->intensity().verdict()))
       .uint("can_bad_frames", cc.bad_frames)
       .uint("can_send_failures", cc.send_failures)
       .uint("commands", counters_.commands)

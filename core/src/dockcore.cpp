@@ -42,6 +42,7 @@ ConfigureStatus detector_supports(DockDetector detector, const DockProfile& prof
 bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& config) {
   config_ = config;
   watch_.configure(config.watchdog);
+  intensity_.configure(config.intensity);
   filter_ = DockPoseFilter(config.filter);
   tasks_.configure(config.task, config.footprint, profile);
   pending_count_ = 0;
@@ -117,6 +118,7 @@ DockEstimate DockcoreBase::breakpoint_estimate(const ScanView& scan) {
 void DockcoreBase::take_inputs(const DockcoreBase& from) {
   odometry_ = from.odometry_;
   watch_ = from.watch_;  // configure() sets this core's thresholds
+  intensity_ = from.intensity_;
   queue_ = from.queue_;
   have_scan_ = from.have_scan_;
   last_scan_us_ = from.last_scan_us_;
@@ -134,7 +136,9 @@ void DockcoreBase::take_inputs(const DockcoreBase& from) {
 const DockEstimate* DockcoreBase::on_scan(const ScanView& scan, std::uint64_t stamp_us, std::uint64_t now_us) {
   if (stamp_us == 0 || stamp_us > now_us) stamp_us = now_us;  // no stamp, or one from the future: when it was read
   if (!watch_.on_scan(stamp_us, now_us)) return nullptr;
-  return &estimate_scan(scan, stamp_us);
+  const DockEstimate& e = estimate_scan(scan, stamp_us);
+  intensity_.add(scan_);
+  return &e;
 }
 
 const DockEstimate& DockcoreBase::rescan() {

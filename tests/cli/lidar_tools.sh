@@ -1,7 +1,7 @@
 #!/bin/bash
 # ctest: lidar-dump on the checked-in captures gives the expected scans and counters; lidar-emu -> pty -> lidar-dump
 # end to end for ld06 and rplidar: with 5 % corrupted bytes the counters show it and scans still arrive; with 5 %
-# corrupted packets dock-sim detect finds the dock in most scans.
+# corrupted packets dock-sim detect finds the dock in most scans; the intensity verdict is printed (LD06: usable).
 # Usage: lidar_tools.sh LIDAR_DUMP LIDAR_EMU DOCK_SIM SOURCE_DIR WORK_DIR
 set -u
 DUMP=$1 EMU=$2 DOCKSIM=$3 SRC=$4 WORK=$5
@@ -55,7 +55,14 @@ e2e() {  # protocol corrupt-option min_found
     2> "$WORK/$proto.detect.err"
   local found; found=$(grep -c '"found":true' "$WORK/$proto.detect")
   [ "$found" -ge "$min_found" ] || fail "$proto $opt: dock found in $found of $scans scans (< $min_found)"
-  echo "ok: $proto $opt: scans=$scans crc_errors=$crc resyncs=$resyncs dock found in $found"
+  # The simulated LD06's intensities follow the surfaces: the intensity check calls them usable once it has judged a
+  # window of scans (16).
+  if [ "$proto" = ld06 ] && [ "$(jget "$WORK/$proto.e2e.json" intensity_scans_judged)" -ge 16 ]; then
+    [ "$(jget "$WORK/$proto.e2e.json" intensity)" = usable ] \
+      || fail "$proto $opt: intensity $(jget "$WORK/$proto.e2e.json" intensity), expected usable"
+  fi
+  grep -q '^intensity: ' "$WORK/$proto.dump.err" || fail "$proto $opt: no intensity verdict after the counters"
+  echo "ok: $proto $opt: scans=$scans crc_errors=$crc resyncs=$resyncs dock found in $found, intensity $(jget "$WORK/$proto.e2e.json" intensity)"
 }
 e2e ld06 "--corrupt 0.05" 0
 e2e rplidar "--corrupt 0.05" 0

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "dockcore/perception/intensity_check.hpp"
 #include "dockcore/protocols/lidar/lidar_rplidar.hpp"
 
 #include "lidar_capture.hpp"
@@ -516,6 +517,34 @@ TEST(Rplidar, RealCapturesPublishEveryCompleteRotation) {
     total_scans += c.scans;
   }
   std::printf("all: complete rotations %zu, scans %zu\n", total_complete, total_scans);
+}
+
+// A real A1's standard-scan quality reads 15 on nearly every return (the realdata README: 96 % of the flat captures
+// returns, 87 % of the turret's): the intensity check must call every capture flat, never usable.
+TEST(Rplidar, RealA1QualityIsJudgedFlat) {
+  const std::string dir = lidar_test::realdata_dir("Rplidar.RealA1QualityIsJudgedFlat");
+  if (dir.empty()) return;
+  const auto files = real_captures(dir);
+  CHECK(!files.empty());
+  auto scan = std::make_unique<LaserScan>();
+  for (const auto& f : files) {
+    const auto bytes = lidar_test::read_file_bytes(f);
+    auto p = make_parser();
+    IntensityCheck check;
+    double share_sum = 0;
+    for (std::size_t i = 0; i < bytes.size(); ++i) {
+      if (!p->feed(bytes[i], i)) continue;
+      CHECK(p->take_scan(*scan));
+      const IntensityScan r = check.add(scan->view());
+      if (r.judged) share_sum += static_cast<double>(r.share);
+    }
+    std::printf("%s: scans %u, judged %u, flat %u, mean share %.3f, verdict %s\n",
+                std::filesystem::path(f).filename().c_str(), check.scans(), check.scans_judged(), check.scans_flat(),
+                check.scans_judged() > 0 ? share_sum / check.scans_judged() : 0.0, to_string(check.verdict()));
+    CHECK(IntensityVerdict::kUsable != check.verdict());
+    CHECK(check.verdict_changes() <= 1);  // unknown, then flat for good
+    if (check.scans_judged() >= check.params().window_scans) CHECK(IntensityVerdict::kFlat == check.verdict());
+  }
 }
 
 TEST(Rplidar, CorruptedRealCaptureLosesRotationsOnlyNearTheDamage) {

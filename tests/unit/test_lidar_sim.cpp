@@ -8,6 +8,7 @@
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
 #include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/intensity_check.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenes.hpp"
@@ -365,7 +366,8 @@ TEST(LidarSim, IntensityFollowsReflectivityRangeAndIncidence) {
   w.add_polyline({V(1, -0.5), V(1, 0.5)}, false, 0.9);
   w.add_polyline({V(-1, -0.5), V(-1, 0.5)}, false, 0.3);
   w.add_polyline({V(-0.5, 3), V(0.5, 3)}, false, 0.9);
-  const LidarModel m = ideal_model("rplidar-a1");  // Beam 180 = 0°, 0 = -180°, 270 = +90°.
+  LidarModel m = ideal_model("rplidar-a1");    // Beam 180 = 0°, 0 = -180°, 270 = +90°.
+  m.intensity_output = IntensityOutput::kRaw;  // the surface model itself, not the A1's saturated quality
   Rng rng(1);
   static dockcore::LaserScan s;
   simulate_scan(w, Pose2{}, m, rng, &s);
@@ -594,4 +596,53 @@ TEST(Scenes, ClutterSceneHasARoomAroundTheLidarAndTheLookAlikes) {
       CHECK_TRUE(s.ranges_m[i] > 0.3 && s.ranges_m[i] < 10 * std::sqrt(2.0));
     }
   }
+}
+
+// What each model reports as intensity, judged by the core's intensity check as a real sensor's would be: an LD06's
+// 0..255 follows the surfaces and is usable; an RPLIDAR's standard-scan quality saturates at 15 as a real A1's does;
+// express mode's constant 47 is flat and a driver without intensity is absent.
+TEST(LidarSim, IntensityOutputsAreJudgedAsTheRealSensorsAre) {
+  World w = room(1.5);
+  w.add_box(V(0.6, 0.4), 0.3, 0.4, 0.3, 0.9);
+  w.add_circle(V(-0.5, -0.6), 0.1, 12, 0.2);
+  struct Case {
+    const char* model;
+    const char* output;
+    dockcore::IntensityVerdict want;
+  };
+  const Case cases[] = {{"ld06", nullptr, dockcore::IntensityVerdict::kUsable},
+                        {"rplidar-a1", nullptr, dockcore::IntensityVerdict::kFlat},
+                        {"rplidar-a2", "constant", dockcore::IntensityVerdict::kFlat},
+                        {"ld06", "none", dockcore::IntensityVerdict::kAbsent},
+                        {"industrial", nullptr, dockcore::IntensityVerdict::kUsable}};
+  for (const Case& c : cases) {
+    LidarModel m;
+    CHECK(lidar_model(c.model, &m));
+    if (c.output != nullptr) CHECK(intensity_output(c.output, &m.intensity_output));
+    Rng rng(7);
+    dockcore::IntensityCheck check;
+    dockcore::LaserScan scan;
+    for (int k = 0; k < 20; ++k) {
+      const Pose2 pose{static_cast<Real>(0.02 * k - 0.2), static_cast<Real>(-0.1), static_cast<Real>(0.05 * k)};
+      simulate_scan(w, pose, m, rng, &scan);
+      check.add(scan.view());
+    }
+    if (check.verdict() != c.want) {
+      std::printf("%s/%s: %s, last share %.2f of %u\n", c.model, to_string(m.intensity_output),
+                  dockcore::to_string(check.verdict()), static_cast<double>(check.last().share),
+                  static_cast<unsigned>(check.last().returns));
+    }
+    CHECK(check.verdict() == c.want);
+  }
+  dockcore::LaserScan scan;
+  LidarModel m;
+  CHECK(lidar_model("ld06", &m));
+  Rng rng(1);
+  simulate_scan(w, Pose2{}, m, rng, &scan);
+  for (std::size_t i = 0; i < scan.count; ++i) {
+    CHECK(scan.intensities[i] == std::round(scan.intensities[i]));
+    CHECK(scan.intensities[i] >= 0 && scan.intensities[i] <= 255);
+  }
+  IntensityOutput o;
+  CHECK(!intensity_output("bright", &o));
 }

@@ -213,6 +213,9 @@ int run_one(const RunOptions& opt) {
       tl.push_back({{"t_s", r6(e.t_s)}, {"kind", docksim::to_string(e.kind)}, {"code", e.code}, {"text", e.text}});
     }
     j["timeline"] = tl;
+    j["lidar_intensity"] = dockcore::to_string(o.intensity);
+    j["intensity_scans_judged"] = o.intensity_scans_judged;
+    j["intensity_scans_flat"] = o.intensity_scans_flat;
     std::cout << j.dump() << "\n";
   } else {
     std::printf("scenario %s, controller %s, seed %llu\n", sc.name.c_str(), ctl.c_str(),
@@ -234,6 +237,8 @@ int run_one(const RunOptions& opt) {
     std::printf("  path %.2f m, reversals %d, in-place turns > 45 deg %d (largest %.0f deg), retries %d\n",
                 o.path_length_m, o.reversals, o.inplace_turns_45, o.max_inplace_turn_rad * kRadToDeg, o.retries);
     if (std::isfinite(o.min_clearance_m)) std::printf("  minimum obstacle clearance %.3f m\n", o.min_clearance_m);
+    std::printf("  lidar intensity %s (%s: %u of %u judged scans flat)\n", dockcore::to_string(o.intensity),
+                docksim::to_string(sc.lidar.intensity_output), o.intensity_scans_flat, o.intensity_scans_judged);
     for (const auto& kv : o.faults) {
       std::printf("  fault %d %s x%d\n", kv.first, dockcore::to_string(static_cast<dockcore::FaultCode>(kv.first)),
                   kv.second);

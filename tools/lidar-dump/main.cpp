@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dockcore/drivers/lidar_driver.hpp"
+#include "dockcore/perception/intensity_check.hpp"
 #include "dockcore/protocols/lidar/lidar_rplidar.hpp"
 #include "docksim/cli_checks.hpp"
 #include "docksim/scan_io.hpp"
@@ -22,21 +23,39 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
 
-nlohmann::json counters_json(const dockcore::LidarParserCounters& c, std::uint32_t reconnects) {
-  return nlohmann::json{{"scans", c.scans}, {"crc_errors", c.crc_errors}, {"resyncs", c.resyncs},
-                        {"dropped_bytes", c.dropped_bytes}, {"reconnects", reconnects}, {"bytes", c.bytes},
-                        {"bytes_accepted", c.bytes_accepted}, {"packets", c.packets}, {"bad_span", c.bad_span},
-                        {"health_packets", c.health_packets}, {"info_packets", c.info_packets},
-                        {"descriptors", c.descriptors}, {"bad_packets", c.bad_packets}, {"samples", c.samples},
-                        {"samples_discarded", c.samples_discarded}, {"bin_collisions", c.bin_collisions},
-                        {"scans_overwritten", c.scans_overwritten}, {"clock_resyncs", c.clock_resyncs},
-                        {"stray_start", c.stray_start}, {"idle_bytes", c.idle_bytes}};
+nlohmann::json counters_json(const dockcore::LidarParserCounters& c, std::uint32_t reconnects,
+                             const dockcore::IntensityCheck& ic) {
+  return nlohmann::json{{"intensity", dockcore::to_string(ic.verdict())},
+                        {"intensity_scans_judged", ic.scans_judged()},
+                        {"intensity_scans_flat", ic.scans_flat()},
+                        {"scans", c.scans},
+                        {"crc_errors", c.crc_errors},
+                        {"resyncs", c.resyncs},
+                        {"dropped_bytes", c.dropped_bytes},
+                        {"reconnects", reconnects},
+                        {"bytes", c.bytes},
+                        {"bytes_accepted", c.bytes_accepted},
+                        {"packets", c.packets},
+                        {"bad_span", c.bad_span},
+                        {"health_packets", c.health_packets},
+                        {"info_packets", c.info_packets},
+                        {"descriptors", c.descriptors},
+                        {"bad_packets", c.bad_packets},
+                        {"samples", c.samples},
+                        {"samples_discarded", c.samples_discarded},
+                        {"bin_collisions", c.bin_collisions},
+                        {"scans_overwritten", c.scans_overwritten},
+                        {"clock_resyncs", c.clock_resyncs},
+                        {"stray_start", c.stray_start},
+                        {"idle_bytes", c.idle_bytes}};
 }
 
 struct Printer {
   bool csv = false;
   std::uint64_t printed = 0;
+  dockcore::IntensityCheck intensity;  ///< The core's verdict on the sensor's intensity, over the printed scans.
   void print(const dockcore::LaserScan& s) {
+    intensity.add(s.view());
     if (csv) {
       for (std::size_t i = 0; i < s.count; ++i)
         std::printf("%llu,%llu,%zu,%.9g,%.6g,%.6g\n", static_cast<unsigned long long>(printed),
@@ -203,6 +222,13 @@ int main(int argc, char** argv) {
                counters.packets, counters.bad_span, counters.health_packets, counters.info_packets,
                counters.descriptors, counters.bad_packets, counters.samples_discarded, counters.bin_collisions,
                counters.scans_overwritten, counters.clock_resyncs);
+  {
+    const dockcore::IntensityCheck& ic = out.intensity;
+    std::fprintf(stderr, "intensity: %s (%u of %u judged scans flat; last: %.0f %% of %u returns within ±%g of %g)\n",
+                 dockcore::to_string(ic.verdict()), ic.scans_flat(), ic.scans_judged(),
+                 static_cast<double>(ic.last().share) * 100.0, static_cast<unsigned>(ic.last().returns),
+                 static_cast<double>(ic.params().flat_band), static_cast<double>(ic.last().mode));
+  }
   if (*proto == LidarProtocol::kRplidar) {
     // Where every byte went; pending = bytes still buffered in the parser (the byte-accounting identity).
     const auto a = dockcore::rplidar_byte_account(
@@ -216,7 +242,7 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(a.idle_bytes), static_cast<unsigned long long>(a.pending_bytes));
   }
   if (!json_counters.empty()) {
-    const std::string j = counters_json(counters, reconnects).dump();
+    const std::string j = counters_json(counters, reconnects, out.intensity).dump();
     if (json_counters == "-") {
       std::printf("%s\n", j.c_str());
     } else {

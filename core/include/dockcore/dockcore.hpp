@@ -15,7 +15,8 @@
 ///   was taken and what became of it.
 /// - on_scan(): detection with the filter's prediction as the estimator's hint (tracking mode; global search when
 ///   the filter has no dock or the hint fails), then the filter update. The scan is copied so the tick can run the
-///   obstacle check and give controllers (seed003) the latest ranges.
+///   obstacle check and give controllers (seed003) the latest ranges, and the copy's intensities go to the
+///   IntensityCheck (intensity()), which says whether this lidar's intensity can carry evidence.
 /// - tick() also shapes the task manager's twist into what the drive is sent (TickOutput::drive_cmd, ::wheels):
 ///   saturation keeping the path's curvature, the acceleration limit over one control period, a zero twist at once
 ///   (stop, fault, idle: the drive's own limits brake), and the drive's inverse kinematics. Every caller (dockd, the
@@ -59,6 +60,7 @@
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_pose_filter.hpp"
 #include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/intensity_check.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
 #include "dockcore/task/command_queue.hpp"
 #include "dockcore/task/input_watch.hpp"
@@ -117,6 +119,8 @@ struct DockcoreConfig {
   TagFusionParams tag{};
   /// This dock's detector. kBreakpoint uses estimator.range_sigma_m for its covariance (breakpoint_measurement.hpp).
   DockDetector detector = DockDetector::kEstimator;
+  /// When the lidar's intensity counts as usable (IntensityCheck; reported, not yet used by detection).
+  IntensityCheckParams intensity{};
 };
 
 /// Per-tick input from the chassis and the host.
@@ -178,10 +182,11 @@ class DockcoreBase {
 
   /// One scan stamped `stamp_us` (its first sample; 0 or later than `now_us` is taken as `now_us`), read at `now_us`:
   /// the input watch's check (a late scan is not used: nullptr, counted), then detection (the configured detector;
-  /// the estimator's hint = the filter's prediction for the odometry pose at the stamp), filter update, scan copy.
-  /// Feed the chassis feedback up to the scan's time first. Returns the scan's estimate (last_estimate(); from the
-  /// breakpoint detector: found, status, pose and covariance only). Cost: the detector's (the estimator's, or
-  /// BreakpointDetector::detect's O(beams)) plus O(count + Odometry::kHistory).
+  /// the estimator's hint = the filter's prediction for the odometry pose at the stamp), filter update, scan copy,
+  /// intensity check. Feed the chassis feedback up to the scan's time first. Returns the scan's estimate
+  /// (last_estimate(); from the breakpoint detector: found, status, pose and covariance only). Cost: the detector's
+  /// (the estimator's, or BreakpointDetector::detect's O(beams)) plus O(count + Odometry::kHistory +
+  /// IntensityCheck::kMaxSamples).
   const DockEstimate* on_scan(const ScanView& scan, std::uint64_t stamp_us, std::uint64_t now_us);
   /// The latest scan (last_scan()) through detection again, e.g. for a profile configure() just set; copies nothing.
   /// An empty estimate before the first scan. Cost: the detector's.
@@ -194,6 +199,9 @@ class DockcoreBase {
   }
   /// The input watch (staleness, late scans, trips). O(1).
   const InputWatch& inputs() const { return watch_; }
+  /// Whether the lidar's intensity is usable, judged on every scan on_scan() takes (IntensityCheck). It belongs to
+  /// the sensor: configure() keeps its history, take_inputs() carries it. O(1).
+  const IntensityCheck& intensity() const { return intensity_; }
 
   /// Queues a host command for the tick (CommandQueue::submit: a cancel is never lost). O(1).
   SubmitResult submit(const QueuedCommand& c, QueuedCommand* replaced = nullptr) { return queue_.submit(c, replaced); }
@@ -267,6 +275,7 @@ class DockcoreBase {
   DockcoreConfig config_{};
   Odometry odometry_{};
   InputWatch watch_{};
+  IntensityCheck intensity_{};
   CommandQueue queue_{};
   // The resume policy: the dock/undock running now, the one stale input interrupted, resumes this task.
   HostCommand running_{};

@@ -272,6 +272,18 @@ const ParamSpec kTable[] = {
     DC_INT("watchdog", "max_resumes", "–", 0, 20, kBoth, watchdog, max_resumes,
            "Resumes per task; then the fault stays."),
 
+    // [intensity]: IntensityCheckParams, whether the lidar's intensity is usable (docs/lidars.md, "Intensity check").
+    DC_REAL("intensity", "flat_share", "–", 0.51, 1, kBoth, intensity, flat_share,
+            "A scan is flat when at least this share of its returns read within ±`flat_band` of one value."),
+    DC_REAL("intensity", "flat_band", "sensor units", 0, 1000, kBoth, intensity, flat_band,
+            "Half-width of \"one value\" (LD06: 0–255, RPLIDAR quality: 0–63)."),
+    DC_INT("intensity", "min_returns", "–", 1, 256, kBoth, intensity, min_returns,
+           "Scans with fewer returns (of at most 256 sampled) are not judged."),
+    DC_INT("intensity", "window_scans", "–", 1, 32, kBoth, intensity, window_scans,
+           "Judged scans the verdict looks back on."),
+    DC_REAL("intensity", "decide_share", "–", 0.51, 1, kBoth, intensity, decide_share,
+            "The verdict (usable, flat, absent) changes when at least this share of the window agrees."),
+
     // [robot.deadband]: WheelDeadbandParams, the output shaping's wheel deadband (docs/architecture.md).
     DC_REAL("robot.deadband", "known_radps", "rad/s", 0, 20, kBoth, deadband, known_radps,
             "Wheel deadband the drive is known to have: slower commands are scaled up to it (0: none known)."),
@@ -585,8 +597,9 @@ std::string markdown_table(const std::string& table, ParamUse use) {
   WatchdogParams watchdog;
   WheelDeadbandParams deadband;
   DockDetector detector = DockDetector::kEstimator;
-  const ParamTargets defaults{&drive,   &limits, &footprint,  &task,     &estimator, &seed000, &seed004,
-                              &seed003, &smooth, &tag_fusion, &watchdog, &deadband,  &detector};
+  IntensityCheckParams intensity;
+  const ParamTargets defaults{&drive,   &limits, &footprint,  &task,     &estimator, &seed000,  &seed004,
+                              &seed003, &smooth, &tag_fusion, &watchdog, &deadband,  &detector, &intensity};
   apply_defaults(defaults, use);
   std::ostringstream out;
   bool any = false;

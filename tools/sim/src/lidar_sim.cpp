@@ -264,6 +264,54 @@ bool World::raycast(const Vec2& origin, const Vec2& dir, double max_range, doubl
   return true;
 }
 
+const char* to_string(IntensityOutput o) {
+  switch (o) {
+    case IntensityOutput::kRaw:
+      return "raw";
+    case IntensityOutput::kLd06:
+      return "ld06";
+    case IntensityOutput::kRplidarQuality:
+      return "rplidar-quality";
+    case IntensityOutput::kConstant:
+      return "constant";
+    case IntensityOutput::kNone:
+      return "none";
+  }
+  return "raw";
+}
+
+bool intensity_output(const std::string& name, IntensityOutput* out) {
+  for (IntensityOutput o : {IntensityOutput::kRaw, IntensityOutput::kLd06, IntensityOutput::kRplidarQuality,
+                            IntensityOutput::kConstant, IntensityOutput::kNone}) {
+    if (name == to_string(o)) {
+      *out = o;
+      return true;
+    }
+  }
+  return false;
+}
+
+namespace {
+
+/// The sensor's report of a raw model intensity (LidarModel::intensity_output).
+double sensor_intensity(const LidarModel& m, double raw) {
+  switch (m.intensity_output) {
+    case IntensityOutput::kRaw:
+      return raw;
+    case IntensityOutput::kLd06:
+      return std::clamp(std::round(raw), 0.0, 255.0);
+    case IntensityOutput::kRplidarQuality:
+      return std::clamp(std::round(15.0 * raw / m.rplidar_saturation), 0.0, 15.0);
+    case IntensityOutput::kConstant:
+      return 47.0;
+    case IntensityOutput::kNone:
+      return 0.0;
+  }
+  return raw;
+}
+
+}  // namespace
+
 bool lidar_model(const std::string& name, LidarModel* out) {
   LidarModel m;
   m.name = name;
@@ -280,6 +328,7 @@ bool lidar_model(const std::string& name, LidarModel* out) {
     m.dropout_prob = 0.005;
     m.angular_jitter_rad = 0.05 * kDegD;
     m.beam_divergence_rad = 0.3 * kDegD;
+    m.intensity_output = IntensityOutput::kLd06;
   } else if (name == "rplidar-a1") {
     // Slamtec RPLIDAR A1M8: ~1 deg, 5.5 Hz, 0.15-12 m, accuracy ~1 % of range under 3 m.
     m.rate_hz = 5.5;
@@ -293,6 +342,7 @@ bool lidar_model(const std::string& name, LidarModel* out) {
     m.dropout_prob = 0.02;
     m.angular_jitter_rad = 0.1 * kDegD;
     m.beam_divergence_rad = 0.5 * kDegD;
+    m.intensity_output = IntensityOutput::kRplidarQuality;
   } else if (name == "rplidar-a2") {
     // Slamtec RPLIDAR A2M8 at 8000 samples/s and 10 Hz: 800 points (0.45 deg), 0.15-12 m, accuracy ~1 % of range.
     m.rate_hz = 10.0;
@@ -306,6 +356,7 @@ bool lidar_model(const std::string& name, LidarModel* out) {
     m.dropout_prob = 0.01;
     m.angular_jitter_rad = 0.05 * kDegD;
     m.beam_divergence_rad = 0.4 * kDegD;
+    m.intensity_output = IntensityOutput::kRplidarQuality;
   } else if (name == "industrial") {
     // SICK TiM/LMS-class safety-rated scanner: 0.25 deg over 270 deg (1081 beams), 25 Hz, 0.05-30 m, 5 mm.
     m.rate_hz = 25.0;
@@ -374,7 +425,7 @@ void simulate_scan(const World& world, const Pose2& lidar_pose, const LidarModel
     const double q = r / model.intensity_ref_range_m;
     const double intensity = model.intensity_scale * s.reflectivity * cos_incidence(s, dx, dy) / (1.0 + q * q);
     out->ranges_m[i] = static_cast<Real>(r);
-    out->intensities[i] = static_cast<Real>(intensity);
+    out->intensities[i] = static_cast<Real>(sensor_intensity(model, intensity));
   }
 }
 

@@ -110,6 +110,7 @@ struct ParseState {
   int mixed_pixels = -1;
   std::string lidar_model = "ld06";
   const toml::node* lidar_model_node = nullptr;
+  std::string lidar_intensity;  ///< [lidar] intensity, empty: the model's own.
   std::string profile = "plate-v";
   const toml::node* profile_node = nullptr;
   bool mounting_set = false;
@@ -185,9 +186,9 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   // dockcore's parameters: the keys, bounds and defaults of the parameter table, the same as dockd's config. The
   // obstacle footprint's body is derived from the chassis below.
   namespace params = dockcore::params;
-  const params::ParamTargets targets{nullptr,      &sc.limits,   &sc.safety,  &sc.task,   &sc.estimator,
-                                     &sc.seed000,  &sc.seed004,  &sc.seed003, &sc.smooth, &sc.tag_fusion,
-                                     &sc.watchdog, &sc.deadband, &sc.detector};
+  const params::ParamTargets targets{nullptr,      &sc.limits,   &sc.safety,   &sc.task,     &sc.estimator,
+                                     &sc.seed000,  &sc.seed004,  &sc.seed003,  &sc.smooth,   &sc.tag_fusion,
+                                     &sc.watchdog, &sc.deadband, &sc.detector, &sc.intensity};
   params::apply_defaults(targets, params::kScenario);
   auto table_keys = [&](const std::string& table, Handlers h) {
     params::add_params(p, h, table, targets, params::kScenario);
@@ -303,6 +304,10 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         {"dropout", [&](const toml::node& n) { st.lidar_dropout = p.number(n, 0, 1); }},
         {"angular_jitter_deg", [&](const toml::node& n) { st.lidar_jitter_rad = p.number(n, 0, 10) * kDeg; }},
         {"mixed_pixels", [&](const toml::node& n) { st.mixed_pixels = p.boolean(n) ? 1 : 0; }},
+        {"intensity",
+         [&](const toml::node& n) {
+           st.lidar_intensity = p.choice(n, {"raw", "ld06", "rplidar-quality", "constant", "none"});
+         }},
         {"rate_hz", [&](const toml::node& n) { st.lidar_rate_hz = p.number(n, 0.5, 100); }},
         // The sensor's range, under the name of dockd's [lidar] range key: it takes that key's bounds.
         {"max_range_m", params::bounded_by(p, "lidar", "max_range_m", &st.lidar_max_range_m)},
@@ -583,6 +588,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
                           })},
       {"host", p.sub("host.", host_handlers)},
       {"watchdog", params::param_sub(p, "watchdog", targets, params::kScenario)},
+      {"intensity", params::param_sub(p, "intensity", targets, params::kScenario)},
       {"controller", p.sub("controller.", controller_handlers)},
       {"camera", p.sub("camera.",
                        [&]() {
@@ -613,6 +619,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   if (st.mixed_pixels >= 0) sc.lidar.mixed_pixels = st.mixed_pixels == 1;
   if (st.lidar_rate_hz > 0) sc.lidar.rate_hz = st.lidar_rate_hz;
   if (st.lidar_max_range_m > 0) sc.lidar.max_range_m = st.lidar_max_range_m;
+  if (!st.lidar_intensity.empty()) intensity_output(st.lidar_intensity, &sc.lidar.intensity_output);
 
   sc.profile_name = st.profile;
   {

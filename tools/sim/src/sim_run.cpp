@@ -181,6 +181,7 @@ dockcore::DockcoreConfig core_config(const Scenario& sc) {
   cfg.control_period_s = static_cast<Real>(sc.chassis.dt_s * kStepsPerTick);
   cfg.watchdog = sc.watchdog;
   cfg.deadband = sc.deadband;
+  cfg.intensity = sc.intensity;
   cfg.detector = sc.detector;
   return cfg;
 }
@@ -686,6 +687,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   out.camera_rendered = rendered;
   out.camera_frames = camera.frames_delivered();
   out.camera_detections = camera.frames_with_target();
+  out.intensity = core->intensity().verdict();
+  out.intensity_scans_judged = core->intensity().scans_judged();
+  out.intensity_scans_flat = core->intensity().scans_flat();
   const ChassisState& fs = chassis.state();
   out.end_time_s = static_cast<double>(k) * dt;
   out.final_state = prev_state;

@@ -195,6 +195,7 @@ struct Scenario {
   dockcore::TagFusionParams tag_fusion{};  ///< [camera.fusion]: the tag covariance model (the parameter table).
   dockcore::WatchdogParams watchdog{};     ///< [watchdog]: the core's input watch (the parameter table).
   dockcore::WheelDeadbandParams deadband{};  ///< [robot.deadband]: what dockcore knows and learns of the deadband.
+  dockcore::IntensityCheckParams intensity{};  ///< [intensity]: the lidar intensity check (the parameter table).
 
   // Lidar.
   LidarModel lidar{};

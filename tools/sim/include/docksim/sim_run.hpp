@@ -117,6 +117,10 @@ struct SimOutcome {
   std::uint64_t camera_detections = 0;
   std::uint64_t tags_fused = 0;
   std::uint64_t tags_refused = 0;
+  /// The core's verdict on the lidar's intensity at the end (Dockcore::intensity()), and its judged and flat scans.
+  dockcore::IntensityVerdict intensity = dockcore::IntensityVerdict::kUnknown;
+  std::uint32_t intensity_scans_judged = 0;
+  std::uint32_t intensity_scans_flat = 0;
 };
 
 struct SimRun {

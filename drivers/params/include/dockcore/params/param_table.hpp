@@ -54,6 +54,7 @@ struct ParamTargets {
   WatchdogParams* watchdog = nullptr;
   WheelDeadbandParams* deadband = nullptr;
   DockDetector* detector = nullptr;  ///< One dock's detector (dockd: each [[docks]] entry; a scenario: [dock]).
+  IntensityCheckParams* intensity = nullptr;  ///< [intensity]: the lidar intensity check.
 };
 
 /// One parameter.
