@@ -178,6 +178,27 @@ TEST(WheelDeadband, StandsInterruptedByShortTurnsAddUpToAStall) {
   DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(1, false)), kTol);
 }
 
+// The stiffer wheel of a creep: the heading corrections carry its command above its deadband, where it turns for
+// longer than stall_ms, and below it, where it stands again. Turning faster than it stood says nothing of a deadband
+// below, so the stands still add up, and the floor comes from the latest stand (the first one, a start from rest at a
+// smaller command, would teach a floor the wheel still stands above).
+TEST(WheelDeadband, TurningFasterThanItStoodKeepsTheStandsAndTheLatestOneSetsTheFloor) {
+  WheelDeadbandParams p;
+  p.stall_ms = 250;
+  WheelDeadband d;
+  d.configure(p);
+  const auto both = [](Real radps) { return wheels(radps, radps); };
+  const auto left_stands = [](Real radps) { return wheels(0, radps); };
+  std::uint64_t t = hold(d, both(static_cast<Real>(0.3)), left_stands(static_cast<Real>(0.3)), 0, 140);  // 140 ms
+  t = hold(d, both(static_cast<Real>(0.9)), both(static_cast<Real>(0.88)), t, 400);       // turns well past stall_ms
+  t = hold(d, both(static_cast<Real>(0.7)), left_stands(static_cast<Real>(0.7)), t, 80);  // 100 ms more
+  LONGS_EQUAL(0, d.raises());
+  hold(d, both(static_cast<Real>(0.7)), left_stands(static_cast<Real>(0.7)), t, 20);
+  LONGS_EQUAL(1, d.raises());
+  DOUBLES_EQUAL(0.875, static_cast<double>(d.floor_radps(0, false)), kTol);  // 1.25 × 0.7, not × 0.3
+  DOUBLES_EQUAL(0.0, static_cast<double>(d.floor_radps(1, false)), kTol);
+}
+
 // A stand that ends in stall_ms of following was the drive being slow, and a command that stops or turns round
 // starts afresh: neither lets two stands add up.
 TEST(WheelDeadband, FollowingForStallMsOrAStoppedCommandForgetsTheStands) {

@@ -56,17 +56,25 @@ void WheelDeadband::observe(const WheelSpeeds& commanded, const WheelSpeeds& mea
     }
     const bool stalled = along < kStallShare * a;
     if (!s.active) {
-      if (stalled) s = Stall{true, reverse, now_us, 0, 0, a};
+      if (stalled) s = Stall{true, reverse, false, now_us, 0, 0, a};
       continue;
     }
     const std::uint64_t dt_us = now_us - s.last_us;
     s.last_us = now_us;
     const std::uint64_t stall_us = static_cast<std::uint64_t>(params_.stall_ms) * 1000u;
     if (!stalled) {
-      s.following_us += dt_us;
-      if (s.following_us >= stall_us) s.active = false;  // it follows: that stand was the drive being slow
+      // Following a command the wheel stood at shows that stand was the drive being slow. Following a larger one
+      // says nothing of a deadband below it: the stiffer wheel of a creep whose heading corrections carry it in and
+      // out of its deadband stands below it and turns above it, and its stands must still add up.
+      if (kAtFloor * a <= s.min_command_radps) s.following_us += dt_us;
+      if (s.following_us >= stall_us) s.active = false;
+      s.turned = true;
       continue;
     }
+    // A stand after turning bounds the deadband by its own commands: an earlier stand's smaller ones may have been a
+    // start from rest, slow to follow, and would teach a floor the wheel still stands above.
+    if (s.turned) s.min_command_radps = a;
+    s.turned = false;
     s.following_us = 0;
     s.stalled_us += dt_us;
     s.min_command_radps = a < s.min_command_radps ? a : s.min_command_radps;

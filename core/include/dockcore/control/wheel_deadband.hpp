@@ -7,11 +7,12 @@
 /// wheels sit below their floors is scaled up as a whole, so the path's curvature is kept and the robot still moves
 /// along it, faster. The floors start at the configured deadband and, when adapting, grow from what the drive does:
 /// a wheel commanded at or above its floor that turns at under a quarter of the command for `stall_ms` in all is
-/// stalled, and its floor becomes 1.25 × the smallest command of that stall, never more than `max_radps`. The stalled
-/// time adds up over interruptions: a wheel whose deadband sits inside the range the controller's corrections sweep
-/// stands, turns, stands again, and no single stand lasts long. A stall ends without learning when the wheel follows
-/// its command for `stall_ms` without a break, or the command stops or turns round. The caller judges when a stall may
-/// be the drive's (not the dock or an obstacle holding the robot). No heap; O(wheels) per call.
+/// stalled, and its floor becomes 1.25 × the smallest command of its latest stand, never more than `max_radps`. The
+/// stalled time adds up over interruptions: a wheel whose deadband sits inside the range the controller's corrections
+/// sweep stands below it, turns above it, stands again, and no single stand lasts long. A stall ends without learning
+/// when the wheel follows, for `stall_ms` without a break, commands no larger than the smallest of its latest stand
+/// (turning faster says nothing of a deadband below), or when the command stops or turns round. The caller judges when
+/// a stall may be the drive's (not the dock or an obstacle holding the robot). No heap; O(wheels) per call.
 
 #include <cstdint>
 
@@ -69,10 +70,11 @@ class WheelDeadband {
   struct Stall {
     bool active = false;
     bool reverse = false;
+    bool turned = false;             ///< Followed since the last stalled tick: the next one begins a new stand.
     std::uint64_t last_us = 0;       ///< The stall's last observation.
     std::uint64_t stalled_us = 0;    ///< Time spent not following since the stall began.
-    std::uint64_t following_us = 0;  ///< Time spent following since the last tick that did not.
-    Real min_command_radps = 0;      ///< Smallest command on a stalled tick.
+    std::uint64_t following_us = 0;  ///< Time spent following a command stood at, since the last stalled tick.
+    Real min_command_radps = 0;      ///< Smallest command on a stalled tick of the latest stand.
   };
   WheelDeadbandParams params_{};
   Real floor_radps_[kMaxDriveWheels][2] = {};
