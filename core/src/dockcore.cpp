@@ -136,9 +136,13 @@ void DockcoreBase::take_inputs(const DockcoreBase& from) {
 const DockEstimate* DockcoreBase::on_scan(const ScanView& scan, std::uint64_t stamp_us, std::uint64_t now_us) {
   if (stamp_us == 0 || stamp_us > now_us) stamp_us = now_us;  // no stamp, or one from the future: when it was read
   if (!watch_.on_scan(stamp_us, now_us)) return nullptr;
-  const DockEstimate& e = estimate_scan(scan, stamp_us);
-  intensity_.add(scan_);
-  return &e;
+  // The sensor's intensity is judged before detection reads it. Until there is a verdict a reflector dock's stripes
+  // are read: taking the geometry alone then would accept another dock of the same shape, and the switch to the
+  // right one once the verdict came would look like a push.
+  intensity_.add(scan);
+  const IntensityVerdict v = intensity_.verdict();
+  estimator_.set_intensity_usable(v == IntensityVerdict::kUsable || v == IntensityVerdict::kUnknown);
+  return &estimate_scan(scan, stamp_us);
 }
 
 const DockEstimate& DockcoreBase::rescan() {

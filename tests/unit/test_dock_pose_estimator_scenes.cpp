@@ -1,8 +1,10 @@
 // DockPoseEstimator on the simulator's scenes: every built-in profile noiseless and noisy (against the Cramér–Rao
 // bound), the scan seam, mount poses, two docks, occlusion, look-alikes, hints, tracking, determinism and a board-sized
 // owner. Its refusals of empty and malformed scans and the placed-profile queries are test_dock_pose_estimator.
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <initializer_list>
 #include <vector>
 
 #include "dockcore/perception/dock_pose_estimator.hpp"
@@ -289,4 +291,88 @@ TEST(DockPoseEstimator, SmallCapacityOwnerGivesTheSameEstimate) {
   const DockEstimate c = small.estimate(g_scan.view(), Pose2{});
   CHECK_EQUAL(static_cast<int>(EstimateStatus::kBadScan), static_cast<int>(c.status));
   CHECK_EQUAL(1u, small.counters().bad_scans);
+}
+
+namespace {
+
+/// plate-v with retro-reflective stripes on its 0.30 m face (segment 1), at [from, to] metres along it.
+DockProfile coded_plate(std::initializer_list<std::pair<double, double>> stripes) {
+  DockProfile p = profile("plate-v");
+  for (const auto& s : stripes) {
+    ReflectorStripe r;
+    r.segment = 1;
+    r.from_m = static_cast<Real>(s.first);
+    r.to_m = static_cast<Real>(s.second);
+    CHECK_EQUAL(static_cast<int>(ProfileError::kOk), static_cast<int>(add_reflector(p, r)));
+  }
+  return p;
+}
+
+double cue(const DockEstimate& e, EvidenceCue c) {
+  return static_cast<double>(e.evidence.cue_nats[static_cast<std::size_t>(c)]);
+}
+
+}  // namespace
+
+// A reflector dock's stripes are read from the LD06's intensities: the dock with its own stripe pattern gains
+// evidence, the same shape with another pattern (another dock's code) or without tape loses so much that it is
+// refused, and without usable intensity the decision is geometric (the cue is 0).
+TEST(DockPoseEstimator, ReflectorStripesTellDocksOfOneShapeApart) {
+  const DockProfile code_a = coded_plate({{0.02, 0.08}, {0.12, 0.18}, {0.22, 0.28}});
+  const DockProfile code_b = coded_plate({{0.02, 0.08}, {0.22, 0.28}});
+  const DockProfile plain = profile("plate-v");
+  docksim::LidarModel m = ld06(0.005);
+  int a_found = 0, b_found = 0, plain_found = 0, n = 0;
+  double a_cue_min = 1e9, b_cue_max = -1e9, plain_cue_max = -1e9;
+  for (double dist : {0.5, 0.9, 1.3}) {
+    for (double bearing_deg : {-20.0, 0.0, 20.0}) {
+      for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+        const Truth t = simulate(code_a, dist, deg_to_rad(bearing_deg), deg_to_rad(10.0), m, seed);
+        ++n;
+        g_est.configure(code_a, EstimatorParams{});
+        g_est.set_intensity_usable(true);
+        const DockEstimate a = g_est.estimate(g_scan.view(), Pose2{});
+        if (a.found) {
+          ++a_found;
+          check_close(t.dock_in_lidar, a, 0.03, deg_to_rad(5.0), "code a");
+          a_cue_min = std::min(a_cue_min, cue(a, EvidenceCue::kIntensity));
+          CHECK(a.evidence.features.regions_matched >= 3);
+          CHECK_EQUAL(0, a.evidence.features.regions_mismatched);
+        }
+        g_est.configure(code_b, EstimatorParams{});
+        g_est.set_intensity_usable(true);
+        const DockEstimate b = g_est.estimate(g_scan.view(), Pose2{});
+        if (b.found) ++b_found;
+        b_cue_max = std::max(b_cue_max, cue(b, EvidenceCue::kIntensity));
+        // The geometry alone: the same scan is a dock of code b's shape.
+        g_est.set_intensity_usable(false);
+        const DockEstimate g = g_est.estimate(g_scan.view(), Pose2{});
+        CHECK(g.found);
+        DOUBLES_EQUAL(0.0, cue(g, EvidenceCue::kIntensity), 0.0);
+        CHECK_EQUAL(0, g.evidence.features.regions_matched + g.evidence.features.regions_mismatched);
+      }
+      // The same shape with no tape at all is not the coded dock.
+      simulate(plain, dist, deg_to_rad(bearing_deg), deg_to_rad(10.0), m, 9);
+      g_est.configure(code_a, EstimatorParams{});
+      g_est.set_intensity_usable(true);
+      const DockEstimate p = g_est.estimate(g_scan.view(), Pose2{});
+      if (p.found) ++plain_found;
+      plain_cue_max = std::max(plain_cue_max, cue(p, EvidenceCue::kIntensity));
+    }
+  }
+  std::printf(
+      "\ncode a found %d/%d (intensity cue >= %.1f nats); as code b %d (cue <= %.1f); untaped %d/9 (cue <= %.1f)\n",
+      a_found, n, a_cue_min, b_found, b_cue_max, plain_found, plain_cue_max);
+  CHECK_EQUAL(n, a_found);
+  CHECK(a_cue_min > 2.0);
+  CHECK_EQUAL(0, b_found);
+  CHECK(b_cue_max < 0.0);
+  CHECK_EQUAL(0, plain_found);
+  // A profile without reflectors never reads intensities: its evidence is the geometric one.
+  simulate(plain, 0.9, 0, 0, m, 1);
+  g_est.configure(plain, EstimatorParams{});
+  g_est.set_intensity_usable(true);
+  const DockEstimate q = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK(q.found);
+  DOUBLES_EQUAL(0.0, cue(q, EvidenceCue::kIntensity), 0.0);
 }

@@ -646,3 +646,49 @@ TEST(LidarSim, IntensityOutputsAreJudgedAsTheRealSensorsAre) {
   IntensityOutput o;
   CHECK(!intensity_output("bright", &o));
 }
+
+// Retro-reflective tape saturates an LD06 at every docking range and at incidences up to the cut-off; the face
+// around it reads as diffuse, and a beam whose footprint straddles a stripe's end reads in between.
+TEST(LidarSim, TapeReadsSaturatedTheFaceDiffuseAndItsEdgesInBetween) {
+  dockcore::DockProfile p;
+  CHECK(dockcore::builtin_profile("plate-v", p) == dockcore::ProfileError::kOk);
+  dockcore::ReflectorStripe st;
+  st.segment = 1;
+  st.from_m = static_cast<Real>(0.10);
+  st.to_m = static_cast<Real>(0.20);
+  CHECK(dockcore::add_reflector(p, st) == dockcore::ProfileError::kOk);
+  LidarModel m = ideal_model("ld06");
+  m.beams = 3600;  // 0.1°: several beams on the stripe and on its ends
+  m.angle_increment_rad = 2 * kPi / 3600;
+  for (const double dist : {0.4, 1.2, 2.4}) {
+    for (const double yaw_deg : {0.0, 40.0}) {
+      World w;
+      w.add_dock(p, Pose2{static_cast<Real>(dist), 0, static_cast<Real>(kPi + yaw_deg * kDeg)}, 0.8);
+      CHECK(w.has_retro());
+      Rng rng(1);
+      static dockcore::LaserScan s;
+      simulate_scan(w, Pose2{}, m, rng, &s);
+      int tape = 0, face = 0, between = 0;
+      for (std::size_t i = 0; i < s.count; ++i) {
+        if (s.ranges_m[i] <= 0) continue;
+        const double v = static_cast<double>(s.intensities[i]);
+        if (v >= 255)
+          ++tape;
+        else if (v < 235)
+          ++face;
+        else
+          ++between;
+      }
+      CHECK_TEXT(tape >= 3, "tape beams");
+      CHECK_TEXT(face >= 10, "face beams");
+      CHECK(between <= 4);  // only footprints straddling a stripe end
+    }
+  }
+  // Past the cut-off angle the tape is an ordinary surface.
+  World w;
+  w.add_dock(p, Pose2{static_cast<Real>(1.0), 0, static_cast<Real>(kPi + 70 * kDeg)}, 0.8);
+  Rng rng(1);
+  static dockcore::LaserScan s;
+  simulate_scan(w, Pose2{}, ideal_model("ld06"), rng, &s);
+  for (std::size_t i = 0; i < s.count; ++i) CHECK(s.intensities[i] < 235);
+}

@@ -237,3 +237,37 @@ TEST(ProfileFile, OutlinesCheckProfileRefusesArePositioned) {
   // Every outward normal points away from the front.
   check_position("points = [[0, 0.2], [0, -0.2]]\n", 1, 10, "no surface faces the front");
 }
+
+TEST(ProfileFile, ReflectorsAreReadInOrderAndRoundTrip) {
+  const std::string text =
+      "points = [[-0.05, -0.2], [0, -0.15], [0, 0.15], [-0.05, 0.2]]\n"
+      "[[reflectors]]\nsegment = 1\nfrom_m = 0.20\nto_m = 0.30\n"
+      "[[reflectors]]\nsegment = 1\nfrom_m = 0\nto_m = 0.1\n";
+  const DockProfile p = parse_profile_toml(text, "t.toml");
+  CHECK_EQUAL(2u, p.reflector_count);
+  CHECK_EQUAL(1, p.reflectors[0].segment);
+  REAL_EQUAL(0.0, p.reflectors[0].from_m, 1e-12);  // in order along the outline, whatever the file's order
+  REAL_EQUAL(0.30, p.reflectors[1].to_m, 1e-6);
+  const DockProfile q = parse_profile_toml(docksim::profile_to_toml(p), "rt.toml");
+  CHECK_EQUAL(2u, q.reflector_count);
+  for (std::size_t i = 0; i < 2; ++i) {
+    CHECK_EQUAL(p.reflectors[i].segment, q.reflectors[i].segment);
+    REAL_EQUAL(p.reflectors[i].from_m, q.reflectors[i].from_m, 1e-9);
+    REAL_EQUAL(p.reflectors[i].to_m, q.reflectors[i].to_m, 1e-9);
+  }
+}
+
+TEST(ProfileFile, BadReflectorsArePositioned) {
+  const std::string pts = "points = [[-0.05, -0.2], [0, -0.15], [0, 0.15], [-0.05, 0.2]]\n";
+  check_position(pts + "[[reflectors]]\nsegment = 3\nfrom_m = 0\nto_m = 0.05\n", 2, 1, "segment 3 does not exist");
+  check_position(pts + "[[reflectors]]\nsegment = 1\nfrom_m = 0.25\nto_m = 0.35\n", 2, 1, "past the end of segment 1");
+  check_position(pts + "[[reflectors]]\nsegment = 1\nfrom_m = 0.1\nto_m = 0.105\n", 2, 1, "shorter than 1 cm");
+  check_position(pts +
+                     "[[reflectors]]\nsegment = 1\nfrom_m = 0\nto_m = 0.1\n[[reflectors]]\nsegment = 1\n"
+                     "from_m = 0.05\nto_m = 0.15\n",
+                 6, 1, "overlaps another reflector");
+  check_position(pts + "[[reflectors]]\nsegment = 1\nfrom_m = 0\n", 2, 1, "needs segment, from_m and to_m");
+  check_position(pts + "[[reflectors]]\nsegment = 1\nfrom_m = 0\nto_m = 0.1\nwidth_m = 3\n", 6, 1,
+                 "unknown key 'reflectors.width_m'");
+  check_position(pts + "reflectors = 3\n", 2, 14, "array of tables");
+}

@@ -433,3 +433,21 @@ TEST(Scenario, TheDockTakesItsDetector) {
   STRCMP_CONTAINS("s.toml:3:12: dock.detector = \"breakpoint\": detector breakpoint finds only the breakpoint dock",
                   mismatch.what());
 }
+
+TEST(Scenario, AnotherDockStandsBesideTheDockWithItsOwnTape) {
+  const docksim::Scenario sc = docksim::load_scenario_file(scenario_dir() + "two-docks.toml");
+  CHECK_EQUAL(2u, sc.profile.reflector_count);
+  CHECK_EQUAL(1u, sc.other_docks.size());
+  const docksim::Scenario::OtherDock& d = sc.other_docks[0];
+  CHECK_EQUAL(1u, d.profile.reflector_count);
+  REAL_EQUAL(0.0, d.pose.x_m, 1e-9);  // the same outline: back planes aligned, origins level
+  REAL_EQUAL(1.0, d.pose.y_m, 1e-3);  // centres 1 m apart, on the dock's left
+  REAL_EQUAL(0.0, d.pose.yaw_rad, 1e-12);
+  // The world holds both docks' tape: one retro piece per stripe.
+  const docksim::World w = docksim::scenario_world(sc);
+  int retro = 0;
+  for (const auto& s : w.segments) retro += s.retro ? 1 : 0;
+  CHECK_EQUAL(3, retro);
+  refused_at("[[dock.furniture]]\nkind = \"dock\"\nside = \"left\"\n", 1, 1, "kind dock without 'profile'");
+  refused_at("[[dock.furniture]]\nkind = \"dock\"\nprofile = \"round\"\n", 3, 11, "dock.furniture.profile");
+}

@@ -15,8 +15,10 @@
 ///   was taken and what became of it.
 /// - on_scan(): detection with the filter's prediction as the estimator's hint (tracking mode; global search when
 ///   the filter has no dock or the hint fails), then the filter update. The scan is copied so the tick can run the
-///   obstacle check and give controllers (seed003) the latest ranges, and the copy's intensities go to the
-///   IntensityCheck (intensity()), which says whether this lidar's intensity can carry evidence.
+///   obstacle check and give controllers (seed003) the latest ranges. Before detection the scan's intensities go to
+///   the IntensityCheck (intensity()): the estimator reads a reflector dock's stripes (EvidenceCue::kIntensity)
+///   unless it calls them flat or absent (so also before its first verdict: the geometry alone would take another
+///   dock of the same shape).
 /// - tick() also shapes the task manager's twist into what the drive is sent (TickOutput::drive_cmd, ::wheels):
 ///   saturation keeping the path's curvature, the acceleration limit over one control period, a zero twist at once
 ///   (stop, fault, idle: the drive's own limits brake), and the drive's inverse kinematics. Every caller (dockd, the
@@ -119,7 +121,8 @@ struct DockcoreConfig {
   TagFusionParams tag{};
   /// This dock's detector. kBreakpoint uses estimator.range_sigma_m for its covariance (breakpoint_measurement.hpp).
   DockDetector detector = DockDetector::kEstimator;
-  /// When the lidar's intensity counts as usable (IntensityCheck; reported, not yet used by detection).
+  /// When the lidar's intensity counts as usable (IntensityCheck): the estimator reads reflector stripes unless the
+  /// verdict is flat or absent.
   IntensityCheckParams intensity{};
 };
 
@@ -181,9 +184,9 @@ class DockcoreBase {
   void take_inputs(const DockcoreBase& from);
 
   /// One scan stamped `stamp_us` (its first sample; 0 or later than `now_us` is taken as `now_us`), read at `now_us`:
-  /// the input watch's check (a late scan is not used: nullptr, counted), then detection (the configured detector;
-  /// the estimator's hint = the filter's prediction for the odometry pose at the stamp), filter update, scan copy,
-  /// intensity check. Feed the chassis feedback up to the scan's time first. Returns the scan's estimate
+  /// the input watch's check (a late scan is not used: nullptr, counted), then the intensity check, detection (the
+  /// configured detector; the estimator's hint = the filter's prediction for the odometry pose at the stamp), filter
+  /// update, scan copy. Feed the chassis feedback up to the scan's time first. Returns the scan's estimate
   /// (last_estimate(); from the breakpoint detector: found, status, pose and covariance only). Cost: the detector's
   /// (the estimator's, or BreakpointDetector::detect's O(beams)) plus O(count + Odometry::kHistory +
   /// IntensityCheck::kMaxSamples).

@@ -76,6 +76,14 @@ constexpr Real kWallSeenMountedNats = static_cast<Real>(1.45);
 constexpr Real kWallMissedMountedNats = static_cast<Real>(-1.67);
 // Between two verified objects, evidence stronger by this much (a likelihood ratio of e^3 = 20) decides over
 // nearness; closer than that, both are taken for docks and the nearest is chosen.
+// The intensity cue, per region of the stripe pattern (a stripe or a gap) with a beam well inside it: on this dock a
+// region reads as the profile says with probability 0.99; on another dock of this shape (another code, or no tape)
+// with probability 0.5.
+constexpr Real kRegionMatchNats = static_cast<Real>(0.683);      // ln(0.99 / 0.5)
+constexpr Real kRegionMismatchNats = static_cast<Real>(-3.912);  // ln(0.01 / 0.5)
+// A beam this close to a stripe's end (plus half its footprint) is left out: its footprint may straddle the edge.
+constexpr Real kStripeEdgeMarginM = static_cast<Real>(0.005);
+
 constexpr Real kSelectMarginNats = static_cast<Real>(3);
 // Beams closer together than this on a surface are not independent evidence: rooms are made of smooth surfaces, so
 // where one beam lands on a dock-like surface by chance its neighbours do too.
@@ -157,6 +165,10 @@ const char* to_string(RejectReason r) {
     case RejectReason::kUncertain: return "pose too uncertain";
     case RejectReason::kFarFromHint: return "too far from the hint";
     case RejectReason::kWeakEvidence: return "evidence below min_evidence_nats";
+    case RejectReason::kWrongCode:
+      return "reflector stripes read another pattern";
+    case RejectReason::kCodeUnread:
+      return "no reflector stripe read (too far for the stripes' width)";
     case RejectReason::kCount: break;
   }
   return "unknown reason";
@@ -172,6 +184,8 @@ const char* to_string(EvidenceCue c) {
     case EvidenceCue::kWall: return "wall";
     case EvidenceCue::kGeometry: return "geometry";
     case EvidenceCue::kPrior: return "prior";
+    case EvidenceCue::kIntensity:
+      return "intensity";
     case EvidenceCue::kCount: break;
   }
   return "unknown cue";
@@ -271,6 +285,7 @@ bool DockPoseEstimatorBase::load_scan(const ScanView& scan) {
   angle_inc_rad_ = scan.angle_increment_rad;
   wraps_ = scan.wraps();
   ranges_m_ = scan.ranges_m;
+  intensities_ = scan.intensities;
   valid_beams_counted_ = false;
   // A lidar's scans keep their geometry from turn to turn: the beam directions are computed again only when it
   // changes, so a tracking scan reads just the beams near the dock.
@@ -621,6 +636,14 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   Vec2 box_lo;
   Vec2 box_hi;
   gated_box(placed_, gate, &box_lo, &box_hi);
+  const bool read_stripes = profile_.reflector_count > 0 && intensity_usable_ && intensities_ != nullptr;
+  // The stripe pattern's regions, read beam by beam: each stripe, the gap before it, the gap after a segment's last.
+  std::uint8_t stripe_n[kMaxReflectors] = {};
+  std::uint8_t stripe_bright[kMaxReflectors] = {};
+  std::uint8_t gap_n[kMaxReflectors] = {};
+  std::uint8_t gap_bright[kMaxReflectors] = {};
+  std::uint8_t after_n[kMaxReflectors] = {};
+  std::uint8_t after_bright[kMaxReflectors] = {};
   for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
     std::size_t i = 0;
     if (!beam_at(first, k, &i)) continue;
@@ -640,6 +663,44 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
       const Real diff = m - expected_m;
       if (m != 0 && std::fabs(diff) <= gate) {
         on_dock = true;
+        if (read_stripes) {
+          const Vec2 hit = expected_m * dir_[i];
+          const Vec2& along = placed_.d_m[seg];
+          const Real len = along.norm();
+          const Real s = (hit - placed_.v_m[seg]).dot(along) / len;
+          // Half the beam's footprint on the surface, and a little more: a beam closer to a stripe's end may
+          // straddle it.
+          const Real edge_m = kStripeEdgeMarginM + R(0.5) * expected_m * angle_inc_rad_ / cos_inc;
+          const bool bright = intensities_[i] >= params_.reflector_min_intensity;
+          // The region the beam lands in: a stripe q, the gap before it (from the previous stripe on this segment
+          // or the segment's start), or the gap after the segment's last stripe.
+          std::size_t last = kMaxReflectors;
+          bool placed_in_region = false;
+          for (std::size_t q = 0; q < profile_.reflector_count && !placed_in_region; ++q) {
+            const ReflectorStripe& st = profile_.reflectors[q];
+            if (st.segment != seg) continue;
+            if (s < st.from_m) {
+              const Real gap_from = last < kMaxReflectors ? profile_.reflectors[last].to_m : R(0);
+              if (s >= gap_from + edge_m && s <= st.from_m - edge_m) {
+                ++gap_n[q];
+                if (bright) ++gap_bright[q];
+              }
+              placed_in_region = true;
+            } else if (s <= st.to_m) {
+              if (s >= st.from_m + edge_m && s <= st.to_m - edge_m) {
+                ++stripe_n[q];
+                if (bright) ++stripe_bright[q];
+              }
+              placed_in_region = true;
+            }
+            last = q;
+          }
+          if (!placed_in_region && last < kMaxReflectors && s >= profile_.reflectors[last].to_m + edge_m &&
+              s <= len - edge_m) {
+            ++after_n[last];
+            if (bright) ++after_bright[last];
+          }
+        }
         ++r.inliers;
         ++seg_expected[seg];
         ++seg_inliers[seg];
@@ -671,6 +732,23 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
         ++r.extensions;
         f.continues += weight(m);
       }
+    }
+  }
+  if (read_stripes) {
+    // A stripe reads as tape when half its beams or more are bright; a gap reads as tape when two or more of its
+    // beams and over a quarter of them are (one stray bright beam is a glint, not another dock's stripe).
+    auto read = [&f](std::uint8_t n, std::uint8_t bright, bool tape_expected) {
+      if (n == 0) return;
+      const bool reads_tape = tape_expected ? 2 * bright >= n : (bright >= 2 && 4 * bright > n);
+      ++(reads_tape == tape_expected ? f.regions_matched : f.regions_mismatched);
+      if (tape_expected && reads_tape) ++f.stripes_matched;
+      if (tape_expected) f.stripe_beams = static_cast<std::uint16_t>(f.stripe_beams + n);
+      f.bright_beams = static_cast<std::uint16_t>(f.bright_beams + bright);
+    };
+    for (std::size_t q = 0; q < profile_.reflector_count; ++q) {
+      read(stripe_n[q], stripe_bright[q], true);
+      read(gap_n[q], gap_bright[q], false);
+      read(after_n[q], after_bright[q], false);
     }
   }
   for (std::size_t j = 0; j < placed_.segments; ++j) {
@@ -721,6 +799,9 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     cue[static_cast<std::size_t>(EvidenceCue::kPrior)] =
         std::log(area_ratio > 1 ? area_ratio : R(1)) - dist2(r.pose, *hint) / (2 * s_prior * s_prior);
   }
+  cue[static_cast<std::size_t>(EvidenceCue::kIntensity)] =
+      kRegionMatchNats * static_cast<Real>(f.regions_matched) +
+      kRegionMismatchNats * static_cast<Real>(f.regions_mismatched);
   for (std::size_t c = 0; c < kEvidenceCueCount; ++c) r.evidence.total_nats += cue[c];
   if (r.inliers > 0) r.rms_m = std::sqrt(sum_sq / static_cast<Real>(r.inliers));
   const std::uint16_t unoccluded_n = static_cast<std::uint16_t>(r.expected - r.occluded);
@@ -741,6 +822,10 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     r.reject = RejectReason::kOutOfRange;
   } else if (r.evidence.total_nats < params_.min_evidence_nats) {
     r.reject = RejectReason::kWeakEvidence;
+  } else if (f.regions_mismatched > 0) {
+    r.reject = RejectReason::kWrongCode;
+  } else if (read_stripes && f.stripes_matched == 0) {
+    r.reject = RejectReason::kCodeUnread;
   }
   if (r.reject != RejectReason::kNone) return;
   r.ok = true;

@@ -29,6 +29,8 @@ const char* to_string(ProfileError e) {
     case ProfileError::kDegenerateSegment: return "two consecutive profile vertices are closer than 1 mm";
     case ProfileError::kNotFinite: return "profile vertex is not a finite number";
     case ProfileError::kUnknownName: return "no built-in profile by that name";
+    case ProfileError::kBadReflector:
+      return "reflector stripe is off its segment, shorter than 1 cm, overlaps another, or is one too many (8)";
   }
   return "unknown profile error";
 }
@@ -96,6 +98,31 @@ ProfileError make_profile(const Vec2* vertices_m, std::size_t n, Real contact_of
   p.vertex_count = n;
   copy_name(name, p.name);
   out = p;
+  return ProfileError::kOk;
+}
+
+ProfileError add_reflector(DockProfile& profile, const ReflectorStripe& stripe) {
+  if (profile.reflector_count >= kMaxReflectors || stripe.segment >= profile.segment_count()) {
+    return ProfileError::kBadReflector;
+  }
+  if (!std::isfinite(stripe.from_m) || !std::isfinite(stripe.to_m)) return ProfileError::kBadReflector;
+  const Real len = (profile.vertices_m[stripe.segment + 1] - profile.vertices_m[stripe.segment]).norm();
+  // A stripe to the segment's end, written with the millimetre precision of a file, may pass its rounded length.
+  ReflectorStripe s = stripe;
+  if (s.to_m > len && s.to_m <= len + to_real(0.0005)) s.to_m = len;
+  if (s.from_m < 0 || s.to_m > len || s.to_m - s.from_m < to_real(0.01)) return ProfileError::kBadReflector;
+  // Position in outline order; refuse any overlap with the stripes on the same segment.
+  std::size_t at = profile.reflector_count;
+  for (std::size_t i = 0; i < profile.reflector_count; ++i) {
+    const ReflectorStripe& r = profile.reflectors[i];
+    if (r.segment == s.segment && r.from_m < s.to_m && s.from_m < r.to_m) return ProfileError::kBadReflector;
+    if (at == profile.reflector_count && (r.segment > s.segment || (r.segment == s.segment && r.from_m > s.from_m))) {
+      at = i;
+    }
+  }
+  for (std::size_t i = profile.reflector_count; i > at; --i) profile.reflectors[i] = profile.reflectors[i - 1];
+  profile.reflectors[at] = s;
+  ++profile.reflector_count;
   return ProfileError::kOk;
 }
 

@@ -195,6 +195,9 @@ const ParamSpec kTable[] = {
     DC_REAL("estimator", "min_evidence_nats", "nats", -20, 100, kBoth, estimator, min_evidence_nats,
             "A candidate is accepted when its evidence (the sum of its cues' log-likelihood ratios, "
             "[docks.md](docks.md#how-the-detector-decides)) reaches this. Higher: fewer false docks, more misses."),
+    DC_REAL("estimator", "reflector_min_intensity", "sensor units", 0, 65535, kBoth, estimator, reflector_min_intensity,
+            "A return at least this bright counts as reflector tape (intensity cue; docks with `[[reflectors]]` on a "
+            "lidar whose intensity is usable). LD06: 0–255."),
     DC_REAL("estimator", "wall_tolerance_m", "m", 0, 0.2, kBoth, estimator, wall_tolerance_m,
             "How far outside the mounting's gap range a wall still counts as the dock's wall."),
     DC_REAL("estimator", "max_sigma_m", "m", 0.001, 1, kBoth, estimator, max_sigma_m,

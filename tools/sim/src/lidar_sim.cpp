@@ -23,6 +23,7 @@ struct RelSeg {
   double inv_len;  // 1/|b-a|, for the incidence angle.
   double reflectivity;
   bool one_sided;
+  bool retro;
   std::uint32_t index;  // Into World::segments.
 };
 
@@ -36,6 +37,7 @@ RelSeg make_rel(const Segment& s, double ox, double oy, std::uint32_t index) {
   r.inv_len = len > 0 ? 1.0 / len : 0.0;
   r.reflectivity = s.reflectivity;
   r.one_sided = s.one_sided;
+  r.retro = s.retro;
   r.index = index;
   return r;
 }
@@ -190,13 +192,40 @@ class ScanCaster {
 
 void World::add_dock(const dockcore::DockProfile& profile, const Pose2& dock_pose, double reflectivity) {
   for (std::size_t i = 0; i + 1 < profile.vertex_count; ++i) {
-    Segment s;
-    s.a = dock_pose.transform(profile.vertices_m[i]);
-    s.b = dock_pose.transform(profile.vertices_m[i + 1]);
-    s.reflectivity = reflectivity;
-    s.one_sided = false;
-    segments.push_back(s);
+    const Vec2 a = dock_pose.transform(profile.vertices_m[i]);
+    const Vec2 b = dock_pose.transform(profile.vertices_m[i + 1]);
+    const Real len = (b - a).norm();
+    // Pieces between the stripes' ends (in order along the segment), each boundary point computed once so that
+    // neighbouring pieces share it exactly.
+    Vec2 from = a;
+    Real at_m = 0;
+    auto piece = [&](Real to_m, bool retro) {
+      const Vec2 to = to_m >= len ? b : Vec2(a + (b - a) * (to_m / len));
+      if (to_m > at_m) {
+        Segment s;
+        s.a = from;
+        s.b = to;
+        s.reflectivity = reflectivity;
+        s.retro = retro;
+        segments.push_back(s);
+      }
+      from = to;
+      at_m = to_m;
+    };
+    for (std::size_t k = 0; k < profile.reflector_count; ++k) {
+      const dockcore::ReflectorStripe& st = profile.reflectors[k];
+      if (st.segment != i) continue;
+      piece(st.from_m, false);
+      piece(st.to_m, true);
+    }
+    piece(len, false);
   }
+}
+
+bool World::has_retro() const {
+  for (const Segment& s : segments)
+    if (s.retro) return true;
+  return false;
 }
 
 void World::add_polyline(const std::vector<Vec2>& pts, bool closed, double reflectivity) {
@@ -392,6 +421,16 @@ void simulate_scan(const World& world, const Pose2& lidar_pose, const LidarModel
 
   const double yaw = static_cast<double>(lidar_pose.yaw_rad);
   const bool use_mixed = model.mixed_pixels && model.beam_divergence_rad > 0;
+  const bool retro_world = world.has_retro();
+  const double cos_retro_cutoff = std::cos(model.retro_cutoff_rad);
+  // The model's intensity of a hit on segment k at range t along (dx, dy).
+  auto raw_intensity = [&](long k, double t, double ddx, double ddy) {
+    const RelSeg& s = caster.seg(k);
+    const double q = t / model.intensity_ref_range_m;
+    const double c = cos_incidence(s, ddx, ddy);
+    if (s.retro && c >= cos_retro_cutoff) return model.intensity_scale * model.retro_gain / (1.0 + q * q);
+    return model.intensity_scale * (s.retro ? 0.5 : s.reflectivity) * c / (1.0 + q * q);
+  };
   const double half_div = 0.5 * model.beam_divergence_rad;
   for (std::size_t i = 0; i < beams; ++i) {
     double theta = yaw + model.angle_min_rad + static_cast<double>(i) * model.angle_increment_rad;
@@ -421,9 +460,17 @@ void simulate_scan(const World& world, const Pose2& lidar_pose, const LidarModel
     if (r < model.min_range_m || r > model.max_range_m) continue;
     if (model.dropout_prob > 0 && rng.bernoulli(model.dropout_prob)) continue;
 
-    const RelSeg& s = caster.seg(k);
-    const double q = r / model.intensity_ref_range_m;
-    const double intensity = model.intensity_scale * s.reflectivity * cos_incidence(s, dx, dy) / (1.0 + q * q);
+    double intensity = raw_intensity(k, r, dx, dy);
+    if (retro_world && half_div > 0) {
+      // The footprint's mean: tape edges read in between (the sub-rays are geometry only, no noise drawn).
+      double sum = intensity;
+      for (const double side : {-half_div, half_div}) {
+        double ts = 0, sx = 0, sy = 0;
+        const long ks = caster.cast(theta + side, cast_range, &ts, &sx, &sy);
+        if (ks >= 0) sum += raw_intensity(ks, ts, sx, sy);
+      }
+      intensity = sum / 3.0;
+    }
     out->ranges_m[i] = static_cast<Real>(r);
     out->intensities[i] = static_cast<Real>(sensor_intensity(model, intensity));
   }

@@ -84,6 +84,11 @@ std::string profile_to_toml(const DockProfile& profile) {
            fmt(static_cast<double>(m.wall_gap_max_m)) + "]\n";
     }
   }
+  for (std::size_t i = 0; i < profile.reflector_count; ++i) {
+    const dockcore::ReflectorStripe& r = profile.reflectors[i];
+    s += "\n[[reflectors]]\nsegment = " + std::to_string(r.segment) +
+         "\nfrom_m = " + fmt(static_cast<double>(r.from_m)) + "\nto_m = " + fmt(static_cast<double>(r.to_m)) + "\n";
+  }
   return s;
 }
 

@@ -46,6 +46,8 @@ const char* to_string(FurnitureKind k) {
       return "bin";
     case FurnitureKind::kChair:
       return "chair";
+    case FurnitureKind::kDock:
+      return "dock";
   }
   return "?";
 }
@@ -111,11 +113,25 @@ struct ParseState {
   std::string lidar_model = "ld06";
   const toml::node* lidar_model_node = nullptr;
   std::string lidar_intensity;  ///< [lidar] intensity, empty: the model's own.
+  struct FurnitureProfile {
+    std::size_t index;  ///< Into Scenario::furniture.
+    std::string ref;    ///< A built-in name or a profile file (relative to the scenario).
+    const toml::node* node;
+  };
+  std::vector<FurnitureProfile> furniture_profiles;
   std::string profile = "plate-v";
   const toml::node* profile_node = nullptr;
   bool mounting_set = false;
   dockcore::DockMounting mounting{};
 };
+
+/// A profile reference as resolve_profile takes it: a built-in name as it is, a relative file path relative to the
+/// scenario file `source_name`.
+std::string profile_ref(const std::string& ref, const std::string& source_name) {
+  const bool is_file =
+      ref.find('/') != std::string::npos || (ref.size() > 5 && ref.compare(ref.size() - 5, 5, ".toml") == 0);
+  return is_file && !ref.empty() && ref[0] != '/' ? dir_of(source_name) + ref : ref;
+}
 
 /// Adds the furniture beside the dock to the scenario's world boxes and circles (docs/scenarios.md, [dock]).
 void place_furniture(Scenario& sc) {
@@ -162,6 +178,23 @@ void place_furniture(Scenario& sc) {
             sc.circles.push_back(c);
           }
         }
+        break;
+      }
+      case FurnitureKind::kDock: {
+        // Its nearest vertex `near` beside the dock, its back plane on the dock's.
+        double o_min_x = 0, o_min_y = 0, o_max_y = 0;
+        for (std::size_t i = 0; i < f.profile.vertex_count; ++i) {
+          const Vec2& v = f.profile.vertices_m[i];
+          o_min_x = i == 0 ? static_cast<double>(v.x()) : std::min(o_min_x, static_cast<double>(v.x()));
+          o_min_y = i == 0 ? static_cast<double>(v.y()) : std::min(o_min_y, static_cast<double>(v.y()));
+          o_max_y = i == 0 ? static_cast<double>(v.y()) : std::max(o_max_y, static_cast<double>(v.y()));
+        }
+        const double y = f.side > 0 ? near - o_min_y : -near - o_max_y;
+        const double x = f.x_set ? f.x_m : min_x - o_min_x;
+        Scenario::OtherDock d;
+        d.profile = f.profile;
+        d.pose = sc.dock_pose.compose(Pose2{static_cast<Real>(x), static_cast<Real>(y), 0});
+        sc.other_docks.push_back(d);
         break;
       }
     }
@@ -354,8 +387,9 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
                       std::string("dock.furniture.kind must be a string, not ") + type_name(*kind_node));
              }
              const std::string kind = kind_str->get();
-             if (kind != "box" && kind != "bin" && kind != "chair") {
-               p.fail(kind_node->source(), "dock.furniture.kind = \"" + kind + "\" is not one of box, bin, chair");
+             if (kind != "box" && kind != "bin" && kind != "chair" && kind != "dock") {
+               p.fail(kind_node->source(),
+                      "dock.furniture.kind = \"" + kind + "\" is not one of box, bin, chair, dock");
              }
              Handlers h{{"kind", [](const toml::node&) {}},
                         {"side",
@@ -374,6 +408,11 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
              } else if (kind == "bin") {
                f.kind = FurnitureKind::kBin;
                h.emplace_back("radius_m", p.num(&f.radius_m, 0.05, 1));
+             } else if (kind == "dock") {
+               f.kind = FurnitureKind::kDock;
+               h.emplace_back("profile", [&, index = sc.furniture.size()](const toml::node& v) {
+                 st.furniture_profiles.push_back({index, p.string(v), &v});
+               });
              } else {
                f.kind = FurnitureKind::kChair;
                h.emplace_back("seat_m", p.num(&f.seat_m, 0.2, 1));
@@ -623,13 +662,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
 
   sc.profile_name = st.profile;
   {
-    // A relative profile path is relative to the scenario file.
-    std::string ref = st.profile;
-    const bool is_file =
-        ref.find('/') != std::string::npos || (ref.size() > 5 && ref.compare(ref.size() - 5, 5, ".toml") == 0);
-    if (is_file && !ref.empty() && ref[0] != '/') ref = dir_of(source_name) + ref;
     try {
-      sc.profile = resolve_profile(ref);
+      sc.profile = resolve_profile(profile_ref(st.profile, source_name));
     } catch (const ProfileFileError& e) {
       p.fail(st.profile_node != nullptr ? st.profile_node->source() : root.source(),
              std::string("dock.profile: ") + e.what());
@@ -637,6 +671,17 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
   }
   // What the detector is told is independent of the world: [dock.mounting] replaces the profile file's.
   if (st.mounting_set) sc.profile.mounting = st.mounting;
+  for (std::size_t i = 0; i < sc.furniture.size(); ++i) {
+    if (sc.furniture[i].kind != FurnitureKind::kDock) continue;
+    const auto it = std::find_if(st.furniture_profiles.begin(), st.furniture_profiles.end(),
+                                 [i](const ParseState::FurnitureProfile& f) { return f.index == i; });
+    if (it == st.furniture_profiles.end()) p.fail(root.source(), "dock.furniture entry of kind dock without 'profile'");
+    try {
+      sc.furniture[i].profile = resolve_profile(profile_ref(it->ref, source_name));
+    } catch (const ProfileFileError& e) {
+      p.fail(it->node->source(), std::string("dock.furniture.profile: ") + e.what());
+    }
+  }
   // The detector must be able to find this dock (refused here rather than when the run configures the core).
   const dockcore::ConfigureStatus detector_ok = dockcore::detector_supports(sc.detector, sc.profile);
   if (detector_ok != dockcore::ConfigureStatus::kOk) {

@@ -310,6 +310,7 @@ bool dock_wall(const Scenario& sc, Vec2* a, Vec2* b) {
 World scenario_world(const Scenario& sc, bool with_dock) {
   World w;
   if (with_dock) w.add_dock(sc.profile, sc.dock_pose);
+  for (const auto& d : sc.other_docks) w.add_dock(d.profile, d.pose);
   Vec2 wall_a, wall_b;
   // Glass stands there but the lidar sees through it: it is not part of the lidar's world.
   if (dock_wall(sc, &wall_a, &wall_b) && !sc.wall_glass) w.add_polyline({wall_a, wall_b}, false, 0.5);
@@ -368,6 +369,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     World& o = occluders;
     for (const auto& pl : sc.polylines) o.add_polyline(pl.points, pl.closed);
     for (const auto& b : sc.boxes) o.add_box(b.centre, b.size_x_m, b.size_y_m, b.yaw_rad);
+    for (const auto& d : sc.other_docks) o.add_dock(d.profile, d.pose);
     for (const auto& s : o.segments) static_obs.segments.push_back({pd(s.a), pd(s.b)});
     for (const auto& c : sc.circles) static_obs.discs.push_back({pd(c.centre), c.r_m});
     for (const auto& c : sc.circles) o.add_circle(c.centre, c.r_m);

@@ -56,27 +56,36 @@ enum class EstimateStatus : std::uint8_t {
 /// Why verification refused a candidate (the rejection rules, in the order they are applied).
 enum class RejectReason : std::uint8_t {
   kNone = 0,
-  kNoConvergence,      ///< Registration found too few points or diverged.
-  kTooFewInliers,      ///< Fewer than min_inliers.
-  kMostlyHidden,       ///< Inliers / expected beams below min_visible_fraction.
-  kOblique,            ///< Face seen beyond max_view_angle_rad.
-  kOutOfRange,         ///< Farther than max_range_m.
-  kUncertain,          ///< Position 1-σ from the covariance above max_sigma_m.
-  kFarFromHint,        ///< Farther than hint_radius_m from the hint.
-  kWeakEvidence,       ///< The cues' log-likelihood ratio is below min_evidence_nats (see the cues for why).
+  kNoConvergence,  ///< Registration found too few points or diverged.
+  kTooFewInliers,  ///< Fewer than min_inliers.
+  kMostlyHidden,   ///< Inliers / expected beams below min_visible_fraction.
+  kOblique,        ///< Face seen beyond max_view_angle_rad.
+  kOutOfRange,     ///< Farther than max_range_m.
+  kUncertain,      ///< Position 1-σ from the covariance above max_sigma_m.
+  kFarFromHint,    ///< Farther than hint_radius_m from the hint.
+  kWeakEvidence,   ///< The cues' log-likelihood ratio is below min_evidence_nats (see the cues for why).
+  /// A reflector dock whose stripe pattern reads otherwise than its profile's (another dock of this shape, or an
+  /// untaped look-alike): a wrong dock id is worse than none. Only with usable intensity (docs/docks.md).
+  kWrongCode,
+  /// A reflector dock none of whose stripes was read bright (too far for the stripes' width, or seen too obliquely):
+  /// the shape alone would take any dock of this shape. Only with usable intensity.
+  kCodeUnread,
   kCount,
 };
 
 /// The terms of the accept decision, each a log-likelihood ratio in nats (positive: evidence for the dock).
 enum class EvidenceCue : std::uint8_t {
-  kFit = 0,      ///< Beams landing on the dock, by how closely (Gaussian of range_sigma_m against a look-alike's).
-  kSeeThrough,   ///< Beams that pass where the dock should stop them, or return nothing there.
-  kFreeSpace,    ///< Surfaces just in front of the dock (free_space_m), where an approaching robot would be.
-  kSupport,      ///< Long dock surfaces with too few of their beams (a surface of the dock that is not there).
-  kEdges,        ///< Beams just past the dock's ends: a surface carrying on in line (against) or stopping (for).
-  kWall,         ///< Beams past the ends meeting the wall where the mounting puts it (for), or not (against).
-  kGeometry,     ///< How well the visible part of the dock fixes all three pose components (a flat face alone cannot).
-  kPrior,        ///< Closeness to the pose hint when hint_radius_m is set (dock database, staging pose).
+  kFit = 0,     ///< Beams landing on the dock, by how closely (Gaussian of range_sigma_m against a look-alike's).
+  kSeeThrough,  ///< Beams that pass where the dock should stop them, or return nothing there.
+  kFreeSpace,   ///< Surfaces just in front of the dock (free_space_m), where an approaching robot would be.
+  kSupport,     ///< Long dock surfaces with too few of their beams (a surface of the dock that is not there).
+  kEdges,       ///< Beams just past the dock's ends: a surface carrying on in line (against) or stopping (for).
+  kWall,        ///< Beams past the ends meeting the wall where the mounting puts it (for), or not (against).
+  kGeometry,    ///< How well the visible part of the dock fixes all three pose components (a flat face alone cannot).
+  kPrior,       ///< Closeness to the pose hint when hint_radius_m is set (dock database, staging pose).
+  /// The profile's reflector stripes read bright and its plain surfaces not (only for profiles with reflectors, on a
+  /// lidar whose intensity is usable: set_intensity_usable()).
+  kIntensity,
   kCount,
 };
 
@@ -103,6 +112,15 @@ struct DecisionFeatures {
   /// Smallest eigenvalue of the fit's information matrix (yaw scaled by the dock's radius), weighted: the number of
   /// independent beams that fix the least constrained pose component.
   Real constraint = 0;
+  /// The stripe pattern as read (profiles with reflectors on a lidar whose intensity is usable; else all 0): regions
+  /// (each stripe, each gap between or beside stripes on a taped segment) with an inlier beam well inside them that
+  /// read as the profile says or not, the inlier beams inside stripes, and the bright beams (>=
+  /// reflector_min_intensity) inside any region.
+  std::uint8_t regions_matched = 0;
+  std::uint8_t regions_mismatched = 0;
+  std::uint8_t stripes_matched = 0;  ///< Of regions_matched: stripes that read bright.
+  std::uint16_t stripe_beams = 0;
+  std::uint16_t bright_beams = 0;
 };
 
 /// A candidate's evidence: each cue's log-likelihood ratio and their sum, nats, and the features behind them.
@@ -156,6 +174,9 @@ struct EstimatorParams {
   Real wall_tolerance_m = static_cast<Real>(0.02);
   DockSelect select = DockSelect::kNearest;
   SegmentParams segments{};                       ///< Line extraction used for candidate generation.
+  /// A return at least this bright (the lidar's own units: LD06 0–255) counts as retro-reflective tape for the
+  /// intensity cue. Only used for profiles with reflectors.
+  Real reflector_min_intensity = static_cast<Real>(235);
 };
 
 /// Parameters for a lidar whose 1-σ range noise is `range_sigma_m`: the noise-dependent gates (inlier gate 3σ,
@@ -217,6 +238,11 @@ class DockPoseEstimatorBase {
   /// Estimates the dock pose in one scan. `lidar_mount` is the lidar's pose in the robot frame. `hint`, if not null,
   /// is an expected dock pose in the robot frame (tracker prediction or configured pose). Cost: see file comment.
   DockEstimate estimate(const ScanView& scan, const Pose2& lidar_mount, const Pose2* hint = nullptr);
+
+  /// Whether the scans' intensities may be read (the lidar's IntensityCheck verdict): without it, the intensity cue
+  /// is 0 and detection is geometric. Default false. O(1).
+  void set_intensity_usable(bool usable) { intensity_usable_ = usable; }
+  bool intensity_usable() const { return intensity_usable_; }
 
   const EstimatorCounters& counters() const { return counters_; }
   const EstimatorParams& params() const { return params_; }
@@ -350,6 +376,8 @@ class DockPoseEstimatorBase {
   std::size_t capacity_;
   // The current scan, in the lidar frame: its ranges (the caller's).
   const Real* ranges_m_ = nullptr;
+  const Real* intensities_ = nullptr;  // the caller's, or null
+  bool intensity_usable_ = false;
   std::size_t dir_beams_ = 0;
   Real dir_angle_min_rad_ = 0;
   Real dir_angle_inc_rad_ = 0;

@@ -18,11 +18,12 @@ constexpr std::size_t kMaxProfileVertices = 32;
 /// Why a profile was refused.
 enum class ProfileError : std::uint8_t {
   kOk = 0,
-  kTooFewVertices,   ///< Fewer than 2 vertices.
-  kTooManyVertices,  ///< More than kMaxProfileVertices.
-  kDegenerateSegment,///< Two consecutive vertices closer than 1 mm.
-  kNotFinite,        ///< A coordinate is NaN or inf.
-  kUnknownName,      ///< No built-in profile by that name.
+  kTooFewVertices,     ///< Fewer than 2 vertices.
+  kTooManyVertices,    ///< More than kMaxProfileVertices.
+  kDegenerateSegment,  ///< Two consecutive vertices closer than 1 mm.
+  kNotFinite,          ///< A coordinate is NaN or inf.
+  kUnknownName,        ///< No built-in profile by that name.
+  kBadReflector,       ///< A reflector stripe off its segment, shorter than 1 cm, overlapping another, or one too many.
 };
 
 /// Human-readable name of a ProfileError, for messages. Never null.
@@ -55,12 +56,27 @@ constexpr Real kMaxWallGapM = static_cast<Real>(0.5);
 /// Checks a mounting's bounds (gap range ordered, within [0, kMaxWallGapM], finite). O(1).
 bool mounting_valid(const DockMounting& m);
 
+/// Most reflector stripes a profile may carry.
+constexpr std::size_t kMaxReflectors = 8;
+
+/// A stripe of retro-reflective tape on one profile segment: from `from_m` to `to_m` along it, measured from the
+/// segment's first vertex (docs/docks.md, "Reflectors"). The pattern of stripes and gaps tells docks of one shape
+/// apart.
+struct ReflectorStripe {
+  std::uint8_t segment = 0;  ///< Segment index: vertices segment .. segment+1.
+  Real from_m = 0;           ///< Start along the segment, m, >= 0.
+  Real to_m = 0;             ///< End along the segment, m, <= the segment's length, >= from_m + 0.01.
+};
+
 /// A dock outline. Trivially copyable, fixed size.
 struct DockProfile {
   Vec2 vertices_m[kMaxProfileVertices] = {};
   std::size_t vertex_count = 0;
   char name[24] = {};
   DockMounting mounting{};  ///< How this dock is installed; the built-ins are kUnknown.
+  /// Retro-reflective stripes, in order along the outline (segment, then from_m); none on the built-ins.
+  ReflectorStripe reflectors[kMaxReflectors] = {};
+  std::size_t reflector_count = 0;
 
   std::size_t segment_count() const { return vertex_count > 0 ? vertex_count - 1 : 0; }
   /// Length of the polyline in metres. O(vertices).
@@ -76,6 +92,11 @@ struct DockProfile {
 /// ProfileError; on error `out` is untouched. O(n).
 ProfileError make_profile(const Vec2* vertices_m, std::size_t n, Real contact_offset_m, const char* name,
                           DockProfile& out);
+
+/// Adds a reflector stripe to `profile`, keeping the stripes in order along the outline. kBadReflector (profile
+/// unchanged) when the segment does not exist, the stripe leaves its segment, is shorter than 1 cm, overlaps another
+/// stripe, is not finite, or kMaxReflectors are there already. O(kMaxReflectors).
+ProfileError add_reflector(DockProfile& profile, const ReflectorStripe& stripe);
 
 /// Names of the built-in profiles, null-terminated list: "breakpoint", "v-marker", "plate-v". Dimensions in docs/docks.md.
 extern const char* const kBuiltinProfileNames[];

@@ -23,6 +23,7 @@ struct Segment {
   Vec2 b;
   double reflectivity = 0.5;  ///< 0..1, scales the simulated intensity.
   bool one_sided = false;
+  bool retro = false;  ///< Retro-reflective tape: bright up to LidarModel::retro_cutoff_rad of incidence.
 };
 
 /// A 2D world: a bag of segments. Helpers add common objects.
@@ -30,8 +31,11 @@ struct World {
   std::vector<Segment> segments;
 
   /// Adds the profile's polyline placed at dock_pose (dock frame -> world); segments are two-sided so the dock's
-  /// back and sides block rays like a solid object.
+  /// back and sides block rays like a solid object. The profile's reflector stripes become retro segments of their
+  /// own (the surface split at their ends, so the outline stays one continuous surface).
   void add_dock(const dockcore::DockProfile& profile, const Pose2& dock_pose, double reflectivity = 0.8);
+  /// Some segment is retro-reflective (simulate_scan then blends the intensity over the beam's footprint).
+  bool has_retro() const;
   void add_polyline(const std::vector<Vec2>& pts, bool closed = false, double reflectivity = 0.5);
   /// Axis-aligned in its own frame, rotated by yaw about its centre.
   void add_box(const Vec2& centre, double size_x, double size_y, double yaw_rad, double reflectivity = 0.5);
@@ -86,9 +90,15 @@ struct LidarModel {
   double mixed_pixel_prob = 0.5;          ///< See mixed_pixel_threshold_m.
   /// Intensity = intensity_scale * reflectivity * |cos(incidence)| / (1 + (range / intensity_ref_range_m)^2),
   /// 0 for no return. A plain falloff model: detectors should only rely on "brighter surface -> larger value".
+  /// Retro-reflective tape (Segment::retro) returns intensity_scale * retro_gain / (1 + (range / ref)^2) whatever
+  /// the incidence up to retro_cutoff_rad (so it saturates an LD06 at every docking range), and beyond it behaves as
+  /// a diffuse surface of reflectivity 0.5. In a world with tape, a beam's intensity is the mean over its footprint
+  /// (three sub-rays at -div/2, 0, +div/2; a miss adds 0): a beam straddling a tape edge reads in between.
   double intensity_scale = 255.0;
   double intensity_ref_range_m = 4.0;     ///< Range at which the intensity falls to half its near value.
   IntensityOutput intensity_output = IntensityOutput::kRaw;  ///< What the sensor reports of that value.
+  double retro_gain = 4.0;  ///< Tape's brightness over a white diffuse surface's, head on.
+  double retro_cutoff_rad = 60.0 * 3.14159265358979323846 / 180.0;  ///< Incidence beyond which tape is diffuse.
   /// kRplidarQuality: the raw value (0..intensity_scale) at and above which the quality reads 15. A real A1 reads 15
   /// on 87–96 % of its valid returns in a room (the realdata README); 30 of 255 gives the simulated rooms that share.
   double rplidar_saturation = 30.0;

@@ -137,6 +137,7 @@ enum class FurnitureKind : std::uint8_t {
   kBox,    ///< "box": a box depth_m (dock x) by width_m (dock y), sides parallel to the dock's axes.
   kBin,    ///< "bin": a round bin (a cylinder) of radius_m.
   kChair,  ///< "chair": four round legs of leg_radius_m at the corners of a seat_m square.
+  kDock,   ///< "dock": another dock (profile, with its own reflectors), facing the same way, back planes aligned.
 };
 
 /// Stable TOML name of a furniture kind ("box", "bin", "chair"). Never null.
@@ -152,6 +153,7 @@ struct DockFurniture {
   double radius_m = 0.15;       ///< bin, m.
   double seat_m = 0.45;         ///< chair: seat side, m (leg centres lie leg_radius_m inside its corners).
   double leg_radius_m = 0.015;  ///< chair, m.
+  dockcore::DockProfile profile{};  ///< dock: its outline and reflectors (a built-in name or a profile file).
   /// Centre along the dock's x, m. Default (x_set false): the object's back stands kFurnitureWallClearanceM in front
   /// of the wall's face, or on the dock's back plane when there is no wall.
   bool x_set = false;
@@ -213,7 +215,14 @@ struct Scenario {
   double wall_gap_m = 0;    ///< The wall's face lies this far behind the profile's minimum x, m, [0, 0.5].
   bool wall_glass = false;  ///< Glass: lidar beams pass through it (absent from the lidar's world).
   double wall_half_length_m = 2.0;
-  std::vector<DockFurniture> furniture;  ///< Beside the dock; also expanded into boxes / circles below.
+  std::vector<DockFurniture> furniture;  ///< Beside the dock; also expanded into boxes / circles / other_docks below.
+  /// Docks other than the one docked to (furniture of kind "dock"), in the world: the lidar sees them (tape and all)
+  /// and they count as obstacles.
+  struct OtherDock {
+    dockcore::DockProfile profile;
+    Pose2 pose;
+  };
+  std::vector<OtherDock> other_docks;
   std::vector<WorldPolyline> polylines;
   std::vector<WorldBox> boxes;
   std::vector<WorldCircle> circles;

@@ -10,6 +10,10 @@
 ///   [mounting]                # optional
 ///   kind = "wall"             # "wall" | "free_standing" | "unknown" (default)
 ///   wall_gap_m = [0, 0.10]    # metres, each in [0, 0.5], min <= max; only with kind = "wall"; default [0, 0.10]
+///   [[reflectors]]            # optional, up to 8: retro-reflective tape on one segment (docs/docks.md, "Reflectors")
+///   segment = 2               # segment index: from point 2 to point 3
+///   from_m = 0.02             # along the segment from its first point, metres
+///   to_m = 0.06               # >= from_m + 0.01, <= the segment's length; stripes must not overlap
 ///
 /// The outline must then pass dockcore::check_profile for an LD06-class lidar (0.8° between beams) at 2.5 m
 /// (kProfileCheckDefaultBeamSpacingRad, kProfileCheckDefaultRangeM): it must not cross itself, must hold 3 beams
@@ -149,6 +153,11 @@ DockProfile parse(const std::string& text, const std::string& source, const std:
   double contact_offset_m = 0;
   DockMounting mounting;
   std::vector<Vec2> v;
+  struct StripeEntry {
+    ReflectorStripe stripe;
+    toml::source_region where;
+  };
+  std::vector<StripeEntry> stripes;
   p.each(root, "",
          toml_reader::Handlers{
              {"name",
@@ -205,6 +214,33 @@ DockProfile parse(const std::string& text, const std::string& source, const std:
                 }
               }},
              {"mounting", [&](const toml::node& n) { mounting = read_mounting(p, n, "mounting."); }},
+             {"reflectors",
+              [&](const toml::node& n) {
+                const toml::array* a = n.as_array();
+                if (a == nullptr) p.fail(n.source(), "reflectors must be an array of tables ([[reflectors]])");
+                for (const toml::node& e : *a) {
+                  StripeEntry s;
+                  s.where = e.source();
+                  double from_m = -1, to_m = -1;
+                  std::int64_t segment = -1;
+                  p.each(p.table(e), "reflectors.",
+                         toml_reader::Handlers{
+                             {"segment",
+                              [&](const toml::node& k) {
+                                segment = p.integer(k, 0, static_cast<std::int64_t>(kMaxProfileVertices) - 2);
+                              }},
+                             {"from_m", [&](const toml::node& k) { from_m = p.number(k, 0, 10); }},
+                             {"to_m", [&](const toml::node& k) { to_m = p.number(k, 0, 10); }},
+                         });
+                  if (segment < 0 || from_m < 0 || to_m < 0) {
+                    p.fail(e.source(), "a reflector needs segment, from_m and to_m");
+                  }
+                  s.stripe.segment = static_cast<std::uint8_t>(segment);
+                  s.stripe.from_m = static_cast<Real>(from_m);
+                  s.stripe.to_m = static_cast<Real>(to_m);
+                  stripes.push_back(s);
+                }
+              }},
          });
   if (points == nullptr) {
     // An empty document has no source region of its own; point at its start.
@@ -224,6 +260,22 @@ DockProfile parse(const std::string& text, const std::string& source, const std:
     p.fail(at, "points: " + check_message(check, kProfileCheckDefaultBeamSpacingRad, kProfileCheckDefaultRangeM));
   }
   out.mounting = mounting;
+  for (std::size_t i = 0; i < stripes.size(); ++i) {
+    const ReflectorStripe& s = stripes[i].stripe;
+    const std::string what = "reflectors[" + std::to_string(i) + "]: ";
+    if (s.segment >= out.segment_count()) {
+      p.fail(stripes[i].where, what + "segment " + std::to_string(s.segment) + " does not exist (the outline has " +
+                                   std::to_string(out.segment_count()) + ")");
+    }
+    const double len = static_cast<double>((out.vertices_m[s.segment + 1] - out.vertices_m[s.segment]).norm());
+    if (static_cast<double>(s.to_m) > len + 0.0005) {
+      p.fail(stripes[i].where, what + "to_m " + std::to_string(s.to_m) + " is past the end of segment " +
+                                   std::to_string(s.segment) + " (" + std::to_string(len) + " m long)");
+    }
+    if (s.to_m - s.from_m < static_cast<Real>(0.01)) p.fail(stripes[i].where, what + "shorter than 1 cm");
+    if (i >= kMaxReflectors) p.fail(stripes[i].where, what + "more than 8 reflectors");
+    if (add_reflector(out, s) != ProfileError::kOk) p.fail(stripes[i].where, what + "overlaps another reflector");
+  }
   return out;
 }
 
