@@ -8,6 +8,26 @@
 
 namespace dockd {
 
+namespace {
+
+/// What the latest scan read of the active dock's reflector code (docs/docks.md, "Reflectors"): "none" (its profile
+/// has no stripes), "not_read" (the lidar's intensity is flat or absent: geometry only), "read" (the dock was found
+/// with its own pattern: it is the dock of this id), "wrong" (a dock of its shape with another pattern was refused),
+/// "unread" (a dock of its shape whose stripes were too far or oblique to read was refused), or "no_dock".
+const char* code_reading(const dockcore::DockcoreBase& core) {
+  if (core.estimator().profile().reflector_count == 0 || core.config().detector != dockcore::DockDetector::kEstimator) {
+    return "none";
+  }
+  if (!core.estimator().intensity_usable()) return "not_read";
+  const dockcore::DockEstimate& e = core.last_estimate();
+  if (e.found) return "read";
+  if (e.reject == dockcore::RejectReason::kWrongCode) return "wrong";
+  if (e.reject == dockcore::RejectReason::kCodeUnread) return "unread";
+  return "no_dock";
+}
+
+}  // namespace
+
 void Daemon::publish_status(std::uint64_t now_us) {
   const dockcore::TaskStatus& s = last_out_.status;
   dockcore::hal::StatusMessage m;
@@ -114,6 +134,7 @@ void Daemon::status_fields(JsonWriter& w, std::uint64_t now_us) const {
       .real("det_evidence_nats", static_cast<double>(e.evidence.total_nats), 1)
       .reals("det_cues_nats", cues, dockcore::kEvidenceCueCount, 1)
       .str("det_reject", e.found ? "none" : dockcore::to_string(e.reject))
+      .str("det_code", code_reading(*core_))
       .real("dock_evidence_nats", static_cast<double>(core_->filter().evidence_nats()), 1)
       .boolean("dock_confirmed", core_->filter().confirmed());
   // The camera's groups go in only when they fit (the status must stay one datagram); each is dropped whole. The

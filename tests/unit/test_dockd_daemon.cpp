@@ -60,8 +60,13 @@ struct Rig {
   } frames;
   bool camera_live = true;
 
+  /// `scenario`: a file of tools/scenarios instead of default.toml.
   explicit Rig(const char* state_name, bool with_udp = false, double start_distance = 1.2, bool record = false,
-               bool watch_camera = false) {
+               bool watch_camera = false, const char* scenario = nullptr) {
+    if (scenario != nullptr) {
+      sc = docksim::load_scenario_file(std::string(DOCKCORE_SOURCE_DIR) + "/tools/scenarios/" + scenario);
+      cfg = dockd_test::scenario_config(sc);
+    }
     state_file = std::string("/tmp/dockd_test_") + std::to_string(::getpid()) + "_" + state_name;
     std::remove(state_file.c_str());
     std::remove((state_file + ".bak").c_str());
@@ -267,6 +272,30 @@ TEST(DockdDaemon, DocksChargesAndUndocksInSimulation) {
   CHECK_EQUAL(static_cast<int>(dockcore::TaskResult::kUndocked), static_cast<int>(r.daemon->last_status().last_result));
   CHECK_FALSE(r.chassis->state().contact);
   CHECK(r.daemon->tick_stats().ticks > 100);
+}
+
+// Two docks of one shape, told apart by their tape: the status says the dock in view was read with its own
+// pattern, and the robot charges at it; the untaped default dock reads no code at all.
+TEST(DockdDaemon, TheStatusSaysWhetherTheDocksCodeWasRead) {
+  Rig r("code", false, 1.2, false, false, "two-docks.toml");
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
+  r.host.command(1, 0);  // dock at dock 0: plate-v-code-a
+  char json[dockcore::drivers::kMaxHostReply];
+  bool read = false;
+  CHECK_TRUE(r.run_until(
+      [&] {
+        if (r.daemon->state() == TaskState::kAlign && r.daemon->status_json(json, sizeof json, r.clock.t) > 0)
+          read = read || std::strstr(json, "\"det_code\":\"read\"") != nullptr;
+        return r.daemon->state() == TaskState::kFinishTasking;
+      },
+      60.0));
+  CHECK_TRUE(read);
+  CHECK_TRUE(r.chassis->state().charging);
+  STRCMP_CONTAINS("\"lidar_intensity\":\"usable\"", json);
+  Rig plain("code_plain");
+  plain.run_until([] { return false; }, 0.5);
+  CHECK(plain.daemon->status_json(json, sizeof json, plain.clock.t) > 0);
+  STRCMP_CONTAINS("\"det_code\":\"none\"", json);
 }
 
 // CAN error frames (counted by the bus, mirrored by the chassis link) reach the session record as can_error events:
