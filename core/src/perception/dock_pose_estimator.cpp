@@ -74,8 +74,6 @@ constexpr Real kGateGrowthShare = static_cast<Real>(0.5);
 constexpr Real kWallSeenUnknownNats = static_cast<Real>(0.196);
 constexpr Real kWallSeenMountedNats = static_cast<Real>(1.45);
 constexpr Real kWallMissedMountedNats = static_cast<Real>(-1.67);
-// Between two verified objects, evidence stronger by this much (a likelihood ratio of e^3 = 20) decides over
-// nearness; closer than that, both are taken for docks and the nearest is chosen.
 // The intensity cue, per region of the stripe pattern (a stripe or a gap) with a beam well inside it: on this dock a
 // region reads as the profile says with probability 0.99; on another dock of this shape (another code, or no tape)
 // with probability 0.5.
@@ -83,7 +81,8 @@ constexpr Real kRegionMatchNats = static_cast<Real>(0.683);      // ln(0.99 / 0.
 constexpr Real kRegionMismatchNats = static_cast<Real>(-3.912);  // ln(0.01 / 0.5)
 // A beam this close to a stripe's end (plus half its footprint) is left out: its footprint may straddle the edge.
 constexpr Real kStripeEdgeMarginM = static_cast<Real>(0.005);
-
+// Between two verified objects, evidence stronger by this much (a likelihood ratio of e^3 = 20) decides over
+// nearness; closer than that, both are taken for docks and the nearest is chosen.
 constexpr Real kSelectMarginNats = static_cast<Real>(3);
 // Beams closer together than this on a surface are not independent evidence: rooms are made of smooth surfaces, so
 // where one beam lands on a dock-like surface by chance its neighbours do too.
@@ -638,12 +637,13 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   gated_box(placed_, gate, &box_lo, &box_hi);
   const bool read_stripes = profile_.reflector_count > 0 && intensity_usable_ && intensities_ != nullptr;
   // The stripe pattern's regions, read beam by beam: each stripe, the gap before it, the gap after a segment's last.
-  std::uint8_t stripe_n[kMaxReflectors] = {};
-  std::uint8_t stripe_bright[kMaxReflectors] = {};
-  std::uint8_t gap_n[kMaxReflectors] = {};
-  std::uint8_t gap_bright[kMaxReflectors] = {};
-  std::uint8_t after_n[kMaxReflectors] = {};
-  std::uint8_t after_bright[kMaxReflectors] = {};
+  // 16 bits: a fine lidar near the dock puts hundreds of beams on one stripe.
+  std::uint16_t stripe_n[kMaxReflectors] = {};
+  std::uint16_t stripe_bright[kMaxReflectors] = {};
+  std::uint16_t gap_n[kMaxReflectors] = {};
+  std::uint16_t gap_bright[kMaxReflectors] = {};
+  std::uint16_t after_n[kMaxReflectors] = {};
+  std::uint16_t after_bright[kMaxReflectors] = {};
   for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
     std::size_t i = 0;
     if (!beam_at(first, k, &i)) continue;
@@ -737,7 +737,7 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   if (read_stripes) {
     // A stripe reads as tape when half its beams or more are bright; a gap reads as tape when two or more of its
     // beams and over a quarter of them are (one stray bright beam is a glint, not another dock's stripe).
-    auto read = [&f](std::uint8_t n, std::uint8_t bright, bool tape_expected) {
+    auto read = [&f](std::uint16_t n, std::uint16_t bright, bool tape_expected) {
       if (n == 0) return;
       const bool reads_tape = tape_expected ? 2 * bright >= n : (bright >= 2 && 4 * bright > n);
       ++(reads_tape == tape_expected ? f.regions_matched : f.regions_mismatched);
