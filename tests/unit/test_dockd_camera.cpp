@@ -164,7 +164,7 @@ TEST(DockdCamera, TheCameraPartCarriesTheCameraFields) {
 }
 
 TEST(DockdCamera, StatusWithoutTheCameraFieldsWhenTheyDoNotFit) {
-  // Every counter at its largest, beside the tag fusion's fields: more than the status's 1400 bytes.
+  // Every counter at its largest, beside the tag fusion's fields: more than the status's 1472 bytes.
   dockcore::hal::CameraStatus cs;
   cs.capture.frames = cs.capture.dropped = cs.capture.late = cs.capture.corrupt = 18446744073709551615ull;
   cs.capture.reconnects = 4294967295u;
@@ -272,7 +272,7 @@ TEST(DockdCamera, ACameraThatNeverDeliversStallsFromStartAndNoWatchdogWithoutOne
 
 TEST(DockdCamera, TheStallFlagComesBeforeTheCameraCountersInAFullStatus) {
   // The own camera after a week at 30 frames/s (18 million frames, a million of them dropped, late or corrupt), a
-  // week after boot. With the tag fusion's fields and the stall flag the status is about 1.24 kB of its 1400 bytes:
+  // week after boot. With the tag fusion's fields and the stall flag the status is about 1.38 kB of its 1472 bytes:
   // the capture counters (about 170 bytes, as the status writes them below) are what is left out, the flag stays.
   dockcore::hal::CameraStatus cs;
   cs.capture.frames = 18144000;

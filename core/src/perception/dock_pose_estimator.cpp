@@ -156,18 +156,26 @@ bool near_pose(const Pose2& a, const Pose2& b, Real d_m, Real yaw_rad) {
 const char* to_string(RejectReason r) {
   switch (r) {
     case RejectReason::kNone: return "none";
-    case RejectReason::kNoConvergence: return "registration failed";
-    case RejectReason::kTooFewInliers: return "too few inliers";
-    case RejectReason::kMostlyHidden: return "mostly hidden";
-    case RejectReason::kOblique: return "face seen too obliquely";
-    case RejectReason::kOutOfRange: return "out of range";
-    case RejectReason::kUncertain: return "pose too uncertain";
-    case RejectReason::kFarFromHint: return "too far from the hint";
-    case RejectReason::kWeakEvidence: return "evidence below min_evidence_nats";
+    case RejectReason::kNoConvergence:
+      return "no_convergence";
+    case RejectReason::kTooFewInliers:
+      return "too_few_inliers";
+    case RejectReason::kMostlyHidden:
+      return "mostly_hidden";
+    case RejectReason::kOblique:
+      return "oblique";
+    case RejectReason::kOutOfRange:
+      return "out_of_range";
+    case RejectReason::kUncertain:
+      return "uncertain";
+    case RejectReason::kFarFromHint:
+      return "far_from_hint";
+    case RejectReason::kWeakEvidence:
+      return "weak_evidence";
     case RejectReason::kWrongCode:
-      return "reflector stripes read another pattern";
+      return "wrong_code";
     case RejectReason::kCodeUnread:
-      return "no reflector stripe read (too far for the stripes' width)";
+      return "code_unread";
     case RejectReason::kCount: break;
   }
   return "unknown reason";

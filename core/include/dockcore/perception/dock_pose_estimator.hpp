@@ -132,7 +132,8 @@ struct DockEvidence {
   EvidenceCue weakest() const;
 };
 
-/// Human-readable name of a RejectReason. Never null.
+/// Short name of a RejectReason ("weak_evidence", "wrong_code", ...; at most 15 characters: it goes into dockd's
+/// one-datagram status as `det_reject`). Never null.
 const char* to_string(RejectReason r);
 
 /// Human-readable name of an EstimateStatus. Never null.

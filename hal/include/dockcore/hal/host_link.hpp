@@ -55,8 +55,9 @@ struct HostPeer {
 
 /// Largest request datagram a HostRequestLink hands on whole, bytes.
 constexpr std::size_t kMaxHostDatagram = 512;
-/// Largest reply or status datagram a HostRequestLink sends, bytes, its newline included.
-constexpr std::size_t kMaxHostReply = 1400;
+/// Largest reply or status datagram a HostRequestLink sends, bytes, its newline included: the largest UDP payload an
+/// Ethernet frame (MTU 1500, less 20 bytes of IPv4 and 8 of UDP header) carries unfragmented.
+constexpr std::size_t kMaxHostReply = 1472;
 
 /// One request datagram as received: bytes only, the consumer parses them.
 struct HostDatagram {
