@@ -61,6 +61,11 @@ IntensityScan IntensityCheck::add(const ScanView& scan) {
   ++scans_;
   IntensityScan r;
   const std::size_t stride = scan.count > kMaxSamples ? (scan.count + kMaxSamples - 1) / kMaxSamples : 1;
+  // A sampled beam's intensity (0 when the scan has none or it is not finite).
+  auto intensity_at = [&scan](std::size_t i) {
+    return scan.intensities != nullptr && std::isfinite(scan.intensities[i]) ? scan.intensities[i]
+                                                                             : static_cast<Real>(0);
+  };
   // Majority vote (Boyer-Moore): if one value holds over half the sampled returns, it is the candidate left.
   Real candidate = 0;
   std::size_t votes = 0;
@@ -68,7 +73,7 @@ IntensityScan IntensityCheck::add(const ScanView& scan) {
   bool all_zero = true;
   for (std::size_t i = 0; i < scan.count; i += stride) {
     if (!is_return(scan.ranges_m[i])) continue;
-    const Real v = scan.intensities != nullptr && std::isfinite(scan.intensities[i]) ? scan.intensities[i] : 0;
+    const Real v = intensity_at(i);
     ++n;
     if (v != 0) all_zero = false;
     if (votes == 0) {
@@ -88,7 +93,7 @@ IntensityScan IntensityCheck::add(const ScanView& scan) {
   std::size_t near = 0;
   for (std::size_t i = 0; i < scan.count; i += stride) {
     if (!is_return(scan.ranges_m[i])) continue;
-    const Real v = scan.intensities != nullptr && std::isfinite(scan.intensities[i]) ? scan.intensities[i] : 0;
+    const Real v = intensity_at(i);
     if (std::fabs(v - candidate) <= p_.flat_band) ++near;
   }
   r.judged = true;

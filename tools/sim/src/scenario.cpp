@@ -133,16 +133,24 @@ std::string profile_ref(const std::string& ref, const std::string& source_name) 
   return is_file && !ref.empty() && ref[0] != '/' ? dir_of(source_name) + ref : ref;
 }
 
-/// Adds the furniture beside the dock to the scenario's world boxes and circles (docs/scenarios.md, [dock]).
-void place_furniture(Scenario& sc) {
-  const dockcore::DockProfile& prof = sc.profile;
+/// A profile's outline extent in its dock frame: its back (smallest x) and its sides (smallest and largest y), m.
+struct Extent {
   double min_x = 0, min_y = 0, max_y = 0;
+};
+Extent extent_of(const dockcore::DockProfile& prof) {
+  Extent e;
   for (std::size_t i = 0; i < prof.vertex_count; ++i) {
     const Vec2& v = prof.vertices_m[i];
-    min_x = i == 0 ? static_cast<double>(v.x()) : std::min(min_x, static_cast<double>(v.x()));
-    min_y = i == 0 ? static_cast<double>(v.y()) : std::min(min_y, static_cast<double>(v.y()));
-    max_y = i == 0 ? static_cast<double>(v.y()) : std::max(max_y, static_cast<double>(v.y()));
+    e.min_x = i == 0 ? static_cast<double>(v.x()) : std::min(e.min_x, static_cast<double>(v.x()));
+    e.min_y = i == 0 ? static_cast<double>(v.y()) : std::min(e.min_y, static_cast<double>(v.y()));
+    e.max_y = i == 0 ? static_cast<double>(v.y()) : std::max(e.max_y, static_cast<double>(v.y()));
   }
+  return e;
+}
+
+/// Adds the furniture beside the dock to the scenario's world boxes and circles (docs/scenarios.md, [dock]).
+void place_furniture(Scenario& sc) {
+  const auto [min_x, min_y, max_y] = extent_of(sc.profile);
   const double back_x = sc.wall ? min_x - sc.wall_gap_m + kFurnitureWallClearanceM : min_x;
   auto world = [&](double x, double y) {
     return sc.dock_pose.transform(Vec2(static_cast<Real>(x), static_cast<Real>(y)));
@@ -182,15 +190,9 @@ void place_furniture(Scenario& sc) {
       }
       case FurnitureKind::kDock: {
         // Its nearest vertex `near` beside the dock, its back plane on the dock's.
-        double o_min_x = 0, o_min_y = 0, o_max_y = 0;
-        for (std::size_t i = 0; i < f.profile.vertex_count; ++i) {
-          const Vec2& v = f.profile.vertices_m[i];
-          o_min_x = i == 0 ? static_cast<double>(v.x()) : std::min(o_min_x, static_cast<double>(v.x()));
-          o_min_y = i == 0 ? static_cast<double>(v.y()) : std::min(o_min_y, static_cast<double>(v.y()));
-          o_max_y = i == 0 ? static_cast<double>(v.y()) : std::max(o_max_y, static_cast<double>(v.y()));
-        }
-        const double y = f.side > 0 ? near - o_min_y : -near - o_max_y;
-        const double x = f.x_set ? f.x_m : min_x - o_min_x;
+        const Extent o = extent_of(f.profile);
+        const double y = f.side > 0 ? near - o.min_y : -near - o.max_y;
+        const double x = f.x_set ? f.x_m : min_x - o.min_x;
         Scenario::OtherDock d;
         d.profile = f.profile;
         d.pose = sc.dock_pose.compose(Pose2{static_cast<Real>(x), static_cast<Real>(y), 0});
