@@ -239,6 +239,14 @@ int run_one(const RunOptions& opt) {
     if (std::isfinite(o.min_clearance_m)) std::printf("  minimum obstacle clearance %.3f m\n", o.min_clearance_m);
     std::printf("  lidar intensity %s (%s: %u of %u judged scans flat)\n", dockcore::to_string(o.intensity),
                 docksim::to_string(sc.lidar.intensity_output), o.intensity_scans_flat, o.intensity_scans_judged);
+    std::printf("  detector: %u scans, dock found in %u; candidates refused:", o.detector.scans, o.detector.found);
+    bool any_refused = false;
+    for (std::size_t k = 1; k < static_cast<std::size_t>(dockcore::RejectReason::kCount); ++k) {
+      if (o.detector.rejected_by[k] == 0) continue;
+      std::printf(" %s %u", dockcore::to_string(static_cast<dockcore::RejectReason>(k)), o.detector.rejected_by[k]);
+      any_refused = true;
+    }
+    std::printf("%s\n", any_refused ? "" : " none");
     for (const auto& kv : o.faults) {
       std::printf("  fault %d %s x%d\n", kv.first, dockcore::to_string(static_cast<dockcore::FaultCode>(kv.first)),
                   kv.second);

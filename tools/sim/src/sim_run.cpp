@@ -692,6 +692,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   out.intensity = core->intensity().verdict();
   out.intensity_scans_judged = core->intensity().scans_judged();
   out.intensity_scans_flat = core->intensity().scans_flat();
+  out.detector = core->estimator().counters();
   const ChassisState& fs = chassis.state();
   out.end_time_s = static_cast<double>(k) * dt;
   out.final_state = prev_state;

@@ -121,6 +121,9 @@ struct SimOutcome {
   dockcore::IntensityVerdict intensity = dockcore::IntensityVerdict::kUnknown;
   std::uint32_t intensity_scans_judged = 0;
   std::uint32_t intensity_scans_flat = 0;
+  /// The dock estimator's counters at the end (scans, found, candidates refused by reason): why a dock was or was
+  /// not taken.
+  dockcore::EstimatorCounters detector{};
 };
 
 struct SimRun {
