@@ -309,9 +309,20 @@ const char* to_string(IntensityOutput o) {
   return "raw";
 }
 
+namespace {
+constexpr IntensityOutput kIntensityOutputs[] = {IntensityOutput::kRaw, IntensityOutput::kLd06,
+                                                 IntensityOutput::kRplidarQuality, IntensityOutput::kConstant,
+                                                 IntensityOutput::kNone};
+}  // namespace
+
+std::vector<std::string> intensity_output_names() {
+  std::vector<std::string> names;
+  for (IntensityOutput o : kIntensityOutputs) names.emplace_back(to_string(o));
+  return names;
+}
+
 bool intensity_output(const std::string& name, IntensityOutput* out) {
-  for (IntensityOutput o : {IntensityOutput::kRaw, IntensityOutput::kLd06, IntensityOutput::kRplidarQuality,
-                            IntensityOutput::kConstant, IntensityOutput::kNone}) {
+  for (IntensityOutput o : kIntensityOutputs) {
     if (name == to_string(o)) {
       *out = o;
       return true;

@@ -339,10 +339,7 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         {"dropout", [&](const toml::node& n) { st.lidar_dropout = p.number(n, 0, 1); }},
         {"angular_jitter_deg", [&](const toml::node& n) { st.lidar_jitter_rad = p.number(n, 0, 10) * kDeg; }},
         {"mixed_pixels", [&](const toml::node& n) { st.mixed_pixels = p.boolean(n) ? 1 : 0; }},
-        {"intensity",
-         [&](const toml::node& n) {
-           st.lidar_intensity = p.choice(n, {"raw", "ld06", "rplidar-quality", "constant", "none"});
-         }},
+        {"intensity", [&](const toml::node& n) { st.lidar_intensity = p.choice(n, intensity_output_names()); }},
         {"rate_hz", [&](const toml::node& n) { st.lidar_rate_hz = p.number(n, 0.5, 100); }},
         // The sensor's range, under the name of dockd's [lidar] range key: it takes that key's bounds.
         {"max_range_m", params::bounded_by(p, "lidar", "max_range_m", &st.lidar_max_range_m)},
@@ -421,6 +418,10 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
                h.emplace_back("leg_radius_m", p.num(&f.leg_radius_m, 0.005, 0.05));
              }
              p.each(*t, "dock.furniture." + kind + ".", h);
+             if (f.kind == FurnitureKind::kDock &&
+                 (st.furniture_profiles.empty() || st.furniture_profiles.back().index != sc.furniture.size())) {
+               p.fail(t->source(), "dock.furniture entry of kind dock without 'profile'");
+             }
              sc.furniture.push_back(f);
            }
          }},
@@ -677,7 +678,6 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
     if (sc.furniture[i].kind != FurnitureKind::kDock) continue;
     const auto it = std::find_if(st.furniture_profiles.begin(), st.furniture_profiles.end(),
                                  [i](const ParseState::FurnitureProfile& f) { return f.index == i; });
-    if (it == st.furniture_profiles.end()) p.fail(root.source(), "dock.furniture entry of kind dock without 'profile'");
     try {
       sc.furniture[i].profile = resolve_profile(profile_ref(it->ref, source_name));
     } catch (const ProfileFileError& e) {

@@ -65,6 +65,8 @@ enum class IntensityOutput : std::uint8_t {
 const char* to_string(IntensityOutput o);
 /// The output named `name` (as to_string writes it); false for an unknown name.
 bool intensity_output(const std::string& name, IntensityOutput* out);
+/// Every output's name, in enum order (the scenario key's choices).
+std::vector<std::string> intensity_output_names();
 
 /// How a lidar samples and what its errors look like.
 struct LidarModel {
