@@ -157,12 +157,17 @@ TEST(Profile, EveryErrorHasItsOwnMessage) {
                                  ProfileError::kTooManyVertices,
                                  ProfileError::kDegenerateSegment,
                                  ProfileError::kNotFinite,
-                                 ProfileError::kUnknownName};
+                                 ProfileError::kUnknownName,
+                                 ProfileError::kReflectorNoSegment,
+                                 ProfileError::kReflectorOffSegment,
+                                 ProfileError::kReflectorTooShort,
+                                 ProfileError::kReflectorOverlap,
+                                 ProfileError::kTooManyReflectors};
   const std::size_t n = sizeof(errors) / sizeof(errors[0]);
   for (std::size_t a = 0; a < n; ++a) {
     const char* msg = to_string(errors[a]);
     CHECK(msg != nullptr);
-    STRCMP_NOCASE_CONTAINS(a == 0 ? "ok" : "profile", msg);
+    STRCMP_NOCASE_CONTAINS(a == 0 ? "ok" : (a < 6 ? "profile" : "reflector"), msg);
     for (std::size_t b = 0; b < a; ++b) CHECK(std::strcmp(msg, to_string(errors[b])) != 0);
   }
   // The capacity the message names is the real one.
@@ -170,6 +175,28 @@ TEST(Profile, EveryErrorHasItsOwnMessage) {
   std::snprintf(cap, sizeof cap, "%zu", kMaxProfileVertices);
   STRCMP_CONTAINS(cap, to_string(ProfileError::kTooManyVertices));
   STRCMP_EQUAL("unknown profile error", to_string(static_cast<ProfileError>(200)));
+}
+
+TEST(Profile, EachBadReflectorSaysWhichRuleItBrokeAndLeavesTheProfileAlone) {
+  DockProfile p;
+  CHECK(builtin_profile("plate-v", p) == ProfileError::kOk);  // face: segment 1, 0.30 m
+  const auto add = [&p](std::uint8_t seg, double from_m, double to_m) {
+    return static_cast<int>(add_reflector(p, ReflectorStripe{seg, static_cast<Real>(from_m), static_cast<Real>(to_m)}));
+  };
+  CHECK_EQUAL(static_cast<int>(ProfileError::kOk), add(1, 0.10, 0.20));
+  CHECK_EQUAL(static_cast<int>(ProfileError::kReflectorNoSegment), add(3, 0.0, 0.05));
+  CHECK_EQUAL(static_cast<int>(ProfileError::kReflectorOffSegment), add(1, 0.25, 0.35));
+  CHECK_EQUAL(static_cast<int>(ProfileError::kReflectorOffSegment), add(1, -0.01, 0.05));
+  CHECK_EQUAL(static_cast<int>(ProfileError::kReflectorOffSegment), add(1, 0.0, std::nan("")));
+  CHECK_EQUAL(static_cast<int>(ProfileError::kReflectorTooShort), add(1, 0.0, 0.005));
+  CHECK_EQUAL(static_cast<int>(ProfileError::kReflectorOverlap), add(1, 0.15, 0.25));
+  CHECK_EQUAL(1u, p.reflector_count);
+  // A file's millimetre rounding past the end is cut at the end, more is refused.
+  CHECK_EQUAL(static_cast<int>(ProfileError::kOk), add(1, 0.25, 0.3004));
+  REAL_EQUAL(0.30, p.reflectors[1].to_m, 1e-6);
+  for (int k = 0; k < 6; ++k) CHECK_EQUAL(static_cast<int>(ProfileError::kOk), add(0, 0.015 * k, 0.015 * k + 0.011));
+  CHECK_EQUAL(static_cast<int>(ProfileError::kTooManyReflectors), add(2, 0.0, 0.05));
+  CHECK_EQUAL(8u, p.reflector_count);
 }
 
 TEST(Profile, MountKindNamesRoundTripAndOthersAreRefused) {

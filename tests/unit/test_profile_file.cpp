@@ -259,13 +259,21 @@ TEST(ProfileFile, ReflectorsAreReadInOrderAndRoundTrip) {
 
 TEST(ProfileFile, BadReflectorsArePositioned) {
   const std::string pts = "points = [[-0.05, -0.2], [0, -0.15], [0, 0.15], [-0.05, 0.2]]\n";
-  check_position(pts + "[[reflectors]]\nsegment = 3\nfrom_m = 0\nto_m = 0.05\n", 2, 1, "segment 3 does not exist");
-  check_position(pts + "[[reflectors]]\nsegment = 1\nfrom_m = 0.25\nto_m = 0.35\n", 2, 1, "past the end of segment 1");
+  check_position(pts + "[[reflectors]]\nsegment = 3\nfrom_m = 0\nto_m = 0.05\n", 2, 1,
+                 "on a segment the outline does not have (segment 3; the outline has 3)");
+  check_position(pts + "[[reflectors]]\nsegment = 1\nfrom_m = 0.25\nto_m = 0.35\n", 2, 1,
+                 "runs off its segment (0.250-0.350 m on segment 1, which is 0.300 m long)");
   check_position(pts + "[[reflectors]]\nsegment = 1\nfrom_m = 0.1\nto_m = 0.105\n", 2, 1, "shorter than 1 cm");
   check_position(pts +
                      "[[reflectors]]\nsegment = 1\nfrom_m = 0\nto_m = 0.1\n[[reflectors]]\nsegment = 1\n"
                      "from_m = 0.05\nto_m = 0.15\n",
-                 6, 1, "overlaps another reflector");
+                 6, 1, "overlaps another");
+  std::string nine = pts;
+  for (int k = 0; k < 9; ++k) {
+    nine += "[[reflectors]]\nsegment = 1\nfrom_m = " + std::to_string(0.03 * k) +
+            "\nto_m = " + std::to_string(0.03 * k + 0.02) + "\n";
+  }
+  check_position(nine, 2 + 4 * 8, 1, "more than 8 reflector stripes");
   check_position(pts + "[[reflectors]]\nsegment = 1\nfrom_m = 0\n", 2, 1, "needs segment, from_m and to_m");
   check_position(pts + "[[reflectors]]\nsegment = 1\nfrom_m = 0\nto_m = 0.1\nwidth_m = 3\n", 6, 1,
                  "unknown key 'reflectors.width_m'");

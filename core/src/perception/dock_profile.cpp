@@ -29,8 +29,16 @@ const char* to_string(ProfileError e) {
     case ProfileError::kDegenerateSegment: return "two consecutive profile vertices are closer than 1 mm";
     case ProfileError::kNotFinite: return "profile vertex is not a finite number";
     case ProfileError::kUnknownName: return "no built-in profile by that name";
-    case ProfileError::kBadReflector:
-      return "reflector stripe is off its segment, shorter than 1 cm, overlaps another, or is one too many (8)";
+    case ProfileError::kReflectorNoSegment:
+      return "reflector stripe on a segment the outline does not have";
+    case ProfileError::kReflectorOffSegment:
+      return "reflector stripe runs off its segment";
+    case ProfileError::kReflectorTooShort:
+      return "reflector stripe shorter than 1 cm";
+    case ProfileError::kReflectorOverlap:
+      return "reflector stripe overlaps another";
+    case ProfileError::kTooManyReflectors:
+      return "more than 8 reflector stripes";
   }
   return "unknown profile error";
 }
@@ -102,20 +110,20 @@ ProfileError make_profile(const Vec2* vertices_m, std::size_t n, Real contact_of
 }
 
 ProfileError add_reflector(DockProfile& profile, const ReflectorStripe& stripe) {
-  if (profile.reflector_count >= kMaxReflectors || stripe.segment >= profile.segment_count()) {
-    return ProfileError::kBadReflector;
-  }
-  if (!std::isfinite(stripe.from_m) || !std::isfinite(stripe.to_m)) return ProfileError::kBadReflector;
+  if (profile.reflector_count >= kMaxReflectors) return ProfileError::kTooManyReflectors;
+  if (stripe.segment >= profile.segment_count()) return ProfileError::kReflectorNoSegment;
+  if (!std::isfinite(stripe.from_m) || !std::isfinite(stripe.to_m)) return ProfileError::kReflectorOffSegment;
   const Real len = (profile.vertices_m[stripe.segment + 1] - profile.vertices_m[stripe.segment]).norm();
   // A stripe to the segment's end, written with the millimetre precision of a file, may pass its rounded length.
   ReflectorStripe s = stripe;
   if (s.to_m > len && s.to_m <= len + to_real(0.0005)) s.to_m = len;
-  if (s.from_m < 0 || s.to_m > len || s.to_m - s.from_m < to_real(0.01)) return ProfileError::kBadReflector;
+  if (s.from_m < 0 || s.to_m > len) return ProfileError::kReflectorOffSegment;
+  if (s.to_m - s.from_m < to_real(0.01)) return ProfileError::kReflectorTooShort;
   // Position in outline order; refuse any overlap with the stripes on the same segment.
   std::size_t at = profile.reflector_count;
   for (std::size_t i = 0; i < profile.reflector_count; ++i) {
     const ReflectorStripe& r = profile.reflectors[i];
-    if (r.segment == s.segment && r.from_m < s.to_m && s.from_m < r.to_m) return ProfileError::kBadReflector;
+    if (r.segment == s.segment && r.from_m < s.to_m && s.from_m < r.to_m) return ProfileError::kReflectorOverlap;
     if (at == profile.reflector_count && (r.segment > s.segment || (r.segment == s.segment && r.from_m > s.from_m))) {
       at = i;
     }

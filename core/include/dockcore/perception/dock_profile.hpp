@@ -18,12 +18,16 @@ constexpr std::size_t kMaxProfileVertices = 32;
 /// Why a profile was refused.
 enum class ProfileError : std::uint8_t {
   kOk = 0,
-  kTooFewVertices,     ///< Fewer than 2 vertices.
-  kTooManyVertices,    ///< More than kMaxProfileVertices.
-  kDegenerateSegment,  ///< Two consecutive vertices closer than 1 mm.
-  kNotFinite,          ///< A coordinate is NaN or inf.
-  kUnknownName,        ///< No built-in profile by that name.
-  kBadReflector,       ///< A reflector stripe off its segment, shorter than 1 cm, overlapping another, or one too many.
+  kTooFewVertices,       ///< Fewer than 2 vertices.
+  kTooManyVertices,      ///< More than kMaxProfileVertices.
+  kDegenerateSegment,    ///< Two consecutive vertices closer than 1 mm.
+  kNotFinite,            ///< A coordinate is NaN or inf.
+  kUnknownName,          ///< No built-in profile by that name.
+  kReflectorNoSegment,   ///< A reflector stripe names a segment the outline does not have.
+  kReflectorOffSegment,  ///< A stripe starts before its segment or ends past it (or is not finite).
+  kReflectorTooShort,    ///< A stripe shorter than 1 cm.
+  kReflectorOverlap,     ///< A stripe overlaps another on its segment.
+  kTooManyReflectors,    ///< kMaxReflectors stripes are there already.
 };
 
 /// Human-readable name of a ProfileError, for messages. Never null.
@@ -93,9 +97,10 @@ struct DockProfile {
 ProfileError make_profile(const Vec2* vertices_m, std::size_t n, Real contact_offset_m, const char* name,
                           DockProfile& out);
 
-/// Adds a reflector stripe to `profile`, keeping the stripes in order along the outline. kBadReflector (profile
-/// unchanged) when the segment does not exist, the stripe leaves its segment, is shorter than 1 cm, overlaps another
-/// stripe, is not finite, or kMaxReflectors are there already. O(kMaxReflectors).
+/// Adds a reflector stripe to `profile`, keeping the stripes in order along the outline. A stripe ending up to 0.5 mm
+/// past its segment's end (a file's millimetre rounding) is cut at the end. On error the profile is unchanged and the
+/// result says which rule the stripe broke: kTooManyReflectors, kReflectorNoSegment, kReflectorOffSegment (also not
+/// finite), kReflectorTooShort (under 1 cm), kReflectorOverlap. O(kMaxReflectors).
 ProfileError add_reflector(DockProfile& profile, const ReflectorStripe& stripe);
 
 /// Names of the built-in profiles, null-terminated list: "breakpoint", "v-marker", "plate-v". Dimensions in docs/docks.md.

@@ -263,18 +263,19 @@ DockProfile parse(const std::string& text, const std::string& source, const std:
   for (std::size_t i = 0; i < stripes.size(); ++i) {
     const ReflectorStripe& s = stripes[i].stripe;
     const std::string what = "reflectors[" + std::to_string(i) + "]: ";
-    if (s.segment >= out.segment_count()) {
-      p.fail(stripes[i].where, what + "segment " + std::to_string(s.segment) + " does not exist (the outline has " +
-                                   std::to_string(out.segment_count()) + ")");
+    const ProfileError e = add_reflector(out, s);
+    if (e == ProfileError::kOk) continue;
+    // add_reflector decides; the message adds what a user needs to mend the entry.
+    char detail[96] = "";
+    if (e == ProfileError::kReflectorNoSegment) {
+      std::snprintf(detail, sizeof detail, " (segment %u; the outline has %zu)", static_cast<unsigned>(s.segment),
+                    out.segment_count());
+    } else if (e == ProfileError::kReflectorOffSegment) {
+      const double len = static_cast<double>((out.vertices_m[s.segment + 1] - out.vertices_m[s.segment]).norm());
+      std::snprintf(detail, sizeof detail, " (%.3f-%.3f m on segment %u, which is %.3f m long)",
+                    static_cast<double>(s.from_m), static_cast<double>(s.to_m), static_cast<unsigned>(s.segment), len);
     }
-    const double len = static_cast<double>((out.vertices_m[s.segment + 1] - out.vertices_m[s.segment]).norm());
-    if (static_cast<double>(s.to_m) > len + 0.0005) {
-      p.fail(stripes[i].where, what + "to_m " + std::to_string(s.to_m) + " is past the end of segment " +
-                                   std::to_string(s.segment) + " (" + std::to_string(len) + " m long)");
-    }
-    if (s.to_m - s.from_m < static_cast<Real>(0.01)) p.fail(stripes[i].where, what + "shorter than 1 cm");
-    if (i >= kMaxReflectors) p.fail(stripes[i].where, what + "more than 8 reflectors");
-    if (add_reflector(out, s) != ProfileError::kOk) p.fail(stripes[i].where, what + "overlaps another reflector");
+    p.fail(stripes[i].where, what + to_string(e) + detail);
   }
   return out;
 }
