@@ -65,6 +65,7 @@ struct Options {
   std::size_t real_limit = 0;                // scans per recording, 0 = all
   std::vector<std::string> real_recordings;  // empty = all
   std::size_t composite_per_cell = 100;      // composites per (recording, profile, kind)
+  bool reflective_clutter = false;           // real: scans with intensities and reflective clutter pasted in
 };
 
 /// Accumulates one cell of a results table.
@@ -555,14 +556,29 @@ json run_real_fp(const Options& o, const RealData& d) {
                               "the first in the world frame (standing sensor: in the sensor frame, stamps <= 1 s "
                               "apart). Denominator: windows (scans - 2 per recording with poses)."}};
   out["recordings"] = d.load_json;
+  out["reflective_clutter"] = o.reflective_clutter;
+  if (o.reflective_clutter) {
+    out["reflective_clutter_text"] =
+        "every return given an LD06 intensity (diffuse, reflectivity 0.1-1.0 per 0.5 m world cell), 1-3 reflective "
+        "objects (taped signs, safety vests, chrome legs) pasted into each window's free space, intensity usable; "
+        "seed " +
+        std::to_string(o.seed);
+  }
   json rows = json::array();
   json totals = json::array();
   for (const auto& pname : o.profiles) {
     const dockcore::DockProfile prof = docksim::resolve_profile(pname);
+    if (o.reflective_clutter && prof.reflector_count == 0) {
+      throw CLI::ValidationError("--reflective-clutter", "profile " + pname + " has no reflector stripes");
+    }
     std::size_t scans = 0, found = 0, windows = 0, confirmed = 0, confirmed_seq = 0;
     Progress pr{"real: false positives", static_cast<long>(d.recordings.size())};
     for (const docksim::LoadedRecording& rec : d.recordings) {
-      const docksim::RealFpResult r = docksim::measure_real_false_positives(rec, prof, rule);
+      docksim::ReflectiveClutterOptions ro;
+      ro.seed = o.seed;
+      const docksim::RealFpResult r = o.reflective_clutter
+                                          ? docksim::measure_real_reflector_false_positives(rec, prof, ro, rule)
+                                          : docksim::measure_real_false_positives(rec, prof, rule);
       json row;
       row["recording"] = rec.info->name;
       row["profile"] = pname;
@@ -743,6 +759,9 @@ void print_real_text(const json& j) {
         std::printf("%-26s %6zu %7zu %6.1f %6.2g  %-18s %s\n", l["name"].get<std::string>().c_str(),
                     l["scans"].get<std::size_t>(), l["skipped_lines"].get<std::size_t>(), l["sigma_mm"].get<double>(),
                     l["resolution_mm"].get<double>(), l["pose_source"].get<std::string>().c_str(), match.c_str());
+      }
+      if (r.contains("reflective_clutter_text")) {
+        std::printf("\nReflective clutter: %s\n", r["reflective_clutter_text"].get<std::string>().c_str());
       }
       std::printf("\nConfirmed: %s\n\n", r["rule"]["text"].get<std::string>().c_str());
       std::printf("(att = windows whose first scan found a dock: the only ones that can confirm)\n");
@@ -926,6 +945,9 @@ void register_perception(CLI::App& app) {
       ->check(docksim::non_negative_integer());
   auto real_names = std::make_shared<std::string>();
   sub->add_option("--real-recordings", *real_names, "Real data: comma-separated recording names (default: all)");
+  sub->add_flag("--reflective-clutter", o->reflective_clutter,
+                "real: give every return an LD06 intensity and paste reflective objects (taped signs, safety vests, "
+                "chrome legs) into the scans; the profiles must carry reflector stripes, read with intensity usable");
   sub->add_option("--composite-n", o->composite_per_cell,
                   "Composite scenes per (recording, profile, placement), at most one per scan")
       ->check(CLI::PositiveNumber);

@@ -331,9 +331,14 @@ bool intensity_output(const std::string& name, IntensityOutput* out) {
   return false;
 }
 
-namespace {
+double surface_intensity(const LidarModel& m, const Segment& s, double range_m, double cos_incidence) {
+  const double q = range_m / m.intensity_ref_range_m;
+  if (s.retro && cos_incidence >= std::cos(s.retro_cutoff_rad > 0 ? s.retro_cutoff_rad : m.retro_cutoff_rad)) {
+    return m.intensity_scale * m.retro_gain / (1.0 + q * q);
+  }
+  return m.intensity_scale * (s.retro ? 0.5 : s.reflectivity) * cos_incidence / (1.0 + q * q);
+}
 
-/// The sensor's report of a raw model intensity (LidarModel::intensity_output).
 double sensor_intensity(const LidarModel& m, double raw) {
   switch (m.intensity_output) {
     case IntensityOutput::kRaw:
@@ -349,8 +354,6 @@ double sensor_intensity(const LidarModel& m, double raw) {
   }
   return raw;
 }
-
-}  // namespace
 
 bool lidar_model(const std::string& name, LidarModel* out) {
   LidarModel m;
@@ -433,14 +436,10 @@ void simulate_scan(const World& world, const Pose2& lidar_pose, const LidarModel
   const double yaw = static_cast<double>(lidar_pose.yaw_rad);
   const bool use_mixed = model.mixed_pixels && model.beam_divergence_rad > 0;
   const bool retro_world = world.has_retro();
-  const double cos_retro_cutoff = std::cos(model.retro_cutoff_rad);
   // The model's intensity of a hit on segment k at range t along (dx, dy).
   auto raw_intensity = [&](long k, double t, double ddx, double ddy) {
     const RelSeg& s = caster.seg(k);
-    const double q = t / model.intensity_ref_range_m;
-    const double c = cos_incidence(s, ddx, ddy);
-    if (s.retro && c >= cos_retro_cutoff) return model.intensity_scale * model.retro_gain / (1.0 + q * q);
-    return model.intensity_scale * (s.retro ? 0.5 : s.reflectivity) * c / (1.0 + q * q);
+    return surface_intensity(model, world.segments[s.index], t, cos_incidence(s, ddx, ddy));
   };
   const double half_div = 0.5 * model.beam_divergence_rad;
   for (std::size_t i = 0; i < beams; ++i) {

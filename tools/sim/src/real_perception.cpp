@@ -3,12 +3,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
+#include <vector>
 
 #include "dockcore/perception/dock_pose_filter.hpp"
 #include "dockcore/perception/line_segments.hpp"
 #include "dockcore/perception/profile_geometry.hpp"
+#include "docksim/lidar_sim.hpp"
 #include "docksim/scenes.hpp"
+#include "docksim/sim_run.hpp"
 
 namespace docksim {
 namespace {
@@ -150,21 +154,31 @@ const char* to_string(CompositeKind k) {
 
 // ---------------------------------------------------------------- false positives
 
-RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dockcore::DockProfile& profile,
-                                          const ConfirmRule& rule) {
+namespace {
+
+/// Loads scan `j` of the recording, as seen in the confirmation window that starts at scan `window` (the single-scan
+/// pass loads scan i as window i's first), into `out`. False when the scan cannot be used.
+using ScanLoader = std::function<bool(std::size_t window, std::size_t j, LaserScan* out)>;
+
+/// The false-positive measurement of measure_real_false_positives over scans given by `load`, with the estimators'
+/// intensity use set to `intensity_usable`.
+RealFpResult measure_fp(const LoadedRecording& rec, const dockcore::DockProfile& profile, const ConfirmRule& rule,
+                        const ScanLoader& load, bool intensity_usable) {
   RealFpResult out;
   const std::size_t n = rec.scans.size();
   auto est = std::make_unique<DockPoseEstimator>();
   auto tracker = std::make_unique<DockPoseEstimator>();  // hinted estimates; keeps est's counters single-scan
   const dockcore::EstimatorParams params = real_estimator_params(*rec.info);
   if (!est->configure(profile, params) || !tracker->configure(profile, params)) return out;
+  est->set_intensity_usable(intensity_usable);
+  tracker->set_intensity_usable(intensity_usable);
   auto scan = std::make_unique<LaserScan>();
   const Pose2 mount = real_lidar_mount();
   std::vector<char> found(n, 0);
   std::vector<Pose2> pose(n);
   std::vector<double> evidence(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
-    if (!rec.scans[i].to_laser_scan(scan.get())) continue;  // the reader already refuses > kMaxScanPoints
+    if (!load(i, i, scan.get())) continue;  // the reader already refuses > kMaxScanPoints
     ++out.scans;
     const dockcore::DockEstimate e = est->estimate(scan->view(), mount);
     if (!e.found) continue;
@@ -200,7 +214,7 @@ RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dock
     for (std::size_t k = 1; k < w && confirmed; ++k) {
       const std::size_t j = i + k;
       const Pose2 hint = rec.sensor_in_world[j].inverse().compose(first_world);
-      confirmed = rec.scans[j].to_laser_scan(scan.get());
+      confirmed = load(i, j, scan.get());
       if (!confirmed) break;
       const dockcore::DockEstimate e = tracker->estimate(scan->view(), mount, &hint);
       confirmed = e.found && agree(rec.sensor_in_world[j].compose(e.pose), first_world, rule.agree_m, rule.agree_rad);
@@ -215,6 +229,201 @@ RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dock
     }
   }
   return out;
+}
+
+/// One pasted world per window: its objects, in the world frame of the window's first scan.
+struct PastedClutter {
+  World world;
+  int objects = 0;
+};
+
+/// Draws the window's reflective clutter in the free space of `first` (its sensor frame = `sensor_in_world`).
+PastedClutter draw_clutter(const ScanView& first, const Pose2& sensor_in_world, const ReflectiveClutterOptions& o,
+                           Rng& rng) {
+  PastedClutter c;
+  const int wanted = 1 + static_cast<int>(rng.uniform() * o.objects_max);
+  const double amin = static_cast<double>(first.angle_min_rad);
+  const double inc = static_cast<double>(first.angle_increment_rad);
+  const double span = inc * static_cast<double>(first.count > 0 ? first.count - 1 : 0);
+  auto to_world = [&sensor_in_world](double x, double y) {
+    return sensor_in_world.transform(Vec2(static_cast<Real>(x), static_cast<Real>(y)));
+  };
+  for (int k = 0; k < wanted; ++k) {
+    for (int attempt = 0; attempt < 20; ++attempt) {
+      const double d = rng.uniform(o.min_range_m, o.max_range_m);
+      const double b = amin + rng.uniform() * span;
+      // Free space: the real returns over the object's angular size lie well beyond it (or there are none).
+      const double half_rad = std::atan2(0.35, d);
+      bool free = true;
+      for (long i = static_cast<long>(std::floor((b - half_rad - amin) / inc));
+           free && i <= static_cast<long>(std::ceil((b + half_rad - amin) / inc)); ++i) {
+        if (i < 0 || i >= static_cast<long>(first.count)) continue;
+        const double r = static_cast<double>(first.ranges_m[i]);
+        free = !(r > 0 && r < d + 0.3);
+      }
+      if (!free) continue;
+      const double cx = d * std::cos(b), cy = d * std::sin(b);
+      const int kind = static_cast<int>(rng.uniform() * 3);
+      if (kind == 0) {  // a sign facing the lidar within ±40°
+        const double len = rng.uniform(0.2, 0.6);
+        const double face = b + dockcore::kPi + rng.uniform(-40.0, 40.0) * dockcore::kPi / 180.0;
+        const double tx = -std::sin(face), ty = std::cos(face);  // along the board
+        // Tape: all over, or 1-3 stripes of 3-15 cm at random places (overlaps merge).
+        std::vector<std::pair<double, double>> tape;
+        if (rng.uniform() < 1.0 / 3.0) {
+          tape.emplace_back(0.0, len);
+        } else {
+          const int stripes = 1 + static_cast<int>(rng.uniform() * 3);
+          for (int q = 0; q < stripes; ++q) {
+            const double w = std::min(len, rng.uniform(0.03, 0.15));
+            const double from = rng.uniform(0.0, len - w);
+            tape.emplace_back(from, from + w);
+          }
+        }
+        // Cut the board at every tape edge; each piece is taped when its middle lies in a stripe.
+        std::vector<double> cuts{0.0, len};
+        for (const auto& t : tape) {
+          cuts.push_back(t.first);
+          cuts.push_back(t.second);
+        }
+        std::sort(cuts.begin(), cuts.end());
+        const double reflectivity = rng.uniform(0.1, 1.0);
+        for (std::size_t q = 0; q + 1 < cuts.size(); ++q) {
+          if (cuts[q + 1] - cuts[q] < 1e-6) continue;
+          const double mid = 0.5 * (cuts[q] + cuts[q + 1]);
+          bool taped = false;
+          for (const auto& t : tape) taped = taped || (mid >= t.first && mid <= t.second);
+          const double s0 = cuts[q] - 0.5 * len, s1 = cuts[q + 1] - 0.5 * len;
+          Segment seg;
+          seg.a = to_world(cx + s0 * tx, cy + s0 * ty);
+          seg.b = to_world(cx + s1 * tx, cy + s1 * ty);
+          seg.reflectivity = reflectivity;
+          seg.retro = taped;
+          c.world.segments.push_back(seg);
+        }
+      } else if (kind == 1) {  // a safety vest: the band all round the torso
+        const std::size_t before = c.world.segments.size();
+        c.world.add_circle(to_world(cx, cy), rng.uniform(0.15, 0.2), 12, 0.5);
+        for (std::size_t q = before; q < c.world.segments.size(); ++q) c.world.segments[q].retro = true;
+      } else {  // chrome legs
+        const double side = rng.uniform(0.40, 0.50), radius = rng.uniform(0.01, 0.015);
+        const double yaw = rng.uniform(-dockcore::kPi, dockcore::kPi);
+        const std::size_t before = c.world.segments.size();
+        for (int q = 0; q < 4; ++q) {
+          const double lx = (q & 1 ? 0.5 : -0.5) * side, ly = (q & 2 ? 0.5 : -0.5) * side;
+          c.world.add_circle(
+              to_world(cx + lx * std::cos(yaw) - ly * std::sin(yaw), cy + lx * std::sin(yaw) + ly * std::cos(yaw)),
+              radius, 8, 0.9);
+        }
+        for (std::size_t q = before; q < c.world.segments.size(); ++q) {
+          c.world.segments[q].retro = true;
+          c.world.segments[q].retro_cutoff_rad = 12.0 * dockcore::kPi / 180.0;
+        }
+      }
+      ++c.objects;
+      break;
+    }
+  }
+  return c;
+}
+
+/// A reflectivity for the world cell around (x, y): uniform 0.1-1.0, the same for every scan that sees the cell.
+double cell_reflectivity(std::uint64_t seed, double x, double y) {
+  const auto cx = static_cast<std::int64_t>(std::floor(x / 0.5));
+  const auto cy = static_cast<std::int64_t>(std::floor(y / 0.5));
+  Rng r(seed ^ (static_cast<std::uint64_t>(cx) * 0x9E3779B97F4A7C15ull) ^
+        (static_cast<std::uint64_t>(cy) * 0xC2B2AE3D27D4EB4Full));
+  return r.uniform(0.1, 1.0);
+}
+
+}  // namespace
+
+RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dockcore::DockProfile& profile,
+                                          const ConfirmRule& rule) {
+  const ScanLoader load = [&rec](std::size_t, std::size_t j, LaserScan* out) {
+    return rec.scans[j].to_laser_scan(out);
+  };
+  return measure_fp(rec, profile, rule, load, false);
+}
+
+RealFpResult measure_real_reflector_false_positives(const LoadedRecording& rec, const dockcore::DockProfile& profile,
+                                                    const ReflectiveClutterOptions& options, const ConfirmRule& rule) {
+  LidarModel ld06;
+  lidar_model("ld06", &ld06);
+  const RangeNoise noise{rec.info->sigma_m, rec.info->resolution_m};
+  const std::uint64_t rec_seed = fnv1a(options.seed * 0x100000001B3ull, rec.info->name);
+  const bool posed = rec.has_poses();
+  // The clutter of the window loaded last (the single-scan pass draws scan i's as window i's; the window pass then
+  // draws each window's again, the same for the same seed).
+  std::size_t clutter_window = static_cast<std::size_t>(-1);
+  PastedClutter clutter;
+  auto first = std::make_unique<LaserScan>();
+  std::vector<Vec2> pts;
+  const ScanLoader load = [&](std::size_t window, std::size_t j, LaserScan* out) {
+    if (window != clutter_window) {
+      if (!rec.scans[window].to_laser_scan(first.get())) return false;
+      Rng rng(trial_seed(rec_seed, window));
+      clutter = draw_clutter(first->view(), posed ? rec.sensor_in_world[window] : Pose2{}, options, rng);
+      clutter_window = window;
+    }
+    if (!rec.scans[j].to_laser_scan(out)) return false;
+    // Poses place the clutter in scan j; without them only the window's own first scan is used.
+    const Pose2 sensor = posed ? rec.sensor_in_world[j] : Pose2{};
+    Rng rng(trial_seed(rec_seed ^ 0x5045u, j * 7919u + window));
+    const std::size_t n = out->count;
+    const ScanView v = out->view();
+    pts.assign(n, Vec2::Zero());
+    for (std::size_t i = 0; i < n; ++i) {
+      const Real a = v.angle_rad(i);
+      pts[i] = out->ranges_m[i] * Vec2(std::cos(a), std::sin(a));
+    }
+    // Real returns: diffuse intensities, the incidence from the line through the neighbours.
+    for (std::size_t i = 0; i < n; ++i) {
+      const double r = static_cast<double>(out->ranges_m[i]);
+      if (!(r > 0)) {
+        out->intensities[i] = 0;
+        continue;
+      }
+      double cos_i = 1.0;
+      if (i > 0 && i + 1 < n && out->ranges_m[i - 1] > 0 && out->ranges_m[i + 1] > 0 &&
+          (pts[i + 1] - pts[i - 1]).norm() < static_cast<Real>(0.1)) {
+        const Vec2 t = (pts[i + 1] - pts[i - 1]).normalized();
+        const Vec2 d = pts[i].normalized();
+        cos_i = std::fabs(static_cast<double>(t.x() * d.y() - t.y() * d.x()));
+      }
+      const Vec2 w = sensor.transform(pts[i]);
+      Segment diffuse;
+      diffuse.reflectivity = cell_reflectivity(rec_seed, static_cast<double>(w.x()), static_cast<double>(w.y()));
+      out->intensities[i] = static_cast<Real>(sensor_intensity(ld06, surface_intensity(ld06, diffuse, r, cos_i)));
+    }
+    if (clutter.objects == 0 || (!posed && j != window)) return true;
+    // Pasted objects: a nearer hit replaces the real return, its intensity the footprint's mean as simulate_scan
+    // takes it.
+    const Vec2 origin(sensor.x_m, sensor.y_m);
+    const double half_div = 0.5 * ld06.beam_divergence_rad;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double theta = static_cast<double>(v.angle_rad(i) + sensor.yaw_rad);
+      double t = 0, raw = 0;
+      for (const double side : {0.0, -half_div, half_div}) {
+        const Vec2 dir(static_cast<Real>(std::cos(theta + side)), static_cast<Real>(std::sin(theta + side)));
+        double ts = 0;
+        std::size_t k = 0;
+        if (!clutter.world.raycast_segment(origin, dir, 12.0, &ts, &k)) continue;
+        const Segment& sg = clutter.world.segments[k];
+        const double ex = static_cast<double>(sg.b.x() - sg.a.x()), ey = static_cast<double>(sg.b.y() - sg.a.y());
+        const double c =
+            std::fabs(static_cast<double>(dir.x()) * ey - static_cast<double>(dir.y()) * ex) / std::hypot(ex, ey);
+        raw += surface_intensity(ld06, sg, ts, c);
+        if (side == 0.0) t = ts;
+      }
+      const double real_r = static_cast<double>(out->ranges_m[i]);
+      if (!(t > 0) || (real_r > 0 && real_r < t)) continue;
+      out->ranges_m[i] = static_cast<Real>(noise.apply(t, rng));
+      out->intensities[i] = static_cast<Real>(sensor_intensity(ld06, raw / 3.0));
+    }
+    return true;
+  };
+  return measure_fp(rec, profile, rule, load, true);
 }
 
 // ---------------------------------------------------------------- composites

@@ -24,6 +24,9 @@ struct Segment {
   double reflectivity = 0.5;  ///< 0..1, scales the simulated intensity.
   bool one_sided = false;
   bool retro = false;  ///< Retro-reflective tape: bright up to LidarModel::retro_cutoff_rad of incidence.
+  /// A retro segment's own cut-off incidence, rad (0: LidarModel::retro_cutoff_rad). Chrome is retro with a small
+  /// one: a mirror-like surface returns the beam only when met near its normal.
+  double retro_cutoff_rad = 0;
 };
 
 /// A 2D world: a bag of segments. Helpers add common objects.
@@ -105,6 +108,12 @@ struct LidarModel {
   /// on 87–96 % of its valid returns in a room (the realdata README); 30 of 255 gives the simulated rooms that share.
   double rplidar_saturation = 30.0;
 };
+
+/// The model's intensity of a return from `s` at `range_m` met at |cos(incidence)| `cos_incidence` (the formula of
+/// LidarModel::intensity_scale's comment), before the sensor's own scale (sensor_intensity). O(1).
+double surface_intensity(const LidarModel& m, const Segment& s, double range_m, double cos_incidence);
+/// What the sensor reports of a model intensity `raw` (LidarModel::intensity_output). O(1).
+double sensor_intensity(const LidarModel& m, double raw);
 
 /// Built-in models: "ld06" (LD06/LD19: 4500 pts/s, 10 Hz, 0.8°, intensity 0..255), "rplidar-a1" (~1°, 5.5 Hz, 360
 /// pts, standard-scan quality), "rplidar-a2" (A2M8: 0.45°, 10 Hz, 800 pts, quality), "industrial" (0.25°, 25 Hz, 270°

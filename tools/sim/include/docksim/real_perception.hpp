@@ -73,6 +73,38 @@ constexpr std::size_t kMaxFalseDockExamples = 8;
 RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dockcore::DockProfile& profile,
                                           const ConfirmRule& rule = ConfirmRule{});
 
+// ---------------------------------------------------------------- reflective clutter
+
+/// Reflective things pasted into real dock-less scans, to measure what a reflector dock's intensity cue meets in a
+/// real room. Per confirmation window (its first scan i), 1..objects_max objects are placed in scan i's free space
+/// (the real return at their bearing lies at least 0.3 m beyond them, or there is none), min..max_range_m from the
+/// lidar, each kind equally likely:
+///  - a sign: a flat board 0.2-0.6 m long facing the lidar within ±40°, taped all over (one in three) or with 1-3
+///    stripes 3-15 cm long;
+///  - a safety vest: a torso, a 12-sided circle of radius 0.15-0.2 m whose band the scan plane crosses (all retro);
+///  - chrome legs: four 8-sided legs of radius 1-1.5 cm at the corners of a 0.40-0.50 m square, retro within 12° of
+///    their normal only (a mirror returns the beam only when met head on).
+/// The objects stand in the world (the window's first sensor pose) and are ray-cast into every scan of the window;
+/// pasted ranges get the recording's noise (RangeNoise).
+/// Every real return gets an LD06 intensity, rounded to 0-255: 255·ρ·|cos i|/(1 + (r/4 m)²), incidence i from the
+/// line through its neighbours (head on when they are not on one surface), reflectivity ρ uniform 0.1-1.0 per 0.5 m
+/// cell of the world (a surface reads alike from scan to scan). So a white wall met head on within ~0.6 m reads
+/// past the reflector threshold as tape would.
+struct ReflectiveClutterOptions {
+  std::uint64_t seed = 1;
+  int objects_max = 3;
+  double min_range_m = 0.4;
+  double max_range_m = 2.5;
+};
+
+/// measure_real_false_positives for a profile with reflector stripes on a lidar whose intensity is usable
+/// (set_intensity_usable(true)), the scans carrying intensities and reflective clutter as ReflectiveClutterOptions
+/// says. Deterministic in (options.seed, recording, window). Cost: as measure_real_false_positives plus O(beams ·
+/// pasted segments) per scan.
+RealFpResult measure_real_reflector_false_positives(const LoadedRecording& rec, const dockcore::DockProfile& profile,
+                                                    const ReflectiveClutterOptions& options,
+                                                    const ConfirmRule& rule = ConfirmRule{});
+
 // ---------------------------------------------------------------- composite scenes
 
 /// Where a pasted dock stands.
