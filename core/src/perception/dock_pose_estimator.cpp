@@ -672,10 +672,8 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
       if (m != 0 && std::fabs(diff) <= gate) {
         on_dock = true;
         if (read_stripes) {
-          const Vec2 hit = expected_m * dir_[i];
-          const Vec2& along = placed_.d_m[seg];
-          const Real len = along.norm();
-          const Real s = (hit - placed_.v_m[seg]).dot(along) / len;
+          const Real len = placed_.len_m[seg];
+          const Real s = placed_.along_m(seg, expected_m * dir_[i]);
           // Half the beam's footprint on the surface, and a little more: a beam closer to a stripe's end may
           // straddle it.
           const Real edge_m = kStripeEdgeMarginM + R(0.5) * expected_m * angle_inc_rad_ / cos_inc;

@@ -37,6 +37,10 @@ struct PlacedProfile {
   bool nearest(const Vec2& p, std::size_t* segment, Real* distance_m, Real* signed_line_distance_m,
                Real* overhang_m) const;
 
+  /// Distance along segment i from its first vertex to p's projection onto its line, metres (negative before the
+  /// first vertex, beyond len_m[i] past the second). Precondition: i < segments. O(1).
+  Real along_m(std::size_t i, const Vec2& p) const { return (p - v_m[i]).dot(u[i]); }
+
   /// Bounding box of the vertices: a point further than d outside [lo_m, hi_m] is further than d from every
   /// segment. Cost O(vertices).
   void bounding_box(Vec2* lo_m, Vec2* hi_m) const;
