@@ -110,6 +110,8 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
     if (t != nullptr) {
       prof = profile_for_target(d->profile, nominal, t->target);
       move_tag(t->target);
+      // The taught code, unless the profile file carries its own; all of it or none (start() reported a misfit).
+      with_taught_code(prof, *t);
     } else if (d->has_target) {
       prof = profile_for_target(d->profile, nominal, d->target);
       move_tag(d->target);
@@ -129,11 +131,26 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
 bool Daemon::start(std::string& error) {
   const std::uint64_t now = io_.clock->now_us();
   std::string msg;
-  const StateLoadStatus st = load_state(cfg_.state_file, state_, msg);
+  std::vector<std::string> warnings;
+  const StateLoadStatus st = load_state(cfg_.state_file, state_, msg, &warnings);
   if (st == StateLoadStatus::kRecoveredBackup || st == StateLoadStatus::kCorruptNoBackup) {
     EventLine e(now, "state_file");
     e.w.str("level", st == StateLoadStatus::kCorruptNoBackup ? "error" : "warn").str_cut("message", msg.c_str(), 1024);
     log_event(e, st == StateLoadStatus::kCorruptNoBackup ? LogLevel::kError : LogLevel::kWarn);
+  }
+  // A taught code that does not fit its dock's profile (a segment it lacks, a stripe off its segment): not applied.
+  for (const TaughtTarget& t : state_.targets) {
+    const DockEntry* d = cfg_.find_dock(t.dock_id);
+    dockcore::DockProfile check = d != nullptr ? d->profile : dockcore::DockProfile{};
+    if (t.stripe_count == 0 || d == nullptr || d->profile.reflector_count > 0 || with_taught_code(check, t)) continue;
+    warnings.push_back(cfg_.state_file + ":" + std::to_string(t.code_line) + ": the taught code of dock " +
+                       std::to_string(t.dock_id) + " does not fit its profile (" +
+                       dockcore::to_string(dockcore::ProfileError::kBadReflector) + "): not applied");
+  }
+  for (const std::string& w : warnings) {
+    EventLine e(now, "state_file");
+    e.w.str("level", "warn").str_cut("message", w.c_str(), 1024);
+    log_event(e, LogLevel::kWarn);
   }
   if (cfg_.record_loop && !cfg_.record_dir.empty()) {
     loop_record_ = std::make_unique<dockcore::drivers::LoopRecordWriter>();
@@ -268,7 +285,7 @@ void Daemon::poll_lidar(std::uint64_t now_us) {
     const dockcore::DockEstimate* e = core_->on_scan(scan->view(), scan->stamp_us, now_us);
     if (e != nullptr && e->found) {
       ++counters_.detections;
-      teach_.sample(*e);
+      teach_.sample(*e, scan->view(), core_->intensity().usable());
     }
   }
 }

@@ -125,6 +125,11 @@ JsonWriter& JsonWriter::uints(const char* k, const std::uint32_t* values, std::s
   return *this;
 }
 
+JsonWriter& JsonWriter::raw(const char* k, const char* value, std::size_t len) {
+  if (key(k)) put(value, len);
+  return *this;
+}
+
 JsonWriter& JsonWriter::fields(const char* body, std::size_t len) {
   if (len == 0 || !ok_) return *this;
   if (!first_ && !put(",", 1)) return *this;

@@ -28,6 +28,8 @@ class JsonWriter {
   /// "key":[v0,v1,...] as real() writes each.
   JsonWriter& reals(const char* key, const double* values, std::size_t count, int decimals);
   JsonWriter& uints(const char* key, const std::uint32_t* values, std::size_t count);
+  /// "key":value with `value` (`len` bytes, already JSON: an array or object its caller built) copied as it is.
+  JsonWriter& raw(const char* key, const char* value, std::size_t len);
   /// Fields another writer made (its body(): `"k":v,...` without braces), copied as they are; nothing when empty.
   JsonWriter& fields(const char* body, std::size_t len);
 

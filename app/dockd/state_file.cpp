@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -30,6 +31,16 @@ void StateData::put(const TaughtTarget& t) {
   targets.push_back(t);
 }
 
+bool with_taught_code(dockcore::DockProfile& profile, const TaughtTarget& t) {
+  if (t.stripe_count == 0 || profile.reflector_count > 0) return false;
+  dockcore::DockProfile coded = profile;
+  for (std::size_t q = 0; q < t.stripe_count; ++q) {
+    if (dockcore::add_reflector(coded, t.stripes[q]) != dockcore::ProfileError::kOk) return false;
+  }
+  profile = coded;
+  return true;
+}
+
 std::uint32_t crc32_ieee(const char* data, std::size_t len) {
   std::uint32_t c = 0xFFFFFFFFu;
   for (std::size_t i = 0; i < len; ++i) {
@@ -47,13 +58,80 @@ std::string serialize_state(const StateData& s) {
                   static_cast<double>(t.target.x_m), static_cast<double>(t.target.y_m),
                   static_cast<double>(t.target.yaw_rad), t.scans, t.spread_m, t.taught_unix_s);
     body += line;
+    if (t.stripe_count > 0) {
+      // The code on its own line: an older reader's target lines stay as they were.
+      std::snprintf(line, sizeof line, "code %u %u %.6f %u", t.dock_id, t.code_scans, t.code_spread_m, t.stripe_count);
+      body += line;
+      for (std::size_t q = 0; q < t.stripe_count && q < dockcore::kMaxReflectors; ++q) {
+        std::snprintf(line, sizeof line, " %u %.6f %.6f", t.stripes[q].segment,
+                      static_cast<double>(t.stripes[q].from_m), static_cast<double>(t.stripes[q].to_m));
+        body += line;
+      }
+      body += '\n';
+    }
   }
   char crc[32];
   std::snprintf(crc, sizeof crc, "crc32 %08x\n", crc32_ieee(body.data(), body.size()));
   return body + crc;
 }
 
-bool parse_state(const std::string& text, StateData& out, std::string& error) {
+namespace {
+
+/// Parses a `code <id> <scans> <spread_m> <n> (<segment> <from_m> <to_m>){n}` line into `t`'s code fields; false +
+/// reason otherwise (t's code untouched). O(line).
+bool parse_code_line(const std::string& line, TaughtTarget& t, unsigned* id_out, std::string& why) {
+  const char* p = line.c_str();
+  unsigned id = 0, scans = 0, n = 0;
+  double spread = 0;
+  int used = 0;
+  if (std::sscanf(p, "code %u %u %lf %u%n", &id, &scans, &spread, &n, &used) != 4 || id > 65535 || scans > 65535 ||
+      !std::isfinite(spread) || spread < 0) {
+    why = "expected 'code <dock_id> <scans> <spread_m> <stripes> <segment> <from_m> <to_m> ...'";
+    return false;
+  }
+  *id_out = id;
+  if (n < 1 || n > dockcore::kMaxReflectors) {
+    why = "1 to " + std::to_string(dockcore::kMaxReflectors) + " stripes";
+    return false;
+  }
+  p += used;
+  dockcore::ReflectorStripe st[dockcore::kMaxReflectors];
+  for (unsigned q = 0; q < n; ++q) {
+    unsigned seg = 0;
+    double from = 0, to = 0;
+    if (std::sscanf(p, " %u %lf %lf%n", &seg, &from, &to, &used) != 3) {
+      why = "stripe " + std::to_string(q + 1) + " of " + std::to_string(n) + " missing or malformed";
+      return false;
+    }
+    p += used;
+    if (seg + 1 >= dockcore::kMaxProfileVertices || !std::isfinite(from) || !std::isfinite(to) || from < 0 ||
+        to < from + 0.01 - 1e-9) {
+      why = "stripe " + std::to_string(q + 1) + " off its segment or shorter than 1 cm";
+      return false;
+    }
+    if (q > 0 &&
+        (seg < st[q - 1].segment || (seg == st[q - 1].segment && from < static_cast<double>(st[q - 1].to_m)))) {
+      why = "stripe " + std::to_string(q + 1) + " out of order or overlapping the one before";
+      return false;
+    }
+    st[q].segment = static_cast<std::uint8_t>(seg);
+    st[q].from_m = static_cast<dockcore::Real>(from);
+    st[q].to_m = static_cast<dockcore::Real>(to);
+  }
+  if (*p != '\0') {
+    why = "more than " + std::to_string(n) + " stripes";
+    return false;
+  }
+  for (unsigned q = 0; q < n; ++q) t.stripes[q] = st[q];
+  t.stripe_count = static_cast<std::uint8_t>(n);
+  t.code_scans = static_cast<std::uint16_t>(scans);
+  t.code_spread_m = spread;
+  return true;
+}
+
+}  // namespace
+
+bool parse_state(const std::string& text, StateData& out, std::string& error, std::vector<std::string>* warnings) {
   const std::size_t pos = text.rfind("crc32 ");
   if (pos == std::string::npos || (pos > 0 && text[pos - 1] != '\n')) {
     error = "no checksum line (truncated?)";
@@ -76,7 +154,34 @@ bool parse_state(const std::string& text, StateData& out, std::string& error) {
     return false;
   }
   StateData s;
+  std::size_t line_no = 1;
   while (std::getline(in, line)) {
+    ++line_no;
+    if (line.compare(0, 5, "code ") == 0) {
+      TaughtTarget code;
+      unsigned id = 0;
+      std::string why;
+      TaughtTarget* target = nullptr;
+      if (parse_code_line(line, code, &id, why)) {
+        for (TaughtTarget& o : s.targets) {
+          if (o.dock_id == id) target = &o;
+        }
+        if (target == nullptr) why = "no target line of dock " + std::to_string(id) + " before it";
+      }
+      if (target == nullptr) {
+        if (warnings != nullptr) {
+          warnings->push_back("line " + std::to_string(line_no) + ": bad code line '" + line.substr(0, 200) + "' (" +
+                              why + "): left out, dock " + std::to_string(id) + " has no taught code");
+        }
+        continue;
+      }
+      for (std::size_t q = 0; q < code.stripe_count; ++q) target->stripes[q] = code.stripes[q];
+      target->stripe_count = code.stripe_count;
+      target->code_scans = code.code_scans;
+      target->code_spread_m = code.code_spread_m;
+      target->code_line = line_no;
+      continue;
+    }
     TaughtTarget t;
     unsigned id = 0, scans = 0;
     double x = 0, y = 0, yaw = 0, spread = 0;
@@ -104,7 +209,8 @@ namespace {
 
 enum class ReadResult { kOk, kMissing, kBad };
 
-ReadResult read_file(const std::string& path, StateData& out, std::string& why) {
+ReadResult read_file(const std::string& path, StateData& out, std::string& why,
+                     std::vector<std::string>* warnings = nullptr) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     if (errno == ENOENT) return ReadResult::kMissing;
@@ -119,7 +225,7 @@ ReadResult read_file(const std::string& path, StateData& out, std::string& why) 
     why = "larger than " + std::to_string(kMaxStateFileBytes) + " bytes";
     return ReadResult::kBad;
   }
-  return parse_state(text, out, why) ? ReadResult::kOk : ReadResult::kBad;
+  return parse_state(text, out, why, warnings) ? ReadResult::kOk : ReadResult::kBad;
 }
 
 std::string dir_of(const std::string& path) {
@@ -129,13 +235,24 @@ std::string dir_of(const std::string& path) {
 
 }  // namespace
 
-StateLoadStatus load_state(const std::string& path, StateData& out, std::string& message) {
+StateLoadStatus load_state(const std::string& path, StateData& out, std::string& message,
+                           std::vector<std::string>* warnings) {
   std::string why;
-  const ReadResult r = read_file(path, out, why);
-  if (r == ReadResult::kOk) return StateLoadStatus::kOk;
+  std::vector<std::string> notes;
+  auto report = [&](const std::string& file) {
+    if (warnings == nullptr) return;
+    for (const std::string& n : notes) warnings->push_back(file + ":" + n.substr(5));  // "line N: ..." -> "FILE:N: ..."
+  };
+  const ReadResult r = read_file(path, out, why, &notes);
+  if (r == ReadResult::kOk) {
+    report(path);
+    return StateLoadStatus::kOk;
+  }
   std::string bak_why;
   StateData bak;
-  const ReadResult rb = read_file(path + ".bak", bak, bak_why);
+  notes.clear();
+  const ReadResult rb = read_file(path + ".bak", bak, bak_why, &notes);
+  if (rb == ReadResult::kOk) report(path + ".bak");
   if (r == ReadResult::kMissing) {
     if (rb == ReadResult::kOk) {
       // A crash between the two renames of save_state leaves only the backup.

@@ -1,6 +1,7 @@
 #pragma once
-/// @file dockd's persistent state: the taught docked-pose targets, by dock id. A small text file ending in a CRC-32
-/// line; written atomically (temp file, fsync, rename, directory fsync) with the previous good copy kept as
+/// @file dockd's persistent state: the taught docked-pose targets, by dock id, each with the reflector code teach
+/// read on the dock, if any. A small text file ending in a CRC-32 line; written atomically (temp file, fsync, rename,
+/// directory fsync) with the previous good copy kept as
 /// "<file>.bak". A file whose checksum or syntax is wrong is reported, moved aside to "<file>.corrupt", and the last
 /// good copy (.bak) is used instead. Start-up / teach only: heap and stdio are fine here.
 
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "dockcore/geometry.hpp"
+#include "dockcore/perception/dock_profile.hpp"
 
 namespace dockd {
 
@@ -20,6 +22,13 @@ struct TaughtTarget {
   std::uint16_t scans = 0;        ///< Detections averaged.
   double spread_m = 0;            ///< Largest position deviation of one detection from the mean, m.
   std::uint64_t taught_unix_s = 0;
+  /// The dock's reflector code as teach read it (docs/dockd.md, "Teach"): stripes along the segments of the dock's
+  /// own profile, in order. None (0) when the dock showed no tape or no code could be read.
+  dockcore::ReflectorStripe stripes[dockcore::kMaxReflectors] = {};
+  std::uint8_t stripe_count = 0;
+  std::uint16_t code_scans = 0;  ///< Scans that read this pattern.
+  double code_spread_m = 0;      ///< Largest deviation of one scan's stripe edge from the mean edge, m.
+  std::size_t code_line = 0;     ///< The code's line in the state file it was loaded from (0: not loaded), for reports.
 };
 
 struct StateData {
@@ -29,6 +38,10 @@ struct StateData {
   /// Adds or replaces the target of t.dock_id.
   void put(const TaughtTarget& t);
 };
+
+/// Adds t's taught stripes to `profile` when it has none of its own and every stripe fits (add_reflector); true
+/// then, else false with `profile` unchanged. O(kMaxReflectors²).
+bool with_taught_code(dockcore::DockProfile& profile, const TaughtTarget& t);
 
 enum class StateLoadStatus : std::uint8_t {
   kOk = 0,
@@ -42,13 +55,18 @@ constexpr std::size_t kMaxStateFileBytes = 1u << 20;
 
 /// Serialised form (with its checksum line). O(targets).
 std::string serialize_state(const StateData& s);
-/// Parses serialised text; false + reason when the checksum, header or a line is wrong. O(size).
-bool parse_state(const std::string& text, StateData& out, std::string& error);
+/// Parses serialised text; false + reason when the checksum, header or a target line is wrong. A bad `code` line
+/// (malformed, a stripe shorter than 1 cm, out of order or overlapping, no target line before it) is left out and
+/// reported in `warnings` ("line N: ..."), changing nothing else. O(size).
+bool parse_state(const std::string& text, StateData& out, std::string& error,
+                 std::vector<std::string>* warnings = nullptr);
 /// CRC-32 (IEEE, reflected, as zlib) of `len` bytes.
 std::uint32_t crc32_ieee(const char* data, std::size_t len);
 
 /// Loads `path` as described in the file comment; `message` explains anything other than kOk / kMissing.
-StateLoadStatus load_state(const std::string& path, StateData& out, std::string& message);
+/// `warnings` receives the code lines left out of the file used ("FILE:LINE: ..."); they make no other change.
+StateLoadStatus load_state(const std::string& path, StateData& out, std::string& message,
+                           std::vector<std::string>* warnings = nullptr);
 /// Writes `s` atomically. False + reason on any I/O error (the previous file is then untouched).
 bool save_state(const std::string& path, const StateData& s, std::string& error);
 

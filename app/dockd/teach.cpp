@@ -9,6 +9,16 @@
 
 namespace dockd {
 
+namespace {
+
+using dockcore::kMaxReflectors;
+
+/// A read stripe agrees with a profile's own when each of its edges lies this close to the profile's: a few beam
+/// spacings at charger range, far below a readable region's width (docs/docks.md, "Reflectors").
+constexpr double kCodeMatchM = 0.010;
+
+}  // namespace
+
 Teacher::Teacher(const DockdConfig& config, TeachHooks& hooks)
     : cfg_(config), hooks_(hooks), samples_(std::make_unique<Pose2[]>(kMaxScans)) {}
 
@@ -50,6 +60,8 @@ void Teacher::start(const HostRequest& r, const TeachConditions& c, std::uint64_
   if (wanted_ > kMaxScans) wanted_ = kMaxScans;  // the parser and the config bound both to 1..kMaxScans already
   have_ = 0;
   sx_ = sy_ = sc_ = ss_ = 0;
+  for (PatternVote& v : votes_) v = PatternVote{};
+  intensity_unusable_ = 0;
   deadline_us_ = now_us + static_cast<std::uint64_t>(cfg_.teach_timeout_s * 1e6);
   request_ = r;
   EventLine e(now_us, "teach_start");
@@ -57,13 +69,41 @@ void Teacher::start(const HostRequest& r, const TeachConditions& c, std::uint64_
   hooks_.log_event(e, LogLevel::kInfo);
 }
 
-void Teacher::sample(const dockcore::DockEstimate& e) {
+void Teacher::sample(const dockcore::DockEstimate& e, const dockcore::ScanView& scan, bool intensity_usable) {
   if (!active_ || have_ >= wanted_) return;
   samples_[have_++] = e.pose;
   sx_ += static_cast<double>(e.pose.x_m);
   sy_ += static_cast<double>(e.pose.y_m);
   sc_ += std::cos(static_cast<double>(e.pose.yaw_rad));
   ss_ += std::sin(static_cast<double>(e.pose.yaw_rad));
+  if (!intensity_usable) {
+    ++intensity_unusable_;
+    return;
+  }
+  // The stripes at the detected pose, on the dock's own profile (the one the core was configured with for the teach).
+  const DockEntry* d = cfg_.find_dock(dock_id_);
+  if (d == nullptr) return;
+  dockcore::StripeReadParams p;
+  p.inlier_gate_m = cfg_.estimator.inlier_gate_m;
+  p.min_intensity = cfg_.estimator.reflector_min_intensity;
+  p.min_range_m = cfg_.estimator.min_range_m;
+  p.min_inlier_beams = cfg_.estimator.min_inliers;
+  const dockcore::StripeRead r = dockcore::read_reflector_stripes(scan, cfg_.lidar_mount, d->profile, e.pose, p);
+  if (r.status != dockcore::StripeReadStatus::kOk) return;  // unread: a vote for no pattern
+  PatternVote& v = votes_[r.count];
+  for (std::size_t q = 0; q < r.count; ++q) {
+    if (v.scans > 0 && v.segments[q] != r.stripes[q].segment) return;
+  }
+  for (std::size_t q = 0; q < r.count; ++q) {
+    v.segments[q] = r.stripes[q].segment;
+    const double edge[2] = {static_cast<double>(r.stripes[q].from_m), static_cast<double>(r.stripes[q].to_m)};
+    for (int k = 0; k < 2; ++k) {
+      v.sum_m[q][k] += edge[k];
+      v.min_m[q][k] = v.scans == 0 ? edge[k] : std::fmin(v.min_m[q][k], edge[k]);
+      v.max_m[q][k] = v.scans == 0 ? edge[k] : std::fmax(v.max_m[q][k], edge[k]);
+    }
+  }
+  ++v.scans;
 }
 
 void Teacher::finish(bool ok, const char* why, std::uint64_t now_us) {
@@ -87,6 +127,63 @@ void Teacher::finish(bool ok, const char* why, std::uint64_t now_us) {
   }
   t.spread_m = spread;
   t.taught_unix_s = static_cast<std::uint64_t>(std::time(nullptr));
+  // The code: the stripe pattern a majority of the scans read, its edges averaged. A profile with its own stripes
+  // keeps them; the teach then says whether what it read agrees.
+  const DockEntry* dock = cfg_.find_dock(id);
+  const bool own_code = dock != nullptr && dock->profile.reflector_count > 0;
+  const char* code = "unread";
+  int best = -1;
+  for (std::size_t c = 0; c <= dockcore::kMaxReflectors; ++c) {
+    if (2u * votes_[c].scans > have_) best = static_cast<int>(c);
+  }
+  dockcore::ReflectorStripe read[dockcore::kMaxReflectors];
+  std::size_t read_n = 0;
+  double code_spread = 0;
+  bool code_matches = false;
+  if (2u * intensity_unusable_ >= have_) {
+    code = "intensity_unusable";
+    best = -1;
+  } else if (best >= 0) {
+    const PatternVote& v = votes_[best];
+    read_n = static_cast<std::size_t>(best);
+    for (std::size_t q = 0; q < read_n; ++q) {
+      const double from = v.sum_m[q][0] / v.scans;
+      const double to = v.sum_m[q][1] / v.scans;
+      read[q].segment = v.segments[q];
+      read[q].from_m = static_cast<Real>(from);
+      read[q].to_m = static_cast<Real>(to);
+      code_spread = std::fmax(code_spread, std::fmax(v.max_m[q][0] - from, from - v.min_m[q][0]));
+      code_spread = std::fmax(code_spread, std::fmax(v.max_m[q][1] - to, to - v.min_m[q][1]));
+    }
+    if (own_code) {
+      code = "profile";
+      code_matches = read_n == dock->profile.reflector_count;
+      for (std::size_t q = 0; q < read_n && code_matches; ++q) {
+        const dockcore::ReflectorStripe& o = dock->profile.reflectors[q];
+        code_matches = o.segment == read[q].segment &&
+                       std::fabs(static_cast<double>(o.from_m - read[q].from_m)) <= kCodeMatchM &&
+                       std::fabs(static_cast<double>(o.to_m - read[q].to_m)) <= kCodeMatchM;
+      }
+    } else if (read_n == 0) {
+      code = "none";
+    } else {
+      // The averaged stripes must make a valid profile (on their segments, apart): otherwise no code is stored.
+      dockcore::DockProfile check = dock != nullptr ? dock->profile : dockcore::DockProfile{};
+      bool valid = dock != nullptr;
+      for (std::size_t q = 0; q < read_n && valid; ++q) {
+        valid = dockcore::add_reflector(check, read[q]) == dockcore::ProfileError::kOk;
+      }
+      if (valid) {
+        code = "taught";
+        for (std::size_t q = 0; q < read_n; ++q) t.stripes[q] = read[q];
+        t.stripe_count = static_cast<std::uint8_t>(read_n);
+        t.code_scans = v.scans;
+        t.code_spread_m = code_spread;
+      } else {
+        code = "invalid";
+      }
+    }
+  }
   // A moving robot or a detection flipping between two fits would teach garbage: 2 cm is far beyond lidar noise
   // averaged over a still robot.
   if (spread > 0.02) {
@@ -105,14 +202,29 @@ void Teacher::finish(bool ok, const char* why, std::uint64_t now_us) {
   hooks_.configure_core(id, false);
   const Pose2 nom = nominal_docked_target(cfg_);
   // The taught target, once for the event and once inside the reply.
-  char tb[256];
+  char tb[640];
   JsonWriter target(tb, sizeof tb);
   target.uint("dock_id", id)
       .uint("scans", t.scans)
       .real("target_x_m", static_cast<double>(t.target.x_m), 4)
       .real("target_y_m", static_cast<double>(t.target.y_m), 4)
-      .real("target_yaw_deg", deg(t.target.yaw_rad), 3);
-  char buf[512];
+      .real("target_yaw_deg", deg(t.target.yaw_rad), 3)
+      .str("code", code);
+  if (best >= 0) {
+    // [[segment, from_m, to_m], ...]
+    char arr[kMaxReflectors * 32 + 4];
+    std::size_t len = 0;
+    arr[len++] = '[';
+    for (std::size_t q = 0; q < read_n; ++q) {
+      const int w = std::snprintf(arr + len, sizeof arr - len, "%s[%u,%.4f,%.4f]", q > 0 ? "," : "", read[q].segment,
+                                  static_cast<double>(read[q].from_m), static_cast<double>(read[q].to_m));
+      if (w > 0) len += static_cast<std::size_t>(w);
+    }
+    arr[len++] = ']';
+    target.raw("stripes", arr, len).uint("code_scans", votes_[best].scans).real("code_spread_mm", code_spread * 1e3, 1);
+    if (own_code) target.boolean("code_matches", code_matches);
+  }
+  char buf[1024];
   JsonWriter reply(buf, sizeof buf);
   reply.boolean("ok", true)
       .str("cmd", "teach")

@@ -1,6 +1,7 @@
 #pragma once
 /// @file dockd's teach: with the robot placed on the charger by hand, the dock's detections are averaged into the
-/// docked-pose target of that dock and stored (docs/dockd.md, "Teach"). Teacher keeps the running teach (its request,
+/// docked-pose target of that dock and stored (docs/dockd.md, "Teach"), with the reflector code the scans read on
+/// the dock at each detected pose. Teacher keeps the running teach (its request,
 /// its samples, its deadline); what it needs of the daemon — the core's configuration, the state file, the reply to
 /// the request, the event log — it asks through TeachHooks. No allocation after construction; every call is bounded
 /// (see each).
@@ -12,6 +13,7 @@
 
 #include "config.hpp"
 #include "dockcore/dockcore.hpp"
+#include "dockcore/perception/reflector_read.hpp"
 #include "events.hpp"
 #include "host_protocol.hpp"
 #include "state_file.hpp"
@@ -66,8 +68,10 @@ class Teacher {
   /// already, the robot is not idle (NOT_TASKING, FINISH_TASKING or FAULT), not on the charger, the lidar is stale
   /// or the core refuses the profile. O(1) plus the core's configuration.
   void start(const HostRequest& r, const TeachConditions& c, std::uint64_t now_us);
-  /// A detection of the dock (robot frame) while a teach runs; ignored when none runs or it has its scans. O(1).
-  void sample(const dockcore::DockEstimate& e);
+  /// A detection of the dock (robot frame) while a teach runs; ignored when none runs or it has its scans. The
+  /// stripes of `scan` (the detection's scan) are read at the detected pose when `intensity_usable` (the lidar's
+  /// intensity check says usable) and tallied by pattern. O(1) without intensity, else O(beams on the dock).
+  void sample(const dockcore::DockEstimate& e, const dockcore::ScanView& scan, bool intensity_usable);
   /// Once per tick: finishes the teach when it has its scans (the target stored and replied, or refused when the
   /// detections spread over 20 mm or the state file cannot be written), or fails it when teach_timeout_s has passed.
   /// O(1) while it runs; O(scans) plus one state-file write when it ends.
@@ -79,6 +83,19 @@ class Teacher {
 
  private:
   void finish(bool ok, const char* why, std::uint64_t now_us);
+
+  /// The scans that read one stripe count: the pattern of the first (segments), the others' edges summed and their
+  /// extremes, edge by edge.
+  struct PatternVote {
+    std::uint16_t scans = 0;
+    std::uint8_t segments[dockcore::kMaxReflectors] = {};
+    double sum_m[dockcore::kMaxReflectors][2] = {};
+    double min_m[dockcore::kMaxReflectors][2] = {};
+    double max_m[dockcore::kMaxReflectors][2] = {};
+  };
+  /// One vote per stripe count 0..kMaxReflectors; a scan whose segments differ from its count's first is unread.
+  PatternVote votes_[dockcore::kMaxReflectors + 1];
+  std::uint16_t intensity_unusable_ = 0;  ///< Samples taken while the lidar's intensity was not usable.
 
   const DockdConfig& cfg_;
   TeachHooks& hooks_;

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -60,9 +61,11 @@ struct Rig {
   } frames;
   bool camera_live = true;
 
-  /// `scenario`: a file of tools/scenarios instead of default.toml.
+  /// `scenario`: a file of tools/scenarios instead of default.toml. `adjust`: changes the config before the daemon
+  /// is built (dock 3, the copy of dock 0, included).
   explicit Rig(const char* state_name, bool with_udp = false, double start_distance = 1.2, bool record = false,
-               bool watch_camera = false, const char* scenario = nullptr) {
+               bool watch_camera = false, const char* scenario = nullptr,
+               const std::function<void(dockd::DockdConfig&)>& adjust = nullptr) {
     if (scenario != nullptr) {
       sc = docksim::load_scenario_file(std::string(DOCKCORE_SOURCE_DIR) + "/tools/scenarios/" + scenario);
       cfg = dockd_test::scenario_config(sc);
@@ -85,6 +88,7 @@ struct Rig {
     d3.id = 3;
     cfg.docks.push_back(d3);
     cfg.task.accepted_dock_ids = (1u << 0) | (1u << 3);
+    if (adjust) adjust(cfg);
     chassis = dockd_test::scenario_chassis(sc, link, clock);
     const docksim::StartPose sp = docksim::start_from(sc, start_distance, 0.2, 0.1);
     chassis->set_true_pose(sp.robot_world);
@@ -682,6 +686,102 @@ TEST(DockdDaemon, TeachStoresTargetUsedByLaterDockings) {
   CHECK(loaded.find(3) != nullptr);
   DOUBLES_EQUAL(static_cast<double>(t->target.x_m), static_cast<double>(loaded.find(3)->target.x_m), 1e-6);
   ::close(s);
+}
+
+namespace {
+
+/// Sends a teach request for `dock_id` over UDP and ticks until its reply; returns the reply ("" when none came).
+std::string teach_over_udp(Rig& r, int dock_id, int scans, int seq) {
+  sockaddr_in to{};
+  const int s = r.udp_client(to);
+  const std::string m = "{\"cmd\":\"teach\",\"dock_id\":" + std::to_string(dock_id) +
+                        ",\"scans\":" + std::to_string(scans) + ",\"seq\":" + std::to_string(seq) + "}";
+  ::sendto(s, m.data(), m.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+  char buf[2048];
+  ssize_t n = -1;
+  for (int i = 0; i < 400 && n <= 0; ++i) {
+    r.tick();
+    n = ::recv(s, buf, sizeof buf - 1, MSG_DONTWAIT);
+  }
+  ::close(s);
+  if (n <= 0) return "";
+  buf[n] = 0;
+  return buf;
+}
+
+}  // namespace
+
+// Two docks of one shape, told apart by their tape (two-docks.toml): dock 3 is configured without stripes. On the
+// charger of the taped dock, teach reads its code (the simulated stripes within a few millimetres) and stores it with
+// the target; a later docking of dock 3 reads that code. Dock 0's profile carries its own stripes: its teach stores
+// none and says whether what it read agrees.
+TEST(DockdDaemon, TeachRecordsTheDocksCodeAndDockingsReadIt) {
+  Rig r("teach_code", true, 1.2, false, false, "two-docks.toml",
+        [](dockd::DockdConfig& c) { c.docks[1].profile.reflector_count = 0; });
+  const dockcore::DockProfile taped = r.cfg.docks[0].profile;
+  CHECK_EQUAL(2u, taped.reflector_count);
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 60.0));
+  CHECK_TRUE(r.chassis->state().contact);
+
+  // Dock 0's profile has its own stripes: kept, the teach reports the agreement.
+  std::string reply = teach_over_udp(r, 0, 10, 7);
+  STRCMP_CONTAINS("{\"ok\":true,\"cmd\":\"teach\"", reply.c_str());
+  STRCMP_CONTAINS("\"code\":\"profile\",\"stripes\":[[1,", reply.c_str());
+  STRCMP_CONTAINS("\"code_matches\":true", reply.c_str());
+  CHECK_EQUAL(0, r.daemon->state_data().find(0)->stripe_count);
+
+  // Dock 3, the same dock without stripes in its profile: the code is taught.
+  reply = teach_over_udp(r, 3, 10, 8);
+  STRCMP_CONTAINS("\"code\":\"taught\",\"stripes\":[[1,", reply.c_str());
+  STRCMP_CONTAINS("\"code_spread_mm\":", reply.c_str());
+  const dockd::TaughtTarget* t = r.daemon->state_data().find(3);
+  CHECK(t != nullptr);
+  CHECK_EQUAL(taped.reflector_count, t->stripe_count);
+  for (std::size_t q = 0; q < t->stripe_count; ++q) {
+    CHECK_EQUAL(taped.reflectors[q].segment, t->stripes[q].segment);
+    CHECK(std::fabs(static_cast<double>(t->stripes[q].from_m - taped.reflectors[q].from_m)) < 0.004);
+    CHECK(std::fabs(static_cast<double>(t->stripes[q].to_m - taped.reflectors[q].to_m)) < 0.004);
+  }
+  CHECK(t->code_scans >= 6);
+  // One scan's edges move with its pose (σ 10 mm lidar: the detections spread ~5 mm) and its beams (4 mm apart).
+  CHECK(t->code_spread_m < 0.010);
+  // In the state file with the target.
+  dockd::StateData loaded;
+  std::string msg;
+  CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kOk),
+              static_cast<int>(dockd::load_state(r.state_file, loaded, msg)));
+  CHECK_EQUAL(t->stripe_count, loaded.find(3)->stripe_count);
+
+  // Off the charger and back, to dock 3: the estimator reads the taught code.
+  r.host.command(3, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kNotTasking; }, 40.0));
+  r.host.command(1, 3);
+  char json[dockcore::drivers::kMaxHostReply];
+  bool read = false;
+  CHECK_TRUE(r.run_until(
+      [&] {
+        if (r.daemon->state() == TaskState::kAlign && r.daemon->status_json(json, sizeof json, r.clock.t) > 0)
+          read = read || std::strstr(json, "\"det_code\":\"read\"") != nullptr;
+        return r.daemon->state() == TaskState::kFinishTasking;
+      },
+      60.0));
+  CHECK_TRUE(read);
+  CHECK_TRUE(r.chassis->state().charging);
+
+  // A lidar whose intensity is flat (an RPLIDAR in express mode): teach records no code and says why.
+  r.sc.lidar.intensity_output = docksim::IntensityOutput::kConstant;
+  CHECK_TRUE(r.run_until(
+      [&] {
+        return r.daemon->status_json(json, sizeof json, r.clock.t) > 0 &&
+               std::strstr(json, "\"lidar_intensity\":\"flat\"") != nullptr;
+      },
+      10.0));
+  reply = teach_over_udp(r, 3, 10, 9);
+  STRCMP_CONTAINS("{\"ok\":true,\"cmd\":\"teach\"", reply.c_str());
+  STRCMP_CONTAINS("\"code\":\"intensity_unusable\"", reply.c_str());
+  CHECK_EQUAL(0, r.daemon->state_data().find(3)->stripe_count);
 }
 
 // SIGHUP config reload (docs/dockd.md, "Config reload").

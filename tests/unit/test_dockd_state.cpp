@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "../support/fake_can_bus.hpp"
 #include "session_record.hpp"
@@ -65,6 +66,81 @@ TEST(DockdState, RoundTripsAndKeepsTheLastGoodCopy) {
   STRCMP_CONTAINS("checksum mismatch", msg.c_str());
   REAL_EQUAL(0.225, static_cast<double>(out.find(1)->target.x_m), 1e-9);
   CHECK_FALSE(read_all(path + ".corrupt").empty());
+}
+
+// A taught code goes on its own line after its target; a file without code lines (an older one) loads as before.
+TEST(DockdState, TheTaughtCodeRoundTripsAndOlderFilesLoad) {
+  dockd::StateData s = one(3, 0.23);
+  dockd::TaughtTarget t = *s.find(3);
+  t.stripe_count = 2;
+  t.stripes[0] = dockcore::ReflectorStripe{1, static_cast<dockcore::Real>(0.0), static_cast<dockcore::Real>(0.1004)};
+  t.stripes[1] = dockcore::ReflectorStripe{1, static_cast<dockcore::Real>(0.2011), static_cast<dockcore::Real>(0.3)};
+  t.code_scans = 18;
+  t.code_spread_m = 0.0021;
+  s.put(t);
+  s.put(*one(5, 0.22).find(5));  // no code
+  std::string err, msg;
+  CHECK_TRUE(dockd::save_state(path, s, err));
+  const std::string text = read_all(path);
+  STRCMP_CONTAINS("\ncode 3 18 0.002100 2 1 0.000000 0.100400 1 0.201100 0.300000\n", text.c_str());
+  dockd::StateData out;
+  std::vector<std::string> warnings;
+  CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kOk),
+              static_cast<int>(dockd::load_state(path, out, msg, &warnings)));
+  CHECK_TRUE(warnings.empty());
+  const dockd::TaughtTarget* got = out.find(3);
+  CHECK_EQUAL(2, got->stripe_count);
+  CHECK_EQUAL(1, got->stripes[1].segment);
+  REAL_EQUAL(0.2011, static_cast<double>(got->stripes[1].from_m), 1e-9);
+  CHECK_EQUAL(18, got->code_scans);
+  CHECK_EQUAL(3u, got->code_line);
+  CHECK_EQUAL(0, out.find(5)->stripe_count);
+  // Applied to a profile without stripes of its own, all or nothing.
+  dockcore::DockProfile p;
+  CHECK(dockcore::builtin_profile("plate-v", p) == dockcore::ProfileError::kOk);
+  CHECK_TRUE(dockd::with_taught_code(p, *got));
+  CHECK_EQUAL(2u, p.reflector_count);
+  CHECK_FALSE(dockd::with_taught_code(p, *got));  // it has its own now
+  // An older file: target lines only.
+  std::string old_body = "dockd-state 1\ntarget 3 0.230000000 0.001000000 3.100000000 20 0.000000 0\n";
+  char crc[32];
+  std::snprintf(crc, sizeof crc, "crc32 %08x\n", dockd::crc32_ieee(old_body.data(), old_body.size()));
+  write_all(path, old_body + crc);
+  CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kOk), static_cast<int>(dockd::load_state(path, out, msg)));
+  CHECK_EQUAL(0, out.find(3)->stripe_count);
+}
+
+// A bad code line (with a good checksum: written by hand or by another program) is reported with the file and line
+// and left out; the targets and the other codes load as they are, and the file is not moved aside.
+TEST(DockdState, ABadCodeLineIsReportedAndChangesNothingElse) {
+  const char* bad_lines[] = {
+      "code 3 18 0.0021 2 1 0.0 0.1",             // a stripe missing
+      "code 3 18 0.0021 1 1 0.20 0.205",          // shorter than 1 cm
+      "code 3 18 0.0021 2 1 0.0 0.1 1 0.05 0.2",  // overlapping
+      "code 3 18 0.0021 1 1 nan 0.1",             // not a number
+      "code 9 18 0.0021 1 1 0.0 0.1",             // no target of dock 9
+      "code 3 18 0.0021 1 1 0.0 0.1 junk",        // trailing text
+  };
+  for (const char* bad : bad_lines) {
+    const std::string body =
+        std::string("dockd-state 1\n") + "target 3 0.230000000 0.001000000 3.100000000 20 0.000000 0\n" + bad + "\n" +
+        "target 5 0.220000000 0.000000000 3.100000000 20 0.000000 0\n" + "code 5 20 0.001 1 1 0.1 0.2\n";
+    char crc[32];
+    std::snprintf(crc, sizeof crc, "crc32 %08x\n", dockd::crc32_ieee(body.data(), body.size()));
+    write_all(path, body + crc);
+    dockd::StateData out;
+    std::vector<std::string> warnings;
+    std::string msg;
+    CHECK_EQUAL(static_cast<int>(dockd::StateLoadStatus::kOk),
+                static_cast<int>(dockd::load_state(path, out, msg, &warnings)));
+    CHECK_EQUAL_TEXT(1u, warnings.size(), bad);
+    STRCMP_CONTAINS((path + ":3: bad code line").c_str(), warnings[0].c_str());
+    CHECK(out.find(3) != nullptr);
+    CHECK_EQUAL(0, out.find(3)->stripe_count);
+    CHECK_EQUAL(1, out.find(5)->stripe_count);
+    CHECK_EQUAL(5u, out.find(5)->code_line);
+    CHECK_TRUE(read_all(path + ".corrupt").empty());
+  }
 }
 
 TEST(DockdState, TruncatedFileWithoutBackupIsReported) {

@@ -84,6 +84,11 @@ dockcore::DockEstimate seen(double x_m, double y_m, double yaw_rad) {
 
 constexpr double kPi = 3.14159265358979323846;
 
+/// A detection from a scan without usable intensity (the geometry alone).
+void sample(dockd::Teacher& t, const dockcore::DockEstimate& e) {
+  t.sample(e, dockcore::ScanView{}, false);
+}
+
 }  // namespace
 
 TEST_GROUP(DockdTeach) {
@@ -113,13 +118,13 @@ TEST(DockdTeach, AveragesItsScansStoresTheTargetAndReplies) {
   STRCMP_CONTAINS("\"event\":\"teach_start\",\"dock_id\":1,\"scans\":4", hooks.events[0].c_str());
 
   // Four detections around (0.230, 0.002) facing the robot, the nominal target being (0.225, 0, 180°).
-  t.sample(seen(0.229, 0.001, kPi - 0.01));
-  t.sample(seen(0.231, 0.003, kPi + 0.01));
+  sample(t, seen(0.229, 0.001, kPi - 0.01));
+  sample(t, seen(0.231, 0.003, kPi + 0.01));
   t.progress(1100000);
   CHECK_TRUE(t.active());  // two of four
-  t.sample(seen(0.230, 0.002, kPi));
-  t.sample(seen(0.230, 0.002, kPi));
-  t.sample(seen(0.5, 0.5, 0));  // beyond its scans: not averaged
+  sample(t, seen(0.230, 0.002, kPi));
+  sample(t, seen(0.230, 0.002, kPi));
+  sample(t, seen(0.5, 0.5, 0));  // beyond its scans: not averaged
   t.progress(1200000);
   CHECK_FALSE(t.active());
 
@@ -151,7 +156,7 @@ TEST(DockdTeach, AStopCancelsTheRunningTeach) {
   CHECK_TRUE(hooks.errors.empty());
   t.start(teach_request(6, 10, 3), ready(), 1000000);
   CHECK_TRUE(t.active());
-  t.sample(seen(0.23, 0, kPi));
+  sample(t, seen(0.23, 0, kPi));
   t.cancel(1100000);
   CHECK_FALSE(t.active());
   CHECK_EQUAL(1u, hooks.errors.size());
@@ -170,8 +175,8 @@ TEST(DockdTeach, AStopCancelsTheRunningTeach) {
 TEST(DockdTeach, FailsWhenTooFewScansSawTheDockBeforeTheTimeout) {
   dockd::Teacher t(cfg, hooks);
   t.start(teach_request(7, 5), ready(), 1000000);
-  t.sample(seen(0.23, 0, kPi));
-  t.sample(seen(0.23, 0, kPi));
+  sample(t, seen(0.23, 0, kPi));
+  sample(t, seen(0.23, 0, kPi));
   t.progress(10999999);
   CHECK_TRUE(t.active());
   t.progress(11000000);  // teach_timeout_s after the start
@@ -180,15 +185,15 @@ TEST(DockdTeach, FailsWhenTooFewScansSawTheDockBeforeTheTimeout) {
   STRCMP_EQUAL("7:only 2 of 5 scans saw the dock within 10 s", hooks.errors[0].c_str());
   CHECK_TRUE(hooks.stored.empty());
   CHECK_EQUAL(3u, hooks.configured.back().dock_id);
-  t.sample(seen(0.23, 0, kPi));  // after the end: ignored
+  sample(t, seen(0.23, 0, kPi));  // after the end: ignored
   CHECK_FALSE(t.active());
 }
 
 TEST(DockdTeach, FailsWhenTheDetectionsSpreadOrTheStateFileCannotBeWritten) {
   dockd::Teacher t(cfg, hooks);
   t.start(teach_request(8, 2), ready(), 1000000);
-  t.sample(seen(0.20, 0, kPi));
-  t.sample(seen(0.25, 0, kPi));  // 25 mm from the mean each: a moving robot
+  sample(t, seen(0.20, 0, kPi));
+  sample(t, seen(0.25, 0, kPi));  // 25 mm from the mean each: a moving robot
   t.progress(1100000);
   CHECK_FALSE(t.active());
   CHECK_EQUAL(1u, hooks.errors.size());
@@ -198,8 +203,8 @@ TEST(DockdTeach, FailsWhenTheDetectionsSpreadOrTheStateFileCannotBeWritten) {
 
   hooks.store_error = "rename: read-only file system";
   t.start(teach_request(9, 2), ready(), 2000000);
-  t.sample(seen(0.23, 0, kPi));
-  t.sample(seen(0.23, 0, kPi));
+  sample(t, seen(0.23, 0, kPi));
+  sample(t, seen(0.23, 0, kPi));
   t.progress(2100000);
   CHECK_FALSE(t.active());
   CHECK_EQUAL(2u, hooks.errors.size());
