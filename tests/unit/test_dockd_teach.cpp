@@ -3,9 +3,11 @@
 // few scans saw the dock before the timeout, detections spread too far, the state file not written.
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "dockcore/perception/profile_geometry.hpp"
 #include "teach.hpp"
 
 #include "CppUTest/TestHarness.h"
@@ -146,6 +148,9 @@ TEST(DockdTeach, AveragesItsScansStoresTheTargetAndReplies) {
       "\"target_y_m\":0.0020,",
       hooks.replies[0].c_str());
   STRCMP_CONTAINS("\"spread_mm\":1.41,\"offset_x_mm\":5.0,\"offset_y_mm\":2.0,", hooks.replies[0].c_str());
+  // Scans without usable intensity: no code, and the reply says why.
+  STRCMP_CONTAINS("\"code\":\"intensity_unusable\",\"spread_mm\"", hooks.replies[0].c_str());
+  CHECK_EQUAL(0, s.stripe_count);
   CHECK_EQUAL(2u, hooks.events.size());
   STRCMP_CONTAINS("\"event\":\"teach_done\",\"dock_id\":1,\"scans\":4,\"target_x_m\":0.2300", hooks.events[1].c_str());
 }
@@ -241,4 +246,82 @@ TEST(DockdTeach, RefusedAtTheStartWhenTheRobotIsNotReady) {
   STRCMP_EQUAL("9:a teach is already running", hooks.errors[5].c_str());
   CHECK_TRUE(t.active());
   CHECK_TRUE(hooks.events.size() == 1u);  // only the one that started
+}
+
+namespace {
+
+/// A 0.2° scan of a plate-v at `dock` (robot frame, lidar at the robot's origin) whose face (segment 1) is bright from
+/// `from_m` to `to_m` along it (none when from_m >= to_m), everything else at 150-156.
+std::unique_ptr<dockcore::LaserScan> taped_scan(const dockcore::DockProfile& plate, const dockcore::Pose2& dock,
+                                                double from_m, double to_m) {
+  auto scan = std::make_unique<dockcore::LaserScan>();
+  scan->reset(1800, static_cast<dockcore::Real>(-kPi), static_cast<dockcore::Real>(2 * kPi / 1800), 0);
+  dockcore::PlacedProfile placed;
+  placed.place(plate, dock);
+  for (std::size_t i = 0; i < scan->count; ++i) {
+    const dockcore::Real a = scan->view().angle_rad(i);
+    const dockcore::Vec2 dir(std::cos(a), std::sin(a));
+    dockcore::Real r = 0;
+    std::size_t seg = 0;
+    scan->intensities[i] = static_cast<dockcore::Real>(150 + i % 7);  // a diffuse face's intensities vary
+    if (!placed.raycast(dir, &r, &seg)) continue;
+    scan->ranges_m[i] = r;
+    const double along = static_cast<double>(placed.along_m(seg, r * dir));
+    if (seg == 1 && along > from_m && along < to_m) scan->intensities[i] = 250;
+  }
+  return scan;
+}
+
+}  // namespace
+
+// With usable intensity each detection's scan is read at its pose: the pattern most scans read is the code (edges
+// averaged), a pattern only half the scans read is none, and a profile with its own stripes keeps them.
+TEST(DockdTeach, TheCodeIsThePatternMostScansRead) {
+  dockcore::DockProfile plate;
+  CHECK(dockcore::builtin_profile("plate-v", plate) == dockcore::ProfileError::kOk);
+  cfg.docks[0].profile = plate;
+  const dockcore::DockEstimate e = seen(0.23, 0.0, kPi);
+  const auto taped = taped_scan(plate, e.pose, 0.05, 0.15);
+  const auto bare = taped_scan(plate, e.pose, 0, 0);
+  dockd::Teacher t(cfg, hooks);
+
+  t.start(teach_request(5, 0), ready(), 1000000);
+  for (int i = 0; i < 3; ++i) t.sample(e, taped->view(), true);
+  t.sample(e, bare->view(), true);
+  t.progress(1100000);
+  CHECK_EQUAL(1u, hooks.stored.size());
+  const dockd::TaughtTarget& s = hooks.stored[0];
+  CHECK_EQUAL(1, s.stripe_count);
+  CHECK_EQUAL(3, s.code_scans);
+  CHECK_EQUAL(1, s.stripes[0].segment);
+  // Edges half-way between beams 0.8 mm apart on the face.
+  DOUBLES_EQUAL(0.05, static_cast<double>(s.stripes[0].from_m), 0.001);
+  DOUBLES_EQUAL(0.15, static_cast<double>(s.stripes[0].to_m), 0.001);
+  STRCMP_CONTAINS("\"code\":\"taught\",\"stripes\":[[1,0.05", hooks.replies[0].c_str());
+  STRCMP_CONTAINS("\"code_scans\":3,\"code_spread_mm\":0.0", hooks.replies[0].c_str());
+  STRCMP_CONTAINS("\"code\":\"taught\"", hooks.events.back().c_str());
+
+  // Two of four scans read the stripe: no majority, no code.
+  t.start(teach_request(6, 0), ready(), 2000000);
+  for (int i = 0; i < 2; ++i) t.sample(e, taped->view(), true);
+  for (int i = 0; i < 2; ++i) t.sample(e, bare->view(), true);
+  t.progress(2100000);
+  CHECK_EQUAL(2u, hooks.stored.size());
+  CHECK_EQUAL(0, hooks.stored[1].stripe_count);
+  STRCMP_CONTAINS("\"code\":\"unread\",\"spread_mm\"", hooks.replies[1].c_str());
+
+  // The profile's own stripes stay; the teach says whether its reading agrees.
+  dockcore::ReflectorStripe own{1, static_cast<dockcore::Real>(0.05), static_cast<dockcore::Real>(0.15)};
+  CHECK(dockcore::add_reflector(cfg.docks[0].profile, own) == dockcore::ProfileError::kOk);
+  t.start(teach_request(7, 0), ready(), 3000000);
+  for (int i = 0; i < 4; ++i) t.sample(e, taped->view(), true);
+  t.progress(3100000);
+  CHECK_EQUAL(0, hooks.stored[2].stripe_count);
+  STRCMP_CONTAINS("\"code\":\"profile\",\"stripes\":[[1,0.05", hooks.replies[2].c_str());
+  STRCMP_CONTAINS("\"code_matches\":true", hooks.replies[2].c_str());
+  t.start(teach_request(8, 0), ready(), 4000000);
+  for (int i = 0; i < 4; ++i) t.sample(e, bare->view(), true);
+  t.progress(4100000);
+  STRCMP_CONTAINS("\"code\":\"profile\",\"stripes\":[],\"code_scans\":4", hooks.replies[3].c_str());
+  STRCMP_CONTAINS("\"code_matches\":false", hooks.replies[3].c_str());
 }
