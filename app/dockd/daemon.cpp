@@ -142,10 +142,13 @@ bool Daemon::start(std::string& error) {
   for (const TaughtTarget& t : state_.targets) {
     const DockEntry* d = cfg_.find_dock(t.dock_id);
     dockcore::DockProfile check = d != nullptr ? d->profile : dockcore::DockProfile{};
-    if (t.stripe_count == 0 || d == nullptr || d->profile.reflector_count > 0 || with_taught_code(check, t)) continue;
+    dockcore::ProfileError why = dockcore::ProfileError::kOk;
+    if (t.stripe_count == 0 || d == nullptr || d->profile.reflector_count > 0 || with_taught_code(check, t, &why)) {
+      continue;
+    }
     warnings.push_back(cfg_.state_file + ":" + std::to_string(t.code_line) + ": the taught code of dock " +
-                       std::to_string(t.dock_id) + " does not fit its profile (" +
-                       dockcore::to_string(dockcore::ProfileError::kBadReflector) + "): not applied");
+                       std::to_string(t.dock_id) + " does not fit its profile (" + dockcore::to_string(why) +
+                       "): not applied");
   }
   for (const std::string& w : warnings) {
     EventLine e(now, "state_file");

@@ -31,11 +31,16 @@ void StateData::put(const TaughtTarget& t) {
   targets.push_back(t);
 }
 
-bool with_taught_code(dockcore::DockProfile& profile, const TaughtTarget& t) {
+bool with_taught_code(dockcore::DockProfile& profile, const TaughtTarget& t, dockcore::ProfileError* why) {
+  if (why != nullptr) *why = dockcore::ProfileError::kOk;
   if (t.stripe_count == 0 || profile.reflector_count > 0) return false;
   dockcore::DockProfile coded = profile;
   for (std::size_t q = 0; q < t.stripe_count; ++q) {
-    if (dockcore::add_reflector(coded, t.stripes[q]) != dockcore::ProfileError::kOk) return false;
+    const dockcore::ProfileError e = dockcore::add_reflector(coded, t.stripes[q]);
+    if (e != dockcore::ProfileError::kOk) {
+      if (why != nullptr) *why = e;
+      return false;
+    }
   }
   profile = coded;
   return true;

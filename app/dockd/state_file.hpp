@@ -40,8 +40,9 @@ struct StateData {
 };
 
 /// Adds t's taught stripes to `profile` when it has none of its own and every stripe fits (add_reflector); true
-/// then, else false with `profile` unchanged. O(kMaxReflectors²).
-bool with_taught_code(dockcore::DockProfile& profile, const TaughtTarget& t);
+/// then, else false with `profile` unchanged and, when a stripe did not fit, add_reflector's reason in `why` (if not
+/// null; kOk otherwise). O(kMaxReflectors²).
+bool with_taught_code(dockcore::DockProfile& profile, const TaughtTarget& t, dockcore::ProfileError* why = nullptr);
 
 enum class StateLoadStatus : std::uint8_t {
   kOk = 0,

@@ -784,6 +784,34 @@ TEST(DockdDaemon, TeachRecordsTheDocksCodeAndDockingsReadIt) {
   CHECK_EQUAL(0, r.daemon->state_data().find(3)->stripe_count);
 }
 
+// A state file with a bad code line and a code that does not fit its dock's profile: each reported at its line, the
+// targets loaded, the misfit code not applied.
+TEST(DockdDaemon, AStateFilesBadCodeIsReportedAtItsLine) {
+  Rig r("code_misfit", false, 1.2, true, false, nullptr, [](dockd::DockdConfig& c) {
+    const std::string body = std::string("dockd-state 1\n") +
+                             "target 0 0.225000000 0.000000000 3.141592654 20 0.001000 0\n" +
+                             "code 0 20 0.001 1 1 0.20 0.205\n" +  // shorter than 1 cm
+                             "target 3 0.225000000 0.000000000 3.141592654 20 0.001000 0\n" +
+                             "code 3 20 0.001 1 5 0.0 0.1\n";  // plate-v has segments 0-2
+    char crc[32];
+    std::snprintf(crc, sizeof crc, "crc32 %08x\n", dockd::crc32_ieee(body.data(), body.size()));
+    std::FILE* f = std::fopen(c.state_file.c_str(), "w");
+    std::fputs((body + crc).c_str(), f);
+    std::fclose(f);
+  });
+  const std::string ev = r.events("state_file");
+  STRCMP_CONTAINS((r.state_file + ":3: bad code line 'code 0 20 0.001 1 1 0.20 0.205'").c_str(), ev.c_str());
+  STRCMP_CONTAINS((r.state_file + ":5: the taught code of dock 3 does not fit its profile (reflector stripe on a "
+                                  "segment the outline does not have): not applied")
+                      .c_str(),
+                  ev.c_str());
+  CHECK(r.daemon->state_data().find(0) != nullptr);
+  CHECK_EQUAL(1, r.daemon->state_data().find(3)->stripe_count);
+  char json[dockcore::drivers::kMaxHostReply];
+  CHECK(r.daemon->status_json(json, sizeof json, r.clock.t) > 0);
+  STRCMP_CONTAINS("\"det_code\":\"none\"", json);  // dock 0: no code applied
+}
+
 // SIGHUP config reload (docs/dockd.md, "Config reload").
 TEST(DockdDaemon, ConfigReloadAppliesValidRejectsBadAndWaitsForIdle) {
   Rig r("reload");
