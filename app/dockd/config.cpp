@@ -140,6 +140,15 @@ const DockEntry* DockdConfig::find_dock(std::uint16_t id) const {
   return nullptr;
 }
 
+dockcore::StripeReadParams stripe_read_params(const DockdConfig& c) {
+  dockcore::StripeReadParams p;
+  p.inlier_gate_m = c.estimator.inlier_gate_m;
+  p.min_intensity = c.estimator.reflector_min_intensity;
+  p.min_range_m = c.estimator.min_range_m;
+  p.min_inlier_beams = c.estimator.min_inliers;
+  return p;
+}
+
 Pose2 nominal_docked_target(const DockdConfig& c) {
   const Real reach = static_cast<Real>(c.pad_reach_m);
   return c.pads_rear ? Pose2{-reach, 0, 0} : Pose2{reach, 0, dockcore::kPi};

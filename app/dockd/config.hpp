@@ -23,6 +23,7 @@
 #include "dockcore/geometry.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/reflector_read.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
 #include "dockcore/task/input_watch.hpp"
 #include "dockcore/task/task_manager.hpp"
@@ -136,6 +137,10 @@ struct DockdConfig {
   /// The dock with `id`, or nullptr.
   const DockEntry* find_dock(std::uint16_t id) const;
 };
+
+/// How dockd reads a dock's reflector stripes (teach, and the code in the status): the estimator's inlier gate,
+/// reflector threshold, blind zone and inlier floor. O(1).
+dockcore::StripeReadParams stripe_read_params(const DockdConfig& c);
 
 /// Input caps (docs/reliability.md, "Security"): beyond them the file is refused with a ConfigError, so no config or
 /// profile file can make dockd (or --check-config, or a SIGHUP reload) use unbounded memory or block.

@@ -155,6 +155,10 @@ class Daemon final : private HostActions, private TeachHooks {
   /// The tag fusion's, the stall flag's and the own camera's groups; with only_if_fits each is left out whole when
   /// `w` has no room for it.
   void camera_groups(JsonWriter& w, bool only_if_fits) const;
+  /// The dock database id whose reflector code the latest scan read: the active dock when it was found with its
+  /// code, another dock of its outline whose code a refused candidate (wrong_code) reads, else -1. O(beams of the
+  /// dock's span · profile segments + docks).
+  int code_dock_id() const;
   void poll_chassis(std::uint64_t now_us);
   void poll_lidar(std::uint64_t now_us);
   void poll_camera(std::uint64_t now_us);

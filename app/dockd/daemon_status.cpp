@@ -10,6 +10,18 @@ namespace dockd {
 
 namespace {
 
+/// A read stripe edge within this of a code's, plus the beam spacing at the dock, is the same edge, m.
+constexpr double kCodeEdgeToleranceM = 0.02;
+
+/// Two profiles of the same outline (every vertex within 1 mm): stripes on one are comparable with the other's.
+bool same_outline(const dockcore::DockProfile& a, const dockcore::DockProfile& b) {
+  if (a.vertex_count != b.vertex_count) return false;
+  for (std::size_t i = 0; i < a.vertex_count; ++i) {
+    if ((a.vertices_m[i] - b.vertices_m[i]).norm() > static_cast<Real>(0.001)) return false;
+  }
+  return true;
+}
+
 /// What the latest scan read of the active dock's reflector code (docs/docks.md, "Reflectors"): "none" (its profile
 /// has no stripes), "not_read" (the lidar's intensity is flat or absent: geometry only), "read" (the dock was found
 /// with its own pattern: it is the dock of this id), "wrong" (a dock of its shape with another pattern was refused),
@@ -27,6 +39,38 @@ const char* code_reading(const dockcore::DockcoreBase& core) {
 }
 
 }  // namespace
+
+int Daemon::code_dock_id() const {
+  const dockcore::DockcoreBase& core = *core_;
+  if (core.estimator().profile().reflector_count == 0 || core.config().detector != dockcore::DockDetector::kEstimator ||
+      !core.estimator().intensity_usable()) {
+    return -1;
+  }
+  const dockcore::DockEstimate& e = core.last_estimate();
+  if (e.found) return active_dock_;
+  const DockEntry* active = cfg_.find_dock(active_dock_);
+  if (e.reject != dockcore::RejectReason::kWrongCode || active == nullptr) return -1;
+  // Another dock of this shape was refused: read its stripes where it stands and look its pattern up among the
+  // database's docks of the same outline (their own stripes, or their taught code).
+  const dockcore::ScanView scan = core.last_scan();
+  const dockcore::StripeRead r = dockcore::read_reflector_stripes(scan, cfg_.lidar_mount, core.estimator().profile(),
+                                                                  e.refused_pose, stripe_read_params(cfg_));
+  if (r.status != dockcore::StripeReadStatus::kOk || r.count == 0) return -1;
+  // An edge is read to about half a beam spacing at the dock, plus the pose's own error.
+  const Real dist_m = std::hypot(e.refused_pose.x_m, e.refused_pose.y_m);
+  const Real tolerance_m = static_cast<Real>(kCodeEdgeToleranceM) + dist_m * scan.angle_increment_rad;
+  for (const DockEntry& d : cfg_.docks) {
+    if (d.id == active_dock_ || !same_outline(d.profile, active->profile)) continue;
+    dockcore::DockProfile coded = d.profile;
+    const TaughtTarget* t = state_.find(d.id);
+    if (t != nullptr) with_taught_code(coded, *t);
+    if (coded.reflector_count > 0 &&
+        dockcore::same_stripes(coded.reflectors, coded.reflector_count, r.stripes, r.count, tolerance_m)) {
+      return d.id;
+    }
+  }
+  return -1;
+}
 
 void Daemon::publish_status(std::uint64_t now_us) {
   const dockcore::TaskStatus& s = last_out_.status;
@@ -135,6 +179,7 @@ void Daemon::status_fields(JsonWriter& w, std::uint64_t now_us) const {
       .reals("det_cues_nats", cues, dockcore::kEvidenceCueCount, 1)
       .str("det_reject", e.found ? "none" : dockcore::to_string(e.reject))
       .str("det_code", code_reading(*core_))
+      .sint("det_code_dock", code_dock_id())
       .real("dock_evidence_nats", static_cast<double>(core_->filter().evidence_nats()), 1)
       .boolean("dock_confirmed", core_->filter().confirmed());
   // The camera's groups go in only when they fit (the status must stay one datagram); each is dropped whole. The

@@ -83,12 +83,8 @@ void Teacher::sample(const dockcore::DockEstimate& e, const dockcore::ScanView& 
   // The stripes at the detected pose, on the dock's own profile (the one the core was configured with for the teach).
   const DockEntry* d = cfg_.find_dock(dock_id_);
   if (d == nullptr) return;
-  dockcore::StripeReadParams p;
-  p.inlier_gate_m = cfg_.estimator.inlier_gate_m;
-  p.min_intensity = cfg_.estimator.reflector_min_intensity;
-  p.min_range_m = cfg_.estimator.min_range_m;
-  p.min_inlier_beams = cfg_.estimator.min_inliers;
-  const dockcore::StripeRead r = dockcore::read_reflector_stripes(scan, cfg_.lidar_mount, d->profile, e.pose, p);
+  const dockcore::StripeRead r =
+      dockcore::read_reflector_stripes(scan, cfg_.lidar_mount, d->profile, e.pose, stripe_read_params(cfg_));
   if (r.status != dockcore::StripeReadStatus::kOk) return;  // unread: a vote for no pattern
   PatternVote& v = votes_[r.count];
   for (std::size_t q = 0; q < r.count; ++q) {
@@ -157,13 +153,8 @@ void Teacher::finish(bool ok, const char* why, std::uint64_t now_us) {
     }
     if (own_code) {
       code = "profile";
-      code_matches = read_n == dock->profile.reflector_count;
-      for (std::size_t q = 0; q < read_n && code_matches; ++q) {
-        const dockcore::ReflectorStripe& o = dock->profile.reflectors[q];
-        code_matches = o.segment == read[q].segment &&
-                       std::fabs(static_cast<double>(o.from_m - read[q].from_m)) <= kCodeMatchM &&
-                       std::fabs(static_cast<double>(o.to_m - read[q].to_m)) <= kCodeMatchM;
-      }
+      code_matches = dockcore::same_stripes(dock->profile.reflectors, dock->profile.reflector_count, read, read_n,
+                                            static_cast<Real>(kCodeMatchM));
     } else if (read_n == 0) {
       code = "none";
     } else {

@@ -302,6 +302,38 @@ TEST(DockdDaemon, TheStatusSaysWhetherTheDocksCodeWasRead) {
   STRCMP_CONTAINS("\"det_code\":\"none\"", json);
 }
 
+// The status names the database dock whose code it read: sent to a dock whose pattern stands nowhere in the room,
+// the robot refuses the taped dock it sees (wrong_code) and the status says that dock is dock 0; never the dock it
+// was sent to.
+TEST(DockdDaemon, TheStatusNamesTheDockWhoseCodeItRead) {
+  Rig r("code_id", false, 1.2, false, false, "two-docks.toml", [](dockd::DockdConfig& c) {
+    dockd::DockEntry& d3 = c.docks.back();  // dock 3: dock 0's outline with a code of its own
+    d3.profile.reflector_count = 0;
+    CHECK(dockcore::add_reflector(d3.profile, {1, 0.0f, 0.05f}) == dockcore::ProfileError::kOk);
+    CHECK(dockcore::add_reflector(d3.profile, {1, 0.25f, 0.30f}) == dockcore::ProfileError::kOk);
+  });
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
+  r.host.command(1, 3);  // dock at dock 3
+  char json[dockcore::drivers::kMaxHostReply];
+  int named_0 = 0, named_other = 0;
+  r.run_until(
+      [&] {
+        if (r.daemon->status_json(json, sizeof json, r.clock.t) > 0 &&
+            std::strstr(json, "\"det_code\":\"wrong\"") != nullptr) {
+          if (std::strstr(json, "\"det_code_dock\":0,") != nullptr) ++named_0;
+          if (std::strstr(json, "\"det_code_dock\":-1,") == nullptr &&
+              std::strstr(json, "\"det_code_dock\":0,") == nullptr) {
+            ++named_other;
+          }
+        }
+        return false;
+      },
+      3.0);
+  CHECK(named_0 > 10);
+  LONGS_EQUAL(0, named_other);
+  CHECK(r.daemon->state() != TaskState::kAlign);  // the wrong dock was never taken
+}
+
 // CAN error frames (counted by the bus, mirrored by the chassis link) reach the session record as can_error events:
 // one per poll that saw new ones, with the totals and how many are new; nothing else changes.
 TEST(DockdDaemon, CanErrorFramesAreLoggedWithTheirTotals) {

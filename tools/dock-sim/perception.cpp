@@ -66,6 +66,7 @@ struct Options {
   std::vector<std::string> real_recordings;  // empty = all
   std::size_t composite_per_cell = 100;      // composites per (recording, profile, kind)
   bool reflective_clutter = false;           // real: scans with intensities and reflective clutter pasted in
+  int reflective_objects = 3;                // ... at most this many objects per window
 };
 
 /// Accumulates one cell of a results table.
@@ -559,10 +560,10 @@ json run_real_fp(const Options& o, const RealData& d) {
   out["reflective_clutter"] = o.reflective_clutter;
   if (o.reflective_clutter) {
     out["reflective_clutter_text"] =
-        "every return given an LD06 intensity (diffuse, reflectivity 0.1-1.0 per 0.5 m world cell), 1-3 reflective "
+        "every return given an LD06 intensity (diffuse, reflectivity 0.1-1.0 per 0.5 m world cell), reflective "
         "objects (taped signs, safety vests, chrome legs) pasted into each window's free space, intensity usable; "
-        "seed " +
-        std::to_string(o.seed);
+        "at most " +
+        std::to_string(o.reflective_objects) + " objects, seed " + std::to_string(o.seed);
   }
   json rows = json::array();
   json totals = json::array();
@@ -576,6 +577,7 @@ json run_real_fp(const Options& o, const RealData& d) {
     for (const docksim::LoadedRecording& rec : d.recordings) {
       docksim::ReflectiveClutterOptions ro;
       ro.seed = o.seed;
+      ro.objects_max = o.reflective_objects;
       const docksim::RealFpResult r = o.reflective_clutter
                                           ? docksim::measure_real_reflector_false_positives(rec, prof, ro, rule)
                                           : docksim::measure_real_false_positives(rec, prof, rule);
@@ -948,6 +950,9 @@ void register_perception(CLI::App& app) {
   sub->add_flag("--reflective-clutter", o->reflective_clutter,
                 "real: give every return an LD06 intensity and paste reflective objects (taped signs, safety vests, "
                 "chrome legs) into the scans; the profiles must carry reflector stripes, read with intensity usable");
+  sub->add_option("--reflective-objects", o->reflective_objects,
+                  "real, with --reflective-clutter: at most this many objects per window (0: intensities only)")
+      ->check(CLI::Range(0, 10));
   sub->add_option("--composite-n", o->composite_per_cell,
                   "Composite scenes per (recording, profile, placement), at most one per scan")
       ->check(CLI::PositiveNumber);

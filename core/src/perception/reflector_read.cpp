@@ -1,5 +1,7 @@
 #include "dockcore/perception/reflector_read.hpp"
 
+#include <cmath>
+
 #include "dockcore/perception/profile_geometry.hpp"
 
 namespace dockcore {
@@ -228,6 +230,18 @@ StripeRead read_reflector_stripes(const ScanView& scan, const Pose2& lidar_mount
   out.count = merged;
   out.status = StripeReadStatus::kOk;
   return out;
+}
+
+bool same_stripes(const ReflectorStripe* a, std::size_t a_count, const ReflectorStripe* b, std::size_t b_count,
+                  Real tolerance_m) {
+  if (a_count != b_count) return false;
+  for (std::size_t q = 0; q < a_count; ++q) {
+    if (a[q].segment != b[q].segment || std::fabs(a[q].from_m - b[q].from_m) > tolerance_m ||
+        std::fabs(a[q].to_m - b[q].to_m) > tolerance_m) {
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace dockcore

@@ -241,7 +241,7 @@ struct PastedClutter {
 PastedClutter draw_clutter(const ScanView& first, const Pose2& sensor_in_world, const ReflectiveClutterOptions& o,
                            Rng& rng) {
   PastedClutter c;
-  const int wanted = 1 + static_cast<int>(rng.uniform() * o.objects_max);
+  const int wanted = o.objects_max > 0 ? 1 + static_cast<int>(rng.uniform() * o.objects_max) : 0;
   const double amin = static_cast<double>(first.angle_min_rad);
   const double inc = static_cast<double>(first.angle_increment_rad);
   const double span = inc * static_cast<double>(first.count > 0 ? first.count - 1 : 0);

@@ -63,4 +63,10 @@ struct StripeRead {
 StripeRead read_reflector_stripes(const ScanView& scan, const Pose2& lidar_mount, const DockProfile& profile,
                                   const Pose2& dock_in_robot, const StripeReadParams& params);
 
+/// Whether two stripe patterns are the same code: as many stripes, each on the same segment with both ends within
+/// `tolerance_m` of the other's (both lists in outline order, as read_reflector_stripes and add_reflector keep
+/// them). O(count).
+bool same_stripes(const ReflectorStripe* a, std::size_t a_count, const ReflectorStripe* b, std::size_t b_count,
+                  Real tolerance_m);
+
 }  // namespace dockcore

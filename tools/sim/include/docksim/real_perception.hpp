@@ -92,7 +92,7 @@ RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dock
 /// past the reflector threshold as tape would.
 struct ReflectiveClutterOptions {
   std::uint64_t seed = 1;
-  int objects_max = 3;
+  int objects_max = 3;  ///< 0: no objects, the real returns' intensities only.
   double min_range_m = 0.4;
   double max_range_m = 2.5;
 };
