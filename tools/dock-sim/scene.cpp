@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -395,8 +396,89 @@ int run_scene(const SceneOptions& o) {
 struct ProfileOptions {
   std::string name = "plate-v";
   std::string svg;
+  std::string layout;
   bool toml = false;
 };
+
+/// Writes the tape layout of `p`'s reflector stripes at 1:1 (millimetres, for printing at 100 %): one bar per taped
+/// segment, as long as the segment, seen from the front, its first vertex on the left (a segment's outward normal is
+/// (dy, -dx), so its direction runs to the right of someone facing it). Tape is black; each edge is dimensioned
+/// from the segment's first vertex.
+void write_tape_layout(const dockcore::DockProfile& p, const std::string& path) {
+  constexpr double kMarginMm = 15, kBarMm = 30, kBandMm = 75;
+  double longest_mm = 0;
+  std::vector<std::size_t> taped;
+  for (std::size_t i = 0; i < p.segment_count(); ++i) {
+    bool has = false;
+    for (std::size_t q = 0; q < p.reflector_count; ++q) has = has || p.reflectors[q].segment == i;
+    if (!has) continue;
+    taped.push_back(i);
+    longest_mm = std::max(longest_mm, static_cast<double>((p.vertices_m[i + 1] - p.vertices_m[i]).norm()) * 1e3);
+  }
+  const double w_mm = std::max(longest_mm + 2 * kMarginMm, 120.0);
+  const double h_mm = 22 + kBandMm * static_cast<double>(taped.size());
+  std::string svg;
+  char buf[512];
+  std::snprintf(
+      buf, sizeof buf,
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.1fmm\" height=\"%.1fmm\" viewBox=\"0 0 %.1f %.1f\" "
+      "font-family=\"sans-serif\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
+      w_mm, h_mm, w_mm, h_mm);
+  svg += buf;
+  std::snprintf(buf, sizeof buf,
+                "<text x=\"%.1f\" y=\"8\" font-size=\"4.5\">Tape layout of \"%s\" at 1:1: print at 100 %%</text>\n",
+                kMarginMm, p.name);
+  svg += buf;
+  std::snprintf(buf, sizeof buf,
+                "<text x=\"%.1f\" y=\"14\" font-size=\"3\">Seen from the front, each bar runs from its segment's "
+                "first vertex (left) to the next. Black: tape; edges in mm from the first vertex.</text>\n",
+                kMarginMm);
+  svg += buf;
+  double y = 22;
+  for (const std::size_t i : taped) {
+    const Vec2 a = p.vertices_m[i], b = p.vertices_m[i + 1];
+    const double len_mm = static_cast<double>((b - a).norm()) * 1e3;
+    std::snprintf(buf, sizeof buf,
+                  "<text x=\"%.1f\" y=\"%.1f\" font-size=\"4\">segment %zu: vertex %zu (%.1f, %.1f) mm to vertex %zu "
+                  "(%.1f, %.1f) mm, %.1f mm long</text>\n",
+                  kMarginMm, y + 6, i, i, static_cast<double>(a.x()) * 1e3, static_cast<double>(a.y()) * 1e3, i + 1,
+                  static_cast<double>(b.x()) * 1e3, static_cast<double>(b.y()) * 1e3, len_mm);
+    svg += buf;
+    const double bar_y = y + 16;
+    std::snprintf(buf, sizeof buf,
+                  "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.1f\" fill=\"none\" stroke=\"#888\" "
+                  "stroke-width=\"0.3\"/>\n",
+                  kMarginMm, bar_y, len_mm, kBarMm);
+    svg += buf;
+    for (std::size_t q = 0; q < p.reflector_count; ++q) {
+      const dockcore::ReflectorStripe& st = p.reflectors[q];
+      if (st.segment != i) continue;
+      const double from_mm = static_cast<double>(st.from_m) * 1e3, to_mm = static_cast<double>(st.to_m) * 1e3;
+      std::snprintf(buf, sizeof buf, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.1f\" fill=\"black\"/>\n",
+                    kMarginMm + from_mm, bar_y, to_mm - from_mm, kBarMm);
+      svg += buf;
+      for (const double e : {from_mm, to_mm}) {
+        std::snprintf(buf, sizeof buf,
+                      "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#d62728\" stroke-width=\"0.3\"/>"
+                      "<text x=\"%.2f\" y=\"%.2f\" font-size=\"3.2\" text-anchor=\"middle\">%.1f</text>\n",
+                      kMarginMm + e, bar_y - 3, kMarginMm + e, bar_y + kBarMm + 3, kMarginMm + e, bar_y + kBarMm + 7,
+                      e);
+        svg += buf;
+      }
+    }
+    std::snprintf(buf, sizeof buf,
+                  "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"black\" stroke-width=\"0.5\"/>"
+                  "<text x=\"%.1f\" y=\"%.1f\" font-size=\"3\">100 mm</text>\n",
+                  kMarginMm, bar_y + kBarMm + 12, kMarginMm + 100, bar_y + kBarMm + 12, kMarginMm + 102,
+                  bar_y + kBarMm + 13);
+    svg += buf;
+    y += kBandMm;
+  }
+  svg += "</svg>\n";
+  std::ofstream f(path);
+  f << svg;
+  if (!f) throw std::runtime_error("cannot write " + path);
+}
 
 void draw_profile(const dockcore::DockProfile& p, const std::string& path) {
   docksim::SvgBounds b;
@@ -411,6 +493,12 @@ void draw_profile(const dockcore::DockProfile& p, const std::string& path) {
           fmtd(", depth %.0f mm", -x_min * 1e3) + ", " + std::to_string(p.vertex_count) + " vertices");
   c.grid(0.05);
   c.polyline(profile_points(p), SvgStyle::line("#333333", 3.0));
+  for (std::size_t q = 0; q < p.reflector_count; ++q) {
+    const dockcore::ReflectorStripe& st = p.reflectors[q];
+    const Vec2 from = p.vertices_m[st.segment];
+    const Vec2 d = (p.vertices_m[st.segment + 1] - from).normalized();
+    c.line(from + d * st.from_m, from + d * st.to_m, SvgStyle::line("#ff7f0e", 7.0));
+  }
   for (std::size_t i = 0; i < p.segment_count(); ++i) {
     const Vec2 mid = (p.vertices_m[i] + p.vertices_m[i + 1]) * static_cast<Real>(0.5);
     c.arrow(mid, mid + p.normal(i) * static_cast<Real>(0.025), SvgStyle::line("#1f77b4", 1.2), 6);
@@ -438,6 +526,7 @@ void draw_profile(const dockcore::DockProfile& p, const std::string& path) {
   c.circle(Vec2(0, 0), 0.006, SvgStyle::filled("#d62728"));
   c.scale_bar(0.1);
   c.legend("dock outline (lidar-visible surface)", SvgStyle::line("#333333", 3.0));
+  if (p.reflector_count > 0) c.legend("reflector tape", SvgStyle::line("#ff7f0e", 7.0));
   c.legend("outward normal (dy, -dx)", SvgStyle::line("#1f77b4", 1.2), docksim::SvgLegendMark::kArrow);
   c.legend("dock frame x (out of the face)", SvgStyle::line("#d62728", 2.0), docksim::SvgLegendMark::kArrow);
   c.legend("dock frame y", SvgStyle::line("#2ca02c", 2.0), docksim::SvgLegendMark::kArrow);
@@ -474,6 +563,25 @@ int run_profile(const ProfileOptions& o) {
       }
       std::printf("\n");
     }
+    for (std::size_t q = 0; q < p.reflector_count; ++q) {
+      const dockcore::ReflectorStripe& st = p.reflectors[q];
+      std::printf("reflector %zu: segment %u, %.1f-%.1f mm from vertex %u\n", q, static_cast<unsigned>(st.segment),
+                  static_cast<double>(st.from_m) * 1e3, static_cast<double>(st.to_m) * 1e3,
+                  static_cast<unsigned>(st.segment));
+    }
+  }
+  if (!o.layout.empty()) {
+    if (p.reflector_count == 0) {
+      std::cerr << "dock-sim profile: --layout: profile " << p.name << " has no reflector stripes\n";
+      return 2;
+    }
+    try {
+      write_tape_layout(p, o.layout);
+    } catch (const std::exception& e) {
+      std::cerr << "dock-sim profile: " << e.what() << "\n";
+      return 2;
+    }
+    if (!o.toml) std::printf("tape layout (1:1) written to %s\n", o.layout.c_str());
   }
   if (!o.svg.empty()) {
     try {
@@ -531,6 +639,8 @@ void register_scene(CLI::App& app) {
   prof->add_option("--name", p->name, "breakpoint, v-marker, plate-v or a .toml file")->capture_default_str();
   prof->add_option("--svg", p->svg, "Write a dimensioned drawing to this file");
   prof->add_flag("--toml", p->toml, "Print the profile in the TOML profile format instead of the table");
+  prof->add_option("--layout", p->layout,
+                   "Write the reflector stripes' tape layout at 1:1 (SVG in millimetres: print at 100 %) to this file");
   prof->callback([p]() {
     const int rc = run_profile(*p);
     if (rc != 0) throw CLI::RuntimeError(rc);
