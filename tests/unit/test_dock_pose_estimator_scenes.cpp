@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "dockcore/perception/dock_pose_estimator.hpp"
+#include "dockcore/perception/profile_geometry.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/scenes.hpp"
 
@@ -313,6 +314,40 @@ double cue(const DockEstimate& e, EvidenceCue c) {
 }
 
 }  // namespace
+
+// A gap seen by one beam that reads bright is a glint or another dock's stripe: the pattern is then not known whole,
+// and a pattern known in part could be another dock's, so the dock is refused as unread rather than taken on the
+// stripes alone. Regions too narrow to hold a beam at this range (the 1.5 cm end gap) are not needed.
+TEST(DockPoseEstimator, AGapSeenByOneBrightBeamLeavesTheCodeUnread) {
+  const DockProfile code = coded_plate({{0.015, 0.13}, {0.17, 0.30}});  // a 4 cm gap: one beam inside it at 1 m
+  const Truth t = simulate(code, 1.0, 0.0, 0.0, ld06(0.002), 3);
+  g_est.configure(code, EstimatorParams{});
+  g_est.set_intensity_usable(true);
+  const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_TRUE(clean.found);
+  CHECK_EQUAL(0, clean.evidence.features.regions_unread);
+  // Light the beams landing well inside the gap, as another dock's tape there would.
+  PlacedProfile placed;
+  placed.place(code, t.dock_in_lidar);
+  const ScanView v = g_scan.view();
+  int lit = 0;
+  for (std::size_t i = 0; i < v.count; ++i) {
+    const Real a = v.angle_rad(i);
+    Real r = 0;
+    std::size_t seg = 0;
+    if (!placed.raycast(Vec2(std::cos(a), std::sin(a)), &r, &seg) || seg != 1) continue;
+    const Real s = placed.along_m(1, r * Vec2(std::cos(a), std::sin(a)));
+    if (s > static_cast<Real>(0.145) && s < static_cast<Real>(0.155)) {
+      g_scan.intensities[i] = 255;
+      ++lit;
+    }
+  }
+  CHECK_EQUAL(1, lit);
+  const DockEstimate glint = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_FALSE(glint.found);
+  CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(glint.reject));
+  CHECK(glint.evidence.features.regions_unread >= 1);
+}
 
 // A reflector dock's stripes are read from the LD06's intensities: the dock with its own stripe pattern gains
 // evidence, the same shape with another pattern (another dock's code) or without tape loses so much that it is

@@ -81,6 +81,8 @@ constexpr Real kRegionMatchNats = static_cast<Real>(0.683);      // ln(0.99 / 0.
 constexpr Real kRegionMismatchNats = static_cast<Real>(-3.912);  // ln(0.01 / 0.5)
 // A beam this close to a stripe's end (plus half its footprint) is left out: its footprint may straddle the edge.
 constexpr Real kStripeEdgeMarginM = static_cast<Real>(0.005);
+// A gap beside a stripe shorter than a stripe may be (add_reflector's 1 cm) is no region of the pattern.
+constexpr Real kMinRegionM = static_cast<Real>(0.01);
 // Between two verified objects, evidence stronger by this much (a likelihood ratio of e^3 = 20) decides over
 // nearness; closer than that, both are taken for docks and the nearest is chosen.
 constexpr Real kSelectMarginNats = static_cast<Real>(3);
@@ -741,20 +743,52 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     }
   }
   if (read_stripes) {
-    // A stripe reads as tape when half its beams or more are bright; a gap reads as tape when two or more of its
-    // beams and over a quarter of them are (one stray bright beam is a glint, not another dock's stripe).
-    auto read = [&f](std::uint16_t n, std::uint16_t bright, bool tape_expected) {
-      if (n == 0) return;
-      const bool reads_tape = tape_expected ? 2 * bright >= n : (bright >= 2 && 4 * bright > n);
+    // A stripe reads as tape when half its beams or more are bright, else as bare. A gap reads bare when at most a
+    // quarter of its beams are bright, as tape when two or more and over a quarter are; one bright beam among
+    // fewer than four is either a glint or another dock's stripe seen by one beam, so that gap is not read.
+    // A region wide enough at this pose to hold a beam inside its edge margins must be read: a pattern known in part
+    // could be another dock's. Narrower ones (an end gap of a centimetre or two, fine regions at range) count when
+    // read and are not needed.
+    auto read = [&](std::uint16_t n, std::uint16_t bright, bool tape_expected, std::uint8_t seg, Real from_m,
+                    Real to_m) {
+      const Vec2 mid = placed_.v_m[seg] + placed_.d_m[seg] * ((from_m + to_m) * R(0.5) / placed_.len_m[seg]);
+      const Real dist_m = mid.norm();
+      Real cos_inc = dist_m > 0 ? std::fabs(placed_.n[seg].dot(mid)) / dist_m : R(1);
+      cos_inc = cos_inc > kMinCosIncidence ? cos_inc : kMinCosIncidence;
+      const Real spacing_m = dist_m * angle_inc_rad_ / cos_inc;
+      const bool needed = to_m - from_m >= 2 * kStripeEdgeMarginM + 2 * spacing_m;
+      bool reads_tape = 2 * bright >= n;
+      if (!tape_expected && n > 0) {
+        if (bright >= 2 && 4 * bright > n) {
+          reads_tape = true;
+        } else if (4 * bright <= n) {
+          reads_tape = false;
+        } else {
+          n = 0;  // neither way: not read
+        }
+      }
+      if (n == 0) {
+        if (needed) ++f.regions_unread;
+        return;
+      }
       ++(reads_tape == tape_expected ? f.regions_matched : f.regions_mismatched);
       if (tape_expected && reads_tape) ++f.stripes_matched;
       if (tape_expected) f.stripe_beams = static_cast<std::uint16_t>(f.stripe_beams + n);
       f.bright_beams = static_cast<std::uint16_t>(f.bright_beams + bright);
     };
     for (std::size_t q = 0; q < profile_.reflector_count; ++q) {
-      read(stripe_n[q], stripe_bright[q], true);
-      read(gap_n[q], gap_bright[q], false);
-      read(after_n[q], after_bright[q], false);
+      const ReflectorStripe& st = profile_.reflectors[q];
+      const bool first_on_segment = q == 0 || profile_.reflectors[q - 1].segment != st.segment;
+      const bool last_on_segment =
+          q + 1 == profile_.reflector_count || profile_.reflectors[q + 1].segment != st.segment;
+      const Real gap_from = first_on_segment ? R(0) : profile_.reflectors[q - 1].to_m;
+      const Real seg_len = placed_.len_m[st.segment];
+      // Gaps shorter than a stripe may be (a stripe laid to a segment's end) are no regions.
+      if (st.from_m - gap_from >= kMinRegionM) read(gap_n[q], gap_bright[q], false, st.segment, gap_from, st.from_m);
+      read(stripe_n[q], stripe_bright[q], true, st.segment, st.from_m, st.to_m);
+      if (last_on_segment && seg_len - st.to_m >= kMinRegionM) {
+        read(after_n[q], after_bright[q], false, st.segment, st.to_m, seg_len);
+      }
     }
   }
   for (std::size_t j = 0; j < placed_.segments; ++j) {
@@ -830,7 +864,7 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     r.reject = RejectReason::kWeakEvidence;
   } else if (f.regions_mismatched > 0) {
     r.reject = RejectReason::kWrongCode;
-  } else if (read_stripes && f.stripes_matched == 0) {
+  } else if (read_stripes && (f.stripes_matched == 0 || f.regions_unread > 0)) {
     r.reject = RejectReason::kCodeUnread;
   }
   if (r.reject != RejectReason::kNone) return;

@@ -67,8 +67,9 @@ enum class RejectReason : std::uint8_t {
   /// A reflector dock whose stripe pattern reads otherwise than its profile's (another dock of this shape, or an
   /// untaped look-alike): a wrong dock id is worse than none. Only with usable intensity (docs/docks.md).
   kWrongCode,
-  /// A reflector dock none of whose stripes was read bright (too far for the stripes' width, or seen too obliquely):
-  /// the shape alone would take any dock of this shape. Only with usable intensity.
+  /// A reflector dock whose pattern was not read whole: a region with no beam well inside it (too far for the
+  /// regions' width, too oblique, hidden), a gap read neither way, or no stripe read bright. A pattern known in part
+  /// could be another dock's. Only with usable intensity.
   kCodeUnread,
   kCount,
 };
@@ -119,6 +120,9 @@ struct DecisionFeatures {
   std::uint8_t regions_matched = 0;
   std::uint8_t regions_mismatched = 0;
   std::uint8_t stripes_matched = 0;  ///< Of regions_matched: stripes that read bright.
+  /// Regions not read: no beam well inside them (too narrow for the range, or hidden), or a gap with one bright beam
+  /// among fewer than four (a glint, or another dock's stripe seen by one beam). Any refuses the code (kCodeUnread).
+  std::uint8_t regions_unread = 0;
   std::uint16_t stripe_beams = 0;
   std::uint16_t bright_beams = 0;
 };
