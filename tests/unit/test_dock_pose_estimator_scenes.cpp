@@ -12,11 +12,14 @@
 #include "docksim/lidar_sim.hpp"
 #include "docksim/scenes.hpp"
 
+#include "coded_docks.hpp"
 #include "real_tolerance.hpp"
 
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
+using dockcore_test::coded_plate;
+using dockcore_test::ld06;
 
 namespace {
 
@@ -27,14 +30,6 @@ LaserScan g_scan;
 struct Truth {
   Pose2 dock_in_lidar;
 };
-
-docksim::LidarModel ld06(double sigma_m) {
-  docksim::LidarModel m;
-  CHECK_TRUE(docksim::lidar_model("ld06", &m));
-  m.sigma_const_m = sigma_m;
-  m.sigma_prop = 0;
-  return m;
-}
 
 DockProfile profile(const char* name) {
   DockProfile p;
@@ -295,19 +290,6 @@ TEST(DockPoseEstimator, SmallCapacityOwnerGivesTheSameEstimate) {
 }
 
 namespace {
-
-/// plate-v with retro-reflective stripes on its 0.30 m face (segment 1), at [from, to] metres along it.
-DockProfile coded_plate(std::initializer_list<std::pair<double, double>> stripes) {
-  DockProfile p = profile("plate-v");
-  for (const auto& s : stripes) {
-    ReflectorStripe r;
-    r.segment = 1;
-    r.from_m = static_cast<Real>(s.first);
-    r.to_m = static_cast<Real>(s.second);
-    CHECK_EQUAL(static_cast<int>(ProfileError::kOk), static_cast<int>(add_reflector(p, r)));
-  }
-  return p;
-}
 
 double cue(const DockEstimate& e, EvidenceCue c) {
   return static_cast<double>(e.evidence.cue_nats[static_cast<std::size_t>(c)]);

@@ -163,6 +163,20 @@ struct Rig {
     }
     return false;
   }
+  /// Sends dock `dock_id` and runs until charging is confirmed (FINISH_TASKING) or max_s; true when it was, and then
+  /// *code_read says whether an ALIGN status said the dock's code was read.
+  bool dock_reading_code(std::uint16_t dock_id, double max_s, bool* code_read) {
+    host.command(1, dock_id);
+    char json[dockcore::drivers::kMaxHostReply];
+    *code_read = false;
+    return run_until(
+        [&] {
+          if (daemon->state() == TaskState::kAlign && daemon->status_json(json, sizeof json, clock.t) > 0)
+            *code_read = *code_read || std::strstr(json, "\"det_code\":\"read\"") != nullptr;
+          return daemon->state() == TaskState::kFinishTasking;
+        },
+        max_s);
+  }
   /// A UDP socket for requests to dockd's host link (a rig `with_udp`); `to` receives the link's address.
   int udp_client(sockaddr_in& to) const {
     to = sockaddr_in{};
@@ -283,17 +297,11 @@ TEST(DockdDaemon, DocksChargesAndUndocksInSimulation) {
 TEST(DockdDaemon, TheStatusSaysWhetherTheDocksCodeWasRead) {
   Rig r("code", false, 1.2, false, false, "two-docks.toml");
   CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
-  r.host.command(1, 0);  // dock at dock 0: plate-v-code-a
-  char json[dockcore::drivers::kMaxHostReply];
   bool read = false;
-  CHECK_TRUE(r.run_until(
-      [&] {
-        if (r.daemon->state() == TaskState::kAlign && r.daemon->status_json(json, sizeof json, r.clock.t) > 0)
-          read = read || std::strstr(json, "\"det_code\":\"read\"") != nullptr;
-        return r.daemon->state() == TaskState::kFinishTasking;
-      },
-      60.0));
+  CHECK_TRUE(r.dock_reading_code(0, 60.0, &read));  // dock 0: plate-v-code-a
   CHECK_TRUE(read);
+  char json[dockcore::drivers::kMaxHostReply];
+  CHECK(r.daemon->status_json(json, sizeof json, r.clock.t) > 0);
   CHECK_TRUE(r.chassis->state().charging);
   STRCMP_CONTAINS("\"lidar_intensity\":\"usable\"", json);
   Rig plain("code_plain");
@@ -789,21 +797,14 @@ TEST(DockdDaemon, TeachRecordsTheDocksCodeAndDockingsReadIt) {
   // Off the charger and back, to dock 3: the estimator reads the taught code.
   r.host.command(3, 0);
   CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kNotTasking; }, 40.0));
-  r.host.command(1, 3);
-  char json[dockcore::drivers::kMaxHostReply];
   bool read = false;
-  CHECK_TRUE(r.run_until(
-      [&] {
-        if (r.daemon->state() == TaskState::kAlign && r.daemon->status_json(json, sizeof json, r.clock.t) > 0)
-          read = read || std::strstr(json, "\"det_code\":\"read\"") != nullptr;
-        return r.daemon->state() == TaskState::kFinishTasking;
-      },
-      60.0));
+  CHECK_TRUE(r.dock_reading_code(3, 60.0, &read));
   CHECK_TRUE(read);
   CHECK_TRUE(r.chassis->state().charging);
 
   // A lidar whose intensity is flat (an RPLIDAR in express mode): teach records no code and says why.
   r.sc.lidar.intensity_output = docksim::IntensityOutput::kConstant;
+  char json[dockcore::drivers::kMaxHostReply];
   CHECK_TRUE(r.run_until(
       [&] {
         return r.daemon->status_json(json, sizeof json, r.clock.t) > 0 &&

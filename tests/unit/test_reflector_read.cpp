@@ -12,37 +12,19 @@
 #include "docksim/lidar_sim.hpp"
 #include "docksim/scenes.hpp"
 
+#include "coded_docks.hpp"
 #include "real_tolerance.hpp"
 
 #include <CppUTest/TestHarness.h>
 
 using namespace dockcore;
+using dockcore_test::coded_plate;
+using dockcore_test::ld06;
 using dockcore_test::pose;
 
 namespace {
 
 LaserScan g_scan;
-
-DockProfile coded_plate(std::initializer_list<std::pair<double, double>> stripes) {
-  DockProfile p;
-  CHECK_EQUAL(static_cast<int>(ProfileError::kOk), static_cast<int>(builtin_profile("plate-v", p)));
-  for (const auto& s : stripes) {
-    ReflectorStripe r;
-    r.segment = 1;
-    r.from_m = static_cast<Real>(s.first);
-    r.to_m = static_cast<Real>(s.second);
-    CHECK_EQUAL(static_cast<int>(ProfileError::kOk), static_cast<int>(add_reflector(p, r)));
-  }
-  return p;
-}
-
-docksim::LidarModel ld06(double sigma_m) {
-  docksim::LidarModel m;
-  CHECK_TRUE(docksim::lidar_model("ld06", &m));
-  m.sigma_const_m = sigma_m;
-  m.sigma_prop = 0;
-  return m;
-}
 
 /// Simulates `prof` with the robot at the world origin, its lidar at `mount`, the dock `dist` metres in front of the
 /// lidar at `bearing` and turned by `yaw`. Returns the dock's pose in the robot frame.
