@@ -692,3 +692,28 @@ TEST(LidarSim, TapeReadsSaturatedTheFaceDiffuseAndItsEdgesInBetween) {
   simulate_scan(w, Pose2{}, ideal_model("ld06"), rng, &s);
   for (std::size_t i = 0; i < s.count; ++i) CHECK(s.intensities[i] < 235);
 }
+
+// A segment's own retro cut-off (chrome): bright only within it of normal incidence, diffuse past it, while tape with
+// the model's cut-off stays bright at the same incidence.
+TEST(LidarSim, SegmentRetroCutoffOverridesTheModels) {
+  for (const double inc_deg : {0.0, 8.0, 25.0}) {
+    for (const bool chrome : {true, false}) {
+      World w;
+      Segment g;  // A 0.3 m board 1 m ahead, turned by inc_deg about its centre.
+      const double c = std::cos(inc_deg * kDeg), s = std::sin(inc_deg * kDeg);
+      g.a = Vec2(static_cast<Real>(1.0 - 0.15 * s), static_cast<Real>(-0.15 * c));
+      g.b = Vec2(static_cast<Real>(1.0 + 0.15 * s), static_cast<Real>(0.15 * c));
+      g.retro = true;
+      if (chrome) g.retro_cutoff_rad = 12 * kDeg;
+      w.segments.push_back(g);
+      LidarModel m = ideal_model("ld06");
+      Rng rng(1);
+      static dockcore::LaserScan scan;
+      simulate_scan(w, Pose2{}, m, rng, &scan);
+      const std::size_t centre = static_cast<std::size_t>(std::lround(-m.angle_min_rad / m.angle_increment_rad));
+      CHECK(scan.ranges_m[centre] > 0);
+      const bool bright = scan.intensities[centre] >= 255;
+      CHECK_EQUAL(!chrome || inc_deg < 12.0, bright);
+    }
+  }
+}
