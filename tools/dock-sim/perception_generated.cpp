@@ -645,7 +645,7 @@ json run_generated(const GeneratedOptions& o) {
   // False positives by look-alike.
   {
     json rows = json::array();
-    for (int k = 0; k < static_cast<int>(docksim::LookAlike::kCount); ++k) {
+    for (int k = 0; k < docksim::kPlainLookAlikes; ++k) {
       json row;
       row["look_alike"] = docksim::to_string(static_cast<docksim::LookAlike>(k));
       for (int c = 0; c < kCases; ++c) {

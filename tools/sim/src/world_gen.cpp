@@ -286,6 +286,164 @@ double different_width(Rng& rng, double width) {
   return width < 0.45 ? 0.7 : 0.2;
 }
 
+// A flat board `thickness` x `width` at `at` (its centre; world), its front face (+x in its frame) split where the
+// tape starts and ends: the parts within `tape` (intervals of y along the face, from -width/2) are retro.
+void add_taped_board(World* w, const Pose2& at, double thickness, double width, double refl,
+                     const std::vector<std::pair<double, double>>& tape) {
+  const double hx = 0.5 * thickness, hy = 0.5 * width;
+  auto seg = [&](double xa, double ya, double xb, double yb, bool retro) {
+    Segment g;
+    g.a = at.transform(v2(xa, ya));
+    g.b = at.transform(v2(xb, yb));
+    g.reflectivity = refl;
+    g.retro = retro;
+    w->segments.push_back(g);
+  };
+  seg(-hx, -hy, -hx, hy, false);
+  seg(-hx, hy, hx, hy, false);
+  seg(hx, -hy, -hx, -hy, false);
+  std::vector<double> cuts{-hy, hy};
+  for (const auto& t : tape) {
+    cuts.push_back(std::clamp(t.first, -hy, hy));
+    cuts.push_back(std::clamp(t.second, -hy, hy));
+  }
+  std::sort(cuts.begin(), cuts.end());
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+    if (cuts[i + 1] - cuts[i] < 1e-9) continue;
+    const double mid = 0.5 * (cuts[i] + cuts[i + 1]);
+    bool retro = false;
+    for (const auto& t : tape) retro = retro || (mid > t.first && mid < t.second);
+    seg(hx, cuts[i], hx, cuts[i + 1], retro);
+  }
+}
+
+// The tape intervals of a 3-region pattern over a face `width` wide centred on 0 (regions from -width/2).
+std::vector<std::pair<double, double>> pattern_tape(double width, int pattern) {
+  std::vector<std::pair<double, double>> t;
+  const double r = width / 3.0;
+  for (int k = 0; k < 3; ++k) {
+    if ((pattern >> k) & 1) t.emplace_back(-0.5 * width + k * r, -0.5 * width + (k + 1) * r);
+  }
+  return t;
+}
+
+// Draws one reflective object of `kind` (world_gen.hpp) and tries to place it beside the dock (box `db`, dock frame)
+// or, for a vest, in front of it; true and added when a free spot is found within kPlacementAttempts draws.
+bool place_reflective(ReflectiveClass kind, const Box& db, Rng& rng, FreeSpace* fs, World* w,
+                      std::vector<GenObject>* objects) {
+  constexpr double kBoardM = 0.02;
+  constexpr int kSides = 16;
+  Shape fit;  // Only its extents, for FreeSpace::ok.
+  double r = 0, a = 0, yaw = 0, cutoff = 0;
+  int bands = 0;
+  double band_c[2] = {}, band_w[2] = {};
+  std::vector<std::pair<double, double>> tape;
+  const double refl = rng.uniform(0.1, 0.9);
+  switch (kind) {
+    case ReflectiveClass::kVest:
+      r = rng.uniform(0.10, 0.20);
+      bands = uniform_int(rng, 1, 2);
+      for (int b = 0; b < bands; ++b) {
+        band_c[b] = sym(rng, kPiD);
+        band_w[b] = rng.uniform(40.0, 120.0) * kDegD;
+      }
+      fit.radius = r;
+      break;
+    case ReflectiveClass::kSign: {
+      a = rng.uniform(0.2, 0.6);
+      yaw = sym(rng, 5 * kDegD);
+      if (rng.bernoulli(0.5)) {
+        tape.emplace_back(-0.5 * a, 0.5 * a);
+      } else {
+        const double frac = rng.uniform(0.2, 1.0);
+        const double t0 = rng.uniform(0.0, 1.0 - frac);
+        tape.emplace_back(-0.5 * a + t0 * a, -0.5 * a + (t0 + frac) * a);
+      }
+      fit.radius = 0.5 * std::hypot(a, kBoardM);
+      break;
+    }
+    case ReflectiveClass::kChromeLegs:
+      a = rng.uniform(0.35, 0.50);
+      r = rng.uniform(0.010, 0.025);
+      yaw = sym(rng, kPiD);
+      cutoff = rng.uniform(10.0, 15.0) * kDegD;
+      fit.radius = 0.5 * std::hypot(a, a) + r;
+      break;
+    case ReflectiveClass::kGlassPane:
+      a = rng.uniform(0.3, 1.0);
+      yaw = sym(rng, 5 * kDegD);
+      fit.radius = 0.5 * std::hypot(a, kBoardM);
+      break;
+    default:
+      return false;
+  }
+  const bool flat = kind == ReflectiveClass::kSign || kind == ReflectiveClass::kGlassPane;
+  if (flat) {
+    const double c = std::fabs(std::cos(yaw)), sn = std::fabs(std::sin(yaw));
+    fit.half_x = 0.5 * (c * kBoardM + sn * a);
+    fit.half_y = 0.5 * (sn * kBoardM + c * a);
+  } else {
+    fit.half_x = fit.half_y = fit.radius;
+  }
+  for (int attempt = 0; attempt < kPlacementAttempts; ++attempt) {
+    Vec2 c;
+    if (kind == ReflectiveClass::kVest) {
+      c = v2(db.x1 + rng.uniform(0.3, 1.5), rng.uniform(db.y0 - 1.5, db.y1 + 1.5));
+    } else {
+      const int side = rng.bernoulli(0.5) ? 1 : -1;
+      const double gap = rng.uniform(0.2, 2.0);
+      const double y = side > 0 ? db.y1 + gap + fit.half_y : db.y0 - gap - fit.half_y;
+      const double base = fs->front_limit ? fs->front_x : db.x0;
+      c = v2(base + fit.half_x + 0.006 + (flat ? rng.uniform(0.0, 0.10) : rng.uniform(0.0, 0.8)), y);
+    }
+    if (!fs->ok(fit, c)) continue;
+    const Pose2 p = fs->dock.compose(pose(X(c), Y(c), yaw));
+    const Vec2 cw = fs->dock.transform(c);
+    const char* name = "";
+    switch (kind) {
+      case ReflectiveClass::kVest: {
+        const std::size_t first = w->segments.size();
+        w->add_circle(cw, r, kSides, refl);
+        for (int i = 0; i < kSides; ++i) {
+          const double mid = -2.0 * kPiD * (i + 0.5) / kSides;  // add_circle goes clockwise.
+          for (int b = 0; b < bands; ++b) {
+            if (std::fabs(std::remainder(mid - band_c[b], 2.0 * kPiD)) <= 0.5 * band_w[b])
+              w->segments[first + static_cast<std::size_t>(i)].retro = true;
+          }
+        }
+        name = "vest";
+        break;
+      }
+      case ReflectiveClass::kSign:
+        add_taped_board(w, p, kBoardM, a, refl, tape);
+        name = "sign";
+        break;
+      case ReflectiveClass::kChromeLegs:
+        for (int sx = -1; sx <= 1; sx += 2) {
+          for (int sy = -1; sy <= 1; sy += 2) {
+            const std::size_t first = w->segments.size();
+            w->add_circle(p.transform(v2(0.5 * sx * a, 0.5 * sy * a)), r, kSides, refl);
+            for (std::size_t k = first; k < w->segments.size(); ++k) {
+              w->segments[k].retro = true;
+              w->segments[k].retro_cutoff_rad = cutoff;
+            }
+          }
+        }
+        name = "chrome-legs";
+        break;
+      case ReflectiveClass::kGlassPane:
+        name = "glass-pane";  // No return: nothing for the lidar, only the place is taken.
+        break;
+      default:
+        break;
+    }
+    fs->taken.emplace_back(c, fit.radius);
+    objects->push_back(GenObject{name, cw, fit.radius});
+    return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 const char* to_string(MountClass c) {
@@ -342,10 +500,66 @@ const char* to_string(LookAlike c) {
       return "notch";
     case LookAlike::kOtherDock:
       return "other-dock";
+    case LookAlike::kOtherCode:
+      return "other-code";
+    case LookAlike::kUntaped:
+      return "untaped";
+    case LookAlike::kTapedBoard:
+      return "taped-board";
     default:
       break;
   }
   return "unknown";
+}
+
+const char* to_string(ReflectiveClass c) {
+  switch (c) {
+    case ReflectiveClass::kVest:
+      return "vest";
+    case ReflectiveClass::kSign:
+      return "sign";
+    case ReflectiveClass::kChromeLegs:
+      return "chrome-legs";
+    case ReflectiveClass::kGlassPane:
+      return "glass-pane";
+    default:
+      break;
+  }
+  return "unknown";
+}
+
+std::size_t longest_segment(const dockcore::DockProfile& profile, double* length_m) {
+  std::size_t best = 0;
+  double best_len = -1;
+  for (std::size_t i = 0; i + 1 < profile.vertex_count; ++i) {
+    const double len = static_cast<double>((profile.vertices_m[i + 1] - profile.vertices_m[i]).norm());
+    if (len > best_len) {
+      best_len = len;
+      best = i;
+    }
+  }
+  if (length_m) *length_m = std::max(0.0, best_len);
+  return best;
+}
+
+bool add_code(dockcore::DockProfile* profile, std::size_t segment, double region_m, int pattern) {
+  profile->reflector_count = 0;
+  if (segment + 1 >= profile->vertex_count) return false;
+  const double len = static_cast<double>((profile->vertices_m[segment + 1] - profile->vertices_m[segment]).norm());
+  const double start = 0.5 * (len - 3 * region_m);
+  if (start < -1e-9 || region_m <= 0) return false;
+  for (int k = 0; k < 3; ++k) {
+    if (!((pattern >> k) & 1)) continue;
+    dockcore::ReflectorStripe st;
+    st.segment = static_cast<std::uint8_t>(segment);
+    st.from_m = static_cast<Real>(std::max(0.0, start + k * region_m));
+    st.to_m = static_cast<Real>(std::min(len, start + (k + 1) * region_m));
+    if (dockcore::add_reflector(*profile, st) != dockcore::ProfileError::kOk) {
+      profile->reflector_count = 0;
+      return false;
+    }
+  }
+  return true;
 }
 
 Pose2 GenScene::lidar_in_world(std::size_t k) const {
@@ -445,6 +659,19 @@ GenScene WorldGenerator::draw(std::uint64_t index, bool with_dock, ScenePath pat
   }
   s.profile.mounting = dockcore::DockMounting{};
   const Box db = bounds(s.profile);
+  if (P.reflectors) {
+    s.profile.reflector_count = 0;
+    double len = 0;
+    const std::size_t seg = longest_segment(s.profile, &len);
+    const double region = P.code_region_m > 0 ? P.code_region_m : len / 3.0;
+    const bool fits = P.code_region_m > 0 ? 3 * region <= len + 1e-9 : len >= kCodeMinSegmentM;
+    const int pattern = uniform_int(rng, kCodePatternMin, kCodePatternMax);
+    if (fits && add_code(&s.profile, seg, region, pattern)) {
+      s.code_pattern = pattern;
+      s.code_segment = static_cast<int>(seg);
+      s.code_region_m = region;
+    }
+  }
 
   // Lidar and its noise.
   const std::string& lname =
@@ -550,7 +777,8 @@ GenScene WorldGenerator::draw(std::uint64_t index, bool with_dock, ScenePath pat
     s.objects.push_back(GenObject{"dock", dock.transform(v2(0.5 * (db.x0 + db.x1), 0.5 * (db.y0 + db.y1))),
                                   0.5 * std::hypot(db.x1 - db.x0, db.y1 - db.y0)});
   } else {
-    s.look_alike = static_cast<LookAlike>(uniform_int(rng, 0, static_cast<int>(LookAlike::kCount) - 1));
+    const int kinds = P.reflectors ? static_cast<int>(LookAlike::kCount) : kPlainLookAlikes;
+    s.look_alike = static_cast<LookAlike>(uniform_int(rng, 0, kinds - 1));
     const double refl = rng.uniform(0.5, 0.95);
     const double width = static_cast<double>(s.profile.width_m());
     double lw = different_width(rng, width);
@@ -591,6 +819,26 @@ GenScene WorldGenerator::draw(std::uint64_t index, bool with_dock, ScenePath pat
         ldepth = ob.x1 - ob.x0;
         break;
       }
+      case LookAlike::kOtherCode:
+      case LookAlike::kUntaped: {
+        dockcore::DockProfile same = s.profile;
+        same.reflector_count = 0;
+        if (s.look_alike == LookAlike::kOtherCode && s.code_pattern != 0) {
+          int p = uniform_int(rng, kCodePatternMin, kCodePatternMax - 1);  // One of the 5 others.
+          if (p >= s.code_pattern) ++p;
+          s.look_alike_pattern = p;
+          add_code(&same, static_cast<std::size_t>(s.code_segment), s.code_region_m, p);
+        }
+        s.world.add_dock(same, dock, refl);
+        lw = db.y1 - db.y0;
+        ldepth = db.x1 - db.x0;
+        break;
+      }
+      case LookAlike::kTapedBoard:
+        s.look_alike_pattern = uniform_int(rng, kCodePatternMin, kCodePatternMax);
+        add_taped_board(&s.world, dock.compose(pose(db.x0 + 0.01, 0, 0)), 0.02, lw, refl,
+                        pattern_tape(lw, s.look_alike_pattern));
+        break;
       default:
         lw = 0;
         break;
@@ -693,6 +941,13 @@ GenScene WorldGenerator::draw(std::uint64_t index, bool with_dock, ScenePath pat
     const Shape sh = draw_shape(k, rng);
     ++s.clutter_wanted;
     if (place(sh, db, rng, &fs, &s.world, &s.objects)) ++s.clutter_placed;
+  }
+  if (P.reflectors) {
+    s.reflective_wanted = uniform_int(rng, 0, 3);
+    for (int i = 0; i < s.reflective_wanted; ++i) {
+      const auto k = static_cast<ReflectiveClass>(uniform_int(rng, 0, static_cast<int>(ReflectiveClass::kCount) - 1));
+      if (place_reflective(k, db, rng, &fs, &s.world, &s.objects)) s.reflective.push_back(k);
+    }
   }
   return s;
 }

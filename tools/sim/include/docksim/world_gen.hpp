@@ -34,6 +34,27 @@
 // 0.05-0.15 m/s, turning ±0.1 rad/s.
 // Dock-less scenes (with_dock = false) are drawn exactly like docking scenes, then the dock is left out and a
 // look-alike (LookAlike) put where it stood.
+//
+// Reflector mode (WorldGenParams::reflectors; off by default, and off every draw is bit for bit what it was without
+// the mode). Everything above still holds, the lidars being whatever WorldGenParams::lidars lists (the reflector
+// benchmark lists `ld06` only), and:
+//  - tape code: the profile's longest segment, if >= 0.18 m (or >= 3 x code_region_m when that is set), gets three
+//    equal regions (each a third of it, or code_region_m wide centred on it) and a pattern drawn uniformly among the
+//    6 with at least one stripe and one gap (bit k = region k from the segment's first vertex taped; each taped region
+//    is a stripe of its own). The profile the detector is told carries the stripes; the dock in the world is taped
+//    the same. A profile without such a segment gets no code (code_pattern 0);
+//  - reflective clutter after the other clutter: 0-3 objects (uniform), each equally likely one of: a safety vest (a
+//    person's torso, a 16-sided circle r 0.10-0.20 m, 0.3-1.5 m in front of the dock's face and up to 1.5 m beside
+//    it, with 1-2 retro bands: arcs of 40-120° of its circumference, centred anywhere); a sign (a board 2 cm thick,
+//    0.2-0.6 m wide, on the wall or up to 10 cm in front of it (level with the dock's back where there is no wall),
+//    yaw ±5°, 0.2-2.0 m beside the dock, taped over all its face (probability 1/2) or over 20-100 % of it at a random
+//    offset); chrome legs (a stool or chair: four 16-sided legs r 1.0-2.5 cm on a 0.35-0.50 m square, 0.2-2.0 m
+//    beside the dock and 0-0.8 m out from the wall, retro with an incidence cutoff of 10-15°,
+//    Segment::retro_cutoff_rad: bright only where a leg's facet faces the lidar); a glass pane (0.3-1.0 m, placed like
+//    a sign: no return, so only its place is taken). As other clutter, never in the line of sight to the dock;
+//  - dock-less scenes draw among all LookAlike kinds, the three tape ones included: the same shape with another of
+//    the 5 other patterns, the same shape untaped, and a taped board (a 2 cm board as kBoard, its face in three equal
+//    regions with one of the 6 patterns).
 // Host-side: std::vector and std::string are used freely.
 #include <cstdint>
 #include <string>
@@ -80,8 +101,28 @@ enum class LookAlike : std::uint8_t {
   kBox,        ///< A box filling the dock's bounding box.
   kNotch,      ///< A 90° V notch (two boards) opening towards the lidar, apex at the back plane.
   kOtherDock,  ///< Another profile (built-in or random).
+  // Reflector mode only (WorldGenParams::reflectors):
+  kOtherCode,   ///< The dock's own shape taped with another code pattern (a dock of the fleet with another id).
+  kUntaped,     ///< The dock's own shape without tape.
+  kTapedBoard,  ///< A board as kBoard whose face carries a 3-region stripe pattern.
   kCount,
 };
+/// Look-alikes drawn outside reflector mode: kNothing .. kOtherDock.
+constexpr int kPlainLookAlikes = static_cast<int>(LookAlike::kOtherDock) + 1;
+
+/// Reflective clutter (reflector mode), see the file comment.
+enum class ReflectiveClass : std::uint8_t {
+  kVest,        ///< A torso with 1-2 retro bands.
+  kSign,        ///< A board on or near the wall, partly or wholly taped.
+  kChromeLegs,  ///< Four chrome legs: retro within 10-15° of normal incidence.
+  kGlassPane,   ///< No return.
+  kCount,
+};
+
+/// Smallest segment a 3-region code is put on when the regions are a third of it, m.
+constexpr double kCodeMinSegmentM = 0.18;
+/// Code patterns: bit k set = region k taped. Valid codes have at least one stripe and one gap: 1..6.
+constexpr int kCodePatternMin = 1, kCodePatternMax = 6;
 /// For board, box and notch the width is 0.2-0.7 m but at least 20 % away from the configured dock's width, and the
 /// other dock's width is too, so a look-alike is never an exact copy of the dock the detector is told about.
 
@@ -89,6 +130,7 @@ enum class LookAlike : std::uint8_t {
 const char* to_string(MountClass c);
 const char* to_string(ClutterClass c);
 const char* to_string(LookAlike c);
+const char* to_string(ReflectiveClass c);
 
 /// Which robot poses a scene is seen from (see the file comment).
 enum class ScenePath : std::uint8_t { kSingle, kConfirm, kApproach };
@@ -109,6 +151,11 @@ struct WorldGenParams {
   double sigma_prop_max = 0.005;                                           ///< σ_p, per metre of range.
   double dropout_max = 0.10;
   double gap_max_m = 0.10;  ///< kGap and kCorner wall gap.
+  /// Reflector mode (file comment): a tape code on the dock, reflective clutter, the tape look-alikes. Off: draws are
+  /// exactly those without the mode.
+  bool reflectors = false;
+  /// Reflector mode: each code region's width, m (the longest segment must hold three); 0 = a third of the segment.
+  double code_region_m = 0;
 };
 
 /// One object of a generated world, for reports and tests: what it is and a circle containing it.
@@ -143,6 +190,13 @@ struct GenScene {
   int clutter_wanted = 0;                      ///< Objects drawn.
   int clutter_placed = 0;                      ///< Of which placed (the rest found no free spot and were left out).
   LookAlike look_alike = LookAlike::kNothing;  ///< Dock-less scenes only.
+  // --- reflector mode
+  int code_pattern = 0;        ///< The dock's code (bit k = region k taped), 0 = none (mode off or no segment for it).
+  int code_segment = -1;       ///< The taped segment, -1 = none.
+  double code_region_m = 0;    ///< Width of each region, m.
+  int look_alike_pattern = 0;  ///< kOtherCode, kTapedBoard: the look-alike's pattern.
+  int reflective_wanted = 0;   ///< Reflective objects drawn.
+  std::vector<ReflectiveClass> reflective;  ///< Of which placed.
   // --- lidar
   LidarModel lidar;  ///< With the drawn noise, dropouts and mixed pixels.
   // --- poses
@@ -173,6 +227,14 @@ struct GenScene {
 /// contacts) is on the outline at y = 0, at the middle of the width (the front end of a step there). `name` is
 /// copied (truncated to the profile's 23 characters). Deterministic for the Rng's state; O(attempts · vertices).
 dockcore::DockProfile random_profile(Rng& rng, const char* name);
+
+/// The profile's longest segment (index; its length in *length_m when not null); the first of equals. O(vertices).
+std::size_t longest_segment(const dockcore::DockProfile& profile, double* length_m);
+
+/// Tapes a 3-region code on `segment`: regions `region_m` wide centred on the segment, region k (k = 0 nearest the
+/// segment's first vertex) a stripe of its own when bit k of `pattern` is set. Replaces any stripes the profile had.
+/// False (stripes cleared) when the three regions do not fit on the segment or add_reflector refuses one. O(1).
+bool add_code(dockcore::DockProfile* profile, std::size_t segment, double region_m, int pattern);
 
 /// Draws scenes. Construct once per seed; draw() is const and thread-safe.
 class WorldGenerator {
