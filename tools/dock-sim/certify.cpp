@@ -231,27 +231,6 @@ std::string toml_text(const toml::table& t) {
   return os.str();
 }
 
-/// log of the binomial probability of k successes in n trials at success rate p (0 < p < 1).
-double log_binom(int n, int k, double p) {
-  return std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) + k * std::log(p) +
-         (n - k) * std::log1p(-p);
-}
-
-/// One-sided lower confidence bound on the success rate (Clopper–Pearson): the p at which k or more successes in n
-/// have probability alpha. 0 when k is 0. Bisection to 1e-9.
-double clopper_pearson_lower(int n, int k, double alpha) {
-  if (k <= 0) return 0;
-  if (k >= n) return std::pow(alpha, 1.0 / n);
-  double lo = 0, hi = 1;
-  for (int it = 0; it < 80; ++it) {
-    const double p = 0.5 * (lo + hi);
-    double tail = 0;
-    for (int i = k; i <= n; ++i) tail += std::exp(log_binom(n, i, p));
-    (tail > alpha ? hi : lo) = p;
-  }
-  return 0.5 * (lo + hi);
-}
-
 /// Why a run did not confirm charging: its fault's name, "timeout", or the state it ended in.
 std::string cause_of(const docksim::SimRun& r) {
   const auto& o = r.outcome;

@@ -29,6 +29,33 @@ double pct(std::vector<double> v, double p) {
   return v[k - 1];
 }
 
+namespace {
+// log of the binomial probability of k successes in n trials at success rate p (0 < p < 1).
+double log_binom(int n, int k, double p) {
+  return std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) + k * std::log(p) +
+         (n - k) * std::log1p(-p);
+}
+}  // namespace
+
+double clopper_pearson_lower(int n, int k, double alpha) {
+  if (k <= 0) return 0;
+  if (k >= n) return std::pow(alpha, 1.0 / n);
+  double lo = 0, hi = 1;
+  for (int it = 0; it < 80; ++it) {
+    const double p = 0.5 * (lo + hi);
+    double tail = 0;
+    for (int i = k; i <= n; ++i) tail += std::exp(log_binom(n, i, p));
+    (tail > alpha ? hi : lo) = p;
+  }
+  return 0.5 * (lo + hi);
+}
+
+double clopper_pearson_upper(int n, int k, double alpha) {
+  if (n <= 0) return 1;
+  // k or fewer hits at rate p is n - k or more misses at rate 1 - p.
+  return 1.0 - clopper_pearson_lower(n, n - k, alpha);
+}
+
 Summary summarise(const std::string& name, const std::vector<docksim::SimRun>& runs) {
   Summary s;
   s.name = name;

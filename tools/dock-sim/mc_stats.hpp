@@ -18,6 +18,13 @@ std::string fmt(const char* f, double v);
 /// Nearest-rank percentile p (0-100) of v; NaN for an empty v. O(n log n).
 double pct(std::vector<double> v, double p);
 
+/// One-sided lower confidence bound on a success rate (Clopper–Pearson) from k successes in n trials: the p at which
+/// k or more successes have probability alpha. 0 when k is 0. Bisection to 1e-9: O(80 (n - k)).
+double clopper_pearson_lower(int n, int k, double alpha);
+/// One-sided upper confidence bound on a rate from k hits in n trials (Clopper–Pearson): the p at which k or fewer
+/// hits have probability alpha; 1 - alpha^(1/n) (about 3/n at alpha 0.05) when k is 0, 1 when n is 0. O(80 k).
+double clopper_pearson_upper(int n, int k, double alpha);
+
 /// Outcome statistics of a set of runs of one controller. Errors and times are over the runs that confirmed charging.
 struct Summary {
   std::string name;

@@ -3,15 +3,11 @@
 // printed, never asserted. See docs/performance.md ("Generalisation over generated worlds").
 #include "perception_generated.hpp"
 
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "dockcore/perception/dock_pose_estimator.hpp"
@@ -20,32 +16,23 @@
 #include "docksim/crlb.hpp"
 #include "docksim/sim_run.hpp"
 #include "docksim/world_gen.hpp"
+#include "perception_gen_common.hpp"
 #include "perception_stats.hpp"
 
 namespace docksim_cli {
+
+using namespace genbench;
+
 namespace {
 
 using dockcore::Pose2;
 using dockcore::Real;
 using json = nlohmann::ordered_json;
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
 // The two ways the estimator is configured: the profile's mounting as the world has it, and left unknown.
 constexpr int kCases = 2;
 const char* const kCaseNames[kCases] = {"told", "unknown"};
-// Target envelope.
-constexpr double kEnvDistanceM = 2.0;
-constexpr double kEnvBearingRad = 45 * kDeg;
-constexpr double kEnvYawRad = 30 * kDeg;
-// A detection is of the dock when it lies this close to the truth (sensor frame); farther it is a wrong detection.
-constexpr double kCorrectPosM = 0.10;
-constexpr double kCorrectYawRad = 10 * kDeg;
-// Three detections on a dock-less scene confirm (a false positive) when each lies this close to the first, world frame.
-constexpr double kAgreePosM = 0.05;
-constexpr double kAgreeYawRad = 5 * kDeg;
-constexpr int kConfirmScans = 3;
 constexpr int kApproachScans = 10;
-constexpr std::uint64_t kScanPeriodUs = 100000;
 // Odometry between scans of a filtered approach: 1 % scale error, 0.5 mm lateral and 0.1° per step (1 σ).
 constexpr double kOdomScaleSigma = 0.01, kOdomLateralSigmaM = 0.0005, kOdomYawSigmaRad = 0.1 * kDeg;
 // Bins with fewer in-envelope scenes than this are not used to pick the worst bin of a target.
@@ -54,7 +41,6 @@ constexpr int kMinBinScenes = 20;
 enum Factor { kProfile, kMounting, kClutter, kLidar, kNoise, kRange, kBearing, kDockYaw, kFactorCount };
 const char* const kFactorNames[kFactorCount] = {"profile", "mounting", "clutter", "lidar",
                                                 "noise",   "range",    "bearing", "dock-yaw"};
-const double kRangeEdges[] = {0.3, 0.6, 1.0, 1.5, 2.0, 2.5};
 const double kBearingEdgesDeg[] = {0, 15, 30, 45, 60};
 const double kYawEdgesDeg[] = {0, 15, 30, 45};
 
@@ -103,13 +89,6 @@ std::vector<std::string> bin_names(Factor f, const docksim::WorldGenParams& p) {
       break;
   }
   return out;
-}
-
-int edge_bin(double v, const double* edges, int bins) {
-  for (int i = 0; i < bins - 1; ++i) {
-    if (v < edges[i + 1]) return i;
-  }
-  return bins - 1;
 }
 
 // Range noise at the dock, the figure the noise bins and the σ rows of the targets use.
@@ -170,39 +149,12 @@ dockcore::EstimatorParams params_for_case(const docksim::GenScene& s, int /*c*/)
   return dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0)));
 }
 
-/// Why the scene's profile is left out of the figures ("" when it is not): check_profile for the scene's lidar and
-/// the estimator's range, with the pose component when it names one.
-std::string exclusion(const dockcore::DockProfile& profile, double beam_spacing_rad, double max_range_m) {
-  const dockcore::ProfileCheck c =
-      dockcore::check_profile(profile, static_cast<Real>(beam_spacing_rad), static_cast<Real>(max_range_m));
-  if (c.reason == dockcore::ProfileCheckReason::kOk) return "";
-  std::string r = dockcore::to_string(c.reason);
-  if (c.component != dockcore::PoseComponent::kNone) r += std::string(" (") + dockcore::to_string(c.component) + ")";
-  return r;
-}
-
 struct Outcome {
   bool found = false, correct = false;
   Errors sensor, robot;
   double lat_over_crlb = std::nan("");
   std::string miss;  // when not a correct detection: why (miss_cause)
 };
-
-/// Why a docking scene's dock was not detected, from the estimate: what the best refused candidate was refused for,
-/// whether it lay at the dock (the right pose refused) or elsewhere (the dock never became a candidate that was
-/// refined to it), or that another pose was accepted.
-std::string miss_cause(const dockcore::DockEstimate& e, const Pose2& truth_sensor, const Pose2& mount_inv) {
-  if (e.found) return "found elsewhere";
-  if (e.status != dockcore::EstimateStatus::kNotVerified) return dockcore::to_string(e.status);
-  const Errors d = errors_of(truth_sensor, mount_inv.compose(e.refused_pose));
-  const bool at_dock = d.pos_m <= kCorrectPosM && d.yaw_rad <= kCorrectYawRad;
-  std::string r = std::string(at_dock ? "at dock: " : "elsewhere: ") + dockcore::to_string(e.reject);
-  if (at_dock && e.reject == dockcore::RejectReason::kWeakEvidence) {
-    const dockcore::EvidenceCue w = e.evidence.weakest();
-    if (w != dockcore::EvidenceCue::kCount) r += std::string(", weakest ") + dockcore::to_string(w);
-  }
-  return r;
-}
 
 struct DockRecord {
   std::string excluded;
@@ -229,24 +181,11 @@ struct FilterRecord {
   Errors sensor[kCases];
 };
 
-std::uint64_t scan_seed(std::uint64_t seed, std::uint64_t stream, std::uint64_t index) {
-  return docksim::trial_seed(docksim::seed_stream(seed, 0x5343414e00ull /* "SCAN" */ + stream), index);
+/// The worker's estimator c for case c.
+void configure(Worker& w, const docksim::GenScene& s) {
+  for (int c = 0; c < kCases; ++c)
+    w.est[static_cast<std::size_t>(c)]->configure(profile_for_case(s, c), params_for_case(s, c));
 }
-
-/// One thread's estimators and scan buffer (the estimator is ~260 KiB: heap, one per case).
-struct Worker {
-  std::unique_ptr<dockcore::DockPoseEstimator> est[kCases];
-  std::unique_ptr<dockcore::LaserScan> scan = std::make_unique<dockcore::LaserScan>();
-  Worker() {
-    for (auto& e : est) e = std::make_unique<dockcore::DockPoseEstimator>();
-  }
-  void configure(const docksim::GenScene& s) {
-    for (int c = 0; c < kCases; ++c) est[c]->configure(profile_for_case(s, c), params_for_case(s, c));
-  }
-  void simulate(const docksim::GenScene& s, std::size_t k, docksim::Rng& rng, std::uint64_t stamp_us) {
-    docksim::simulate_scan(s.world, s.lidar_in_world(k), s.lidar, rng, scan.get(), stamp_us);
-  }
-};
 
 double max_range_for(const docksim::GenScene& s) {
   return static_cast<double>(params_for_case(s, 1).max_range_m);
@@ -276,16 +215,16 @@ DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
                                                       s.lidar.angle_increment_rad, beams, sigma_at_dock(s), 0);
   // Dropped beams carry no information: the bound's σ grows by 1/sqrt(1 - dropout).
   const double crlb_lat = bound.ok ? bound.sigma_lateral_m / std::sqrt(1.0 - s.lidar.dropout_prob) : std::nan("");
-  w.configure(s);
+  configure(w, s);
   const Pose2 mount_inv = s.lidar_mount.inverse();
   for (int c = 0; c < kCases; ++c) {
-    const dockcore::DockEstimate e = w.est[c]->estimate(w.scan->view(), s.lidar_mount);
+    const dockcore::DockEstimate e = w.est[static_cast<std::size_t>(c)]->estimate(w.scan->view(), s.lidar_mount);
     Outcome& o = r.c[c];
     o.found = e.found;
     if (e.found) {
       o.sensor = errors_of(truth_sensor, mount_inv.compose(e.pose));
       o.robot = errors_of(truth_robot, e.pose);
-      o.correct = o.sensor.pos_m <= kCorrectPosM && o.sensor.yaw_rad <= kCorrectYawRad;
+      o.correct = is_correct(o.sensor);
       if (crlb_lat > 0) o.lat_over_crlb = o.sensor.lat_m / crlb_lat;
     }
     if (!o.correct) o.miss = miss_cause(e, truth_sensor, mount_inv);
@@ -300,30 +239,20 @@ FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
   r.look_alike = static_cast<int>(s.look_alike);
   r.excluded = exclusion(s.profile, s.lidar.angle_increment_rad, max_range_for(s));
   if (!r.excluded.empty()) return r;
-  w.configure(s);
+  configure(w, s);
   docksim::Rng rng(scan_seed(g.seed(), 1, i));
-  Pose2 first[kCases];
-  bool agree[kCases] = {true, true};
+  Confirmation conf[kCases];
   for (int k = 0; k < kConfirmScans; ++k) {
     w.simulate(s, static_cast<std::size_t>(k), rng, static_cast<std::uint64_t>(k) * kScanPeriodUs);
     for (int c = 0; c < kCases; ++c) {
-      const dockcore::DockEstimate e = w.est[c]->estimate(w.scan->view(), s.lidar_mount);
-      if (!e.found) {
-        agree[c] = false;
-        continue;
-      }
-      ++r.hits[c];
-      // The robot's odometry is exact here: the detections are compared where they put the dock in the world.
-      const Pose2 in_world = s.robot_path[static_cast<std::size_t>(k)].compose(e.pose);
-      if (k == 0) {
-        first[c] = in_world;
-      } else {
-        const Errors d = errors_of(first[c], in_world);
-        if (d.pos_m > kAgreePosM || d.yaw_rad > kAgreeYawRad) agree[c] = false;
-      }
+      const dockcore::DockEstimate e = w.est[static_cast<std::size_t>(c)]->estimate(w.scan->view(), s.lidar_mount);
+      conf[c].add(k, e, s.robot_path[static_cast<std::size_t>(k)]);
     }
   }
-  for (int c = 0; c < kCases; ++c) r.confirmed[c] = agree[c] && r.hits[c] == kConfirmScans;
+  for (int c = 0; c < kCases; ++c) {
+    r.hits[c] = conf[c].hits;
+    r.confirmed[c] = conf[c].confirmed();
+  }
   return r;
 }
 
@@ -333,7 +262,7 @@ FilterRecord run_filter(const docksim::WorldGenerator& g, std::uint64_t i, Worke
   r.noise = noise_class(s);
   r.excluded = exclusion(s.profile, s.lidar.angle_increment_rad, max_range_for(s));
   if (!r.excluded.empty()) return r;
-  w.configure(s);
+  configure(w, s);
   docksim::Rng rng(scan_seed(g.seed(), 2, i));
   dockcore::DockPoseFilter filter[kCases];
   Pose2 odom{};
@@ -350,7 +279,8 @@ FilterRecord run_filter(const docksim::WorldGenerator& g, std::uint64_t i, Worke
     for (int c = 0; c < kCases; ++c) {
       const bool have = filter[c].initialised();
       const Pose2 hint = have ? filter[c].dock_in_robot(odom) : Pose2{};
-      const dockcore::DockEstimate e = w.est[c]->estimate(w.scan->view(), s.lidar_mount, have ? &hint : nullptr);
+      const dockcore::DockEstimate e =
+          w.est[static_cast<std::size_t>(c)]->estimate(w.scan->view(), s.lidar_mount, have ? &hint : nullptr);
       if (e.found) {
         filter[c].update(e.pose, e.covariance, odom, stamp);
       } else {
@@ -368,17 +298,6 @@ FilterRecord run_filter(const docksim::WorldGenerator& g, std::uint64_t i, Worke
 }
 
 // ---------------------------------------------------------------- aggregation
-
-struct Rate {
-  int n = 0, k = 0;
-  void add(bool hit) {
-    ++n;
-    k += hit ? 1 : 0;
-  }
-  json to_json() const {
-    return json{{"n", n}, {"hits", k}, {"rate", n ? json(static_cast<double>(k) / n) : json(nullptr)}};
-  }
-};
 
 json maybe(double v, double scale, double digits) {
   if (std::isnan(v)) return nullptr;
@@ -445,7 +364,7 @@ json rate_cell(const std::vector<const Errors*>& errs, int n) {
   for (const Errors* e : errs) {
     pos.push_back(e->pos_m);
     yaw.push_back(e->yaw_rad);
-    wrong += e->pos_m > kCorrectPosM || e->yaw_rad > kCorrectYawRad ? 1 : 0;
+    wrong += is_correct(*e) ? 0 : 1;
   }
   return json{{"n", n},
               {"found_rate", n ? json(static_cast<double>(errs.size()) / n) : json(nullptr)},
@@ -522,35 +441,15 @@ json run_generated(const GeneratedOptions& o) {
   std::vector<FreeRecord> frees(n_free);
   std::vector<FilterRecord> filters(n_filter);
 
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::size_t total = n_dock + n_free + n_filter;
-  std::atomic<std::size_t> next{0}, done{0};
-  std::mutex progress;
-  auto work = [&]() {
-    Worker w;
-    for (;;) {
-      const std::size_t i = next.fetch_add(1);
-      if (i >= total) return;
-      if (i < n_dock) {
-        docks[i] = run_dock(gen, i, w);
-      } else if (i < n_dock + n_free) {
-        frees[i - n_dock] = run_free(gen, i - n_dock, w);
-      } else {
-        filters[i - n_dock - n_free] = run_filter(gen, i - n_dock - n_free, w);
-      }
-      const std::size_t d = done.fetch_add(1) + 1;
-      if (d % 200 == 0 || d == total) {
-        std::lock_guard<std::mutex> lock(progress);
-        std::fprintf(stderr, "\rgenerated worlds %7zu / %zu", d, total);
-        if (d == total) std::fprintf(stderr, "\n");
-      }
+  run_scenes(n_dock + n_free + n_filter, o.jobs, kCases, "generated worlds", [&](std::size_t i, Worker& w) {
+    if (i < n_dock) {
+      docks[i] = run_dock(gen, i, w);
+    } else if (i < n_dock + n_free) {
+      frees[i - n_dock] = run_free(gen, i - n_dock, w);
+    } else {
+      filters[i - n_dock - n_free] = run_filter(gen, i - n_dock - n_free, w);
     }
-  };
-  std::vector<std::thread> pool;
-  for (int j = 0; j < std::max(1, o.jobs); ++j) pool.emplace_back(work);
-  for (auto& th : pool) th.join();
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::fprintf(stderr, "generated worlds: %zu scenes in %.1f s with %d threads\n", total, seconds, std::max(1, o.jobs));
+  });
 
   json out;
   out["config"] = {{"seed", o.seed},
@@ -729,49 +628,6 @@ json run_generated(const GeneratedOptions& o) {
 // ---------------------------------------------------------------- printing
 
 namespace {
-
-// Pads to `width` display columns (UTF-8 aware: σ, ≤ and ° are one column, several bytes); right-aligned if right.
-std::string pad(const std::string& s, std::size_t width, bool right = false) {
-  std::size_t cols = 0;
-  for (const unsigned char ch : s) cols += (ch & 0xC0) != 0x80 ? 1 : 0;
-  if (cols >= width) return s;
-  const std::string fill(width - cols, ' ');
-  return right ? fill + s : s + fill;
-}
-std::string fmt(const json& v, const char* f, double scale = 1) {
-  if (v.is_null()) return "-";
-  char buf[48];
-  std::snprintf(buf, sizeof buf, f, scale * v.get<double>());
-  return buf;
-}
-std::string pct(const json& v, const char* f = "%.1f %%") {
-  return fmt(v, f, 100);
-}
-std::string rate_n(const json& r, const char* f = "%.1f %%") {
-  return pct(r["rate"], f) + " (" + std::to_string(r["n"].get<int>()) + ")";
-}
-
-struct Column {
-  const char* title;
-  std::size_t width;
-  bool right;
-};
-
-void print_row(const std::vector<Column>& cols, const std::vector<std::string>& cells) {
-  std::string line;
-  for (std::size_t i = 0; i < cols.size(); ++i) {
-    if (i > 0) line += ' ';
-    line += pad(cells[i], cols[i].width, cols[i].right);
-  }
-  while (!line.empty() && line.back() == ' ') line.pop_back();
-  std::printf("%s\n", line.c_str());
-}
-
-void print_header(const std::vector<Column>& cols) {
-  std::vector<std::string> t;
-  for (const Column& c : cols) t.emplace_back(c.title);
-  print_row(cols, t);
-}
 
 const std::vector<Column> kFactorColumns = {
     {"bin", 20, false},           {"case", 7, false},        {"scenes", 6, true},          {"det σ≤10 (n)", 15, true},
