@@ -462,6 +462,15 @@ TEST(WorldGen, ReflectorModeTapesTheLongestSegmentWithAValidCode) {
     bool retro = false;  // The world's dock is taped as the profile says.
     for (const Segment& w : s.world.segments) retro = retro || (w.retro && w.retro_cutoff_rad < 0);
     CHECK_TRUE(retro);
+    // No other surface lies on a stripe (a wall flush with a face in its plane would hide the tape from the rays).
+    for (std::size_t k = 0; k < s.profile.reflector_count; ++k) {
+      const dockcore::ReflectorStripe& r = s.profile.reflectors[k];
+      const Vec2 va = s.profile.vertices_m[r.segment], vb = s.profile.vertices_m[r.segment + 1];
+      const Real u = static_cast<Real>(0.5) * (r.from_m + r.to_m) / (vb - va).norm();
+      const Vec2 mid = s.dock_in_world.transform(va + u * (vb - va));
+      for (const Segment& w : s.world.segments)
+        if (!w.retro) CHECK_TRUE(dist_to_segment(mid, w.a, w.b) > 1e-6);
+    }
   }
   LONGS_EQUAL(6, static_cast<long>(patterns.size()));
   CHECK_TRUE(coded > 100 && uncoded > 0);

@@ -773,13 +773,14 @@ GenScene WorldGenerator::draw(std::uint64_t index, bool with_dock, ScenePath pat
   // The dock, or a look-alike in its place.
   Box keep = db;  // What the line of sight must reach: the dock's box, widened to the look-alike's.
   if (with_dock) {
-    s.world.add_dock(s.profile, dock, rng.uniform(0.5, 0.95));
+    s.dock_reflectivity = rng.uniform(0.5, 0.95);
+    s.world.add_dock(s.profile, dock, s.dock_reflectivity);
     s.objects.push_back(GenObject{"dock", dock.transform(v2(0.5 * (db.x0 + db.x1), 0.5 * (db.y0 + db.y1))),
                                   0.5 * std::hypot(db.x1 - db.x0, db.y1 - db.y0)});
   } else {
     const int kinds = P.reflectors ? static_cast<int>(LookAlike::kCount) : kPlainLookAlikes;
     s.look_alike = static_cast<LookAlike>(uniform_int(rng, 0, kinds - 1));
-    const double refl = rng.uniform(0.5, 0.95);
+    const double refl = s.dock_reflectivity = rng.uniform(0.5, 0.95);
     const double width = static_cast<double>(s.profile.width_m());
     double lw = different_width(rng, width);
     double ldepth = 0.02;
@@ -852,6 +853,31 @@ GenScene WorldGenerator::draw(std::uint64_t index, bool with_dock, ScenePath pat
 
   // Walls, in the dock frame. Back plane x0 = the profile's smallest x.
   const double x0 = db.x0, L = kWallHalfLengthM;
+  // A back wall at x = xw, from y = ya to yb. In reflector mode, with the dock (or its shape) standing there, it leaves
+  // out where a dock segment lies in the wall's plane: there the dock's surface is what the lidar sees, its tape
+  // included (a coincident wall would win the ray cast's tie and hide the tape). Outside the mode it is one segment,
+  // as it always was.
+  auto back_wall = [&](double xw, double ya, double yb) {
+    const bool dock_shape = with_dock || s.look_alike == LookAlike::kOtherCode || s.look_alike == LookAlike::kUntaped;
+    if (!P.reflectors || !dock_shape || xw != x0) {
+      add_segment(&s.world, dock, xw, ya, xw, yb, wall_refl);
+      return;
+    }
+    const double lo = std::min(ya, yb), hi = std::max(ya, yb);
+    std::vector<std::pair<double, double>> cuts;
+    for (std::size_t i = 0; i + 1 < s.profile.vertex_count; ++i) {
+      const Vec2& a = s.profile.vertices_m[i];
+      const Vec2& b = s.profile.vertices_m[i + 1];
+      if (X(a) == x0 && X(b) == x0) cuts.emplace_back(std::min(Y(a), Y(b)), std::max(Y(a), Y(b)));
+    }
+    std::sort(cuts.begin(), cuts.end());
+    double from = lo;
+    for (const auto& c : cuts) {
+      if (c.first > from) add_segment(&s.world, dock, xw, from, xw, std::min(c.first, hi), wall_refl);
+      from = std::max(from, c.second);
+    }
+    if (hi > from) add_segment(&s.world, dock, xw, from, xw, hi, wall_refl);
+  };
   auto wall_object = [&](const char* kind, double xa, double ya, double xb, double yb) {
     s.objects.push_back(
         GenObject{kind, dock.transform(v2(0.5 * (xa + xb), 0.5 * (ya + yb))), 0.5 * std::hypot(xb - xa, yb - ya)});
@@ -859,14 +885,14 @@ GenScene WorldGenerator::draw(std::uint64_t index, bool with_dock, ScenePath pat
   switch (s.mount) {
     case MountClass::kFlush:
     case MountClass::kGap:
-      add_segment(&s.world, dock, x0 - s.wall_gap_m, -L, x0 - s.wall_gap_m, L, wall_refl);
+      back_wall(x0 - s.wall_gap_m, -L, L);
       wall_object("wall", x0 - s.wall_gap_m, -L, x0 - s.wall_gap_m, L);
       fs.front_limit = true;
       fs.front_x = x0 - s.wall_gap_m;
       break;
     case MountClass::kSkirting: {
       const double d = s.skirting_depth_m, ya = db.y1 + s.skirting_end_gap_m, yb = db.y0 - s.skirting_end_gap_m;
-      add_segment(&s.world, dock, x0, -L, x0, L, wall_refl);
+      back_wall(x0, -L, L);
       const double board_refl = rng.uniform(0.2, 0.9);
       s.world.add_polyline({dock.transform(v2(x0, ya)), dock.transform(v2(x0 + d, ya)), dock.transform(v2(x0 + d, L))},
                            false, board_refl);
@@ -897,7 +923,7 @@ GenScene WorldGenerator::draw(std::uint64_t index, bool with_dock, ScenePath pat
       const double xw = x0 - s.wall_gap_m;
       const double ys = s.corner_side > 0 ? db.y1 + s.corner_distance_m : db.y0 - s.corner_distance_m;
       const double far = s.corner_side > 0 ? -L : L;
-      add_segment(&s.world, dock, xw, far, xw, ys, wall_refl);
+      back_wall(xw, far, ys);
       add_segment(&s.world, dock, xw, ys, xw + 2.5, ys, wall_refl);
       wall_object("wall", xw, far, xw, ys);
       wall_object("second-wall", xw, ys, xw + 2.5, ys);

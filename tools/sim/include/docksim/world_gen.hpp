@@ -54,7 +54,9 @@
 //    a sign: no return, so only its place is taken). As other clutter, never in the line of sight to the dock;
 //  - dock-less scenes draw among all LookAlike kinds, the three tape ones included: the same shape with another of
 //    the 5 other patterns, the same shape untaped, and a taped board (a 2 cm board as kBoard, its face in three equal
-//    regions with one of the 6 patterns).
+//    regions with one of the 6 patterns);
+//  - a back wall leaves out where a segment of the dock (or of a look-alike of its shape) lies in the wall's plane, so
+//    the tape on a face flush with the wall is what the rays meet.
 // Host-side: std::vector and std::string are used freely.
 #include <cstdint>
 #include <string>
@@ -190,6 +192,7 @@ struct GenScene {
   int clutter_wanted = 0;                      ///< Objects drawn.
   int clutter_placed = 0;                      ///< Of which placed (the rest found no free spot and were left out).
   LookAlike look_alike = LookAlike::kNothing;  ///< Dock-less scenes only.
+  double dock_reflectivity = 0;                ///< The dock's (or the look-alike's) surface, 0..1.
   // --- reflector mode
   int code_pattern = 0;        ///< The dock's code (bit k = region k taped), 0 = none (mode off or no segment for it).
   int code_segment = -1;       ///< The taped segment, -1 = none.
