@@ -30,6 +30,7 @@
 #include "docksim/rng.hpp"
 #include "docksim/scenes.hpp"
 #include "perception_generated.hpp"
+#include "perception_reflectors.hpp"
 #include "perception_stats.hpp"
 
 namespace docksim_cli {
@@ -927,8 +928,9 @@ void register_perception(CLI::App& app) {
   sub->add_option("--lidars", *lidars, "Comma-separated lidar models");
   sub->add_option("--sigmas-mm", *sigmas, "Comma-separated range noise levels, millimetres");
   sub->add_option("--sections", *sections,
-                  "Comma-separated: accuracy, targets, fp (simulated); generated (generated worlds); real (false "
-                  "positives on the real dock-less recordings), composite (docks ray-cast into real scans)");
+                  "Comma-separated: accuracy, targets, fp (simulated); generated (generated worlds); reflectors "
+                  "(reflector docks on generated worlds); real (false positives on the real dock-less recordings), "
+                  "composite (docks ray-cast into real scans)");
   auto gen = std::make_shared<GeneratedOptions>();
   sub->add_option("--gen-scenes", gen->scenes, "generated: docking scenes (one scan each)")->check(CLI::PositiveNumber);
   sub->add_option("--gen-fp-scenes", gen->fp_scenes,
@@ -937,9 +939,21 @@ void register_perception(CLI::App& app) {
   sub->add_option("--gen-filter-runs", gen->filter_runs,
                   "generated: 1 s filtered approaches (default: a fifth of --gen-scenes)")
       ->check(CLI::PositiveNumber);
-  sub->add_option("--gen-profiles", gen->profiles, "generated: random profiles in the pool")
+  sub->add_option("--gen-profiles", gen->profiles, "generated, reflectors: random profiles in the pool")
       ->check(CLI::Range(1, 10000));
-  sub->add_option("--jobs", gen->jobs, "generated: worker threads (the figures do not depend on it)")
+  auto refl = std::make_shared<ReflectorOptions>();
+  sub->add_option("--refl-scenes", refl->scenes, "reflectors: docking scenes (one scan each)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--refl-fp-scenes", refl->fp_scenes,
+                  "reflectors: dock-less scenes, 3 scans each (default: as many as --refl-scenes)")
+      ->check(CLI::PositiveNumber);
+  sub->add_flag("--read-range", refl->read_range,
+                "reflectors: also measure the readable range of a code per lidar (ld06, industrial) and region width "
+                "(5, 7.5, 10 cm)");
+  sub->add_option("--read-range-scenes", refl->read_range_scenes,
+                  "reflectors: docking scenes per (lidar, region width) of --read-range")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--jobs", gen->jobs, "generated, reflectors: worker threads (the figures do not depend on it)")
       ->check(CLI::Range(1, 64));
   sub->add_option("--realdata", o->realdata_dir,
                   "Real-data folder (default: $DOCKCORE_REALDATA, else <repo>/../shared/realdata)");
@@ -973,7 +987,7 @@ void register_perception(CLI::App& app) {
   sub->add_option("--detector", o->cost_detector,
                   "Cost: all | estimator | estimator-tracking | breakpoint | vmarker (one detector for callgrind)")
       ->check(CLI::IsMember({"all", "estimator", "estimator-tracking", "breakpoint", "vmarker"}));
-  sub->callback([o, gen, profiles, lidars, sigmas, sections, real_names]() {
+  sub->callback([o, gen, refl, profiles, lidars, sigmas, sections, real_names]() {
     o->profiles = split_csv(*profiles);
     o->real_recordings = split_csv(*real_names);
     o->lidars = split_csv(*lidars);
@@ -992,9 +1006,11 @@ void register_perception(CLI::App& app) {
     } else {
       const std::vector<std::string> secs = split_csv(*sections);
       for (const std::string& s : secs) {
-        if (s != "accuracy" && s != "targets" && s != "fp" && s != "generated" && s != "real" && s != "composite") {
-          throw CLI::ValidationError("--sections",
-                                     "unknown section " + s + " (accuracy, targets, fp, generated, real, composite)");
+        if (s != "accuracy" && s != "targets" && s != "fp" && s != "generated" && s != "reflectors" && s != "real" &&
+            s != "composite") {
+          throw CLI::ValidationError(
+              "--sections",
+              "unknown section " + s + " (accuracy, targets, fp, generated, reflectors, real, composite)");
         }
       }
       auto has = [&secs](const char* s) { return std::find(secs.begin(), secs.end(), s) != secs.end(); };
@@ -1004,6 +1020,12 @@ void register_perception(CLI::App& app) {
       if (has("generated")) {
         gen->seed = o->seed;
         j["generated"] = run_generated(*gen);
+      }
+      if (has("reflectors")) {
+        refl->seed = o->seed;
+        refl->jobs = gen->jobs;
+        refl->profiles = gen->profiles;
+        j["reflectors"] = run_reflectors(*refl);
       }
       if (has("real") || has("composite")) {
         const std::unique_ptr<RealData> data = load_real_data(*o);
@@ -1016,6 +1038,7 @@ void register_perception(CLI::App& app) {
     } else {
       print_text(j);
       if (j.contains("generated")) print_generated(j["generated"]);
+      if (j.contains("reflectors")) print_reflectors(j["reflectors"]);
     }
   });
 }
