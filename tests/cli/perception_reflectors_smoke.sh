@@ -19,7 +19,8 @@ import json, sys
 r = json.load(open(sys.argv[1]))["reflectors"]
 fail = []
 for k in ("detection", "by_range", "by_bearing", "by_incidence", "by_face_reflectivity", "misses",
-          "confident_wrong_id", "false_positives", "look_alikes", "reflective_clutter", "read_range", "targets"):
+          "confident_wrong_id", "false_positives", "detections_elsewhere_by_object", "look_alikes", "reflective_clutter",
+          "read_range", "targets"):
     if k not in r:
         fail.append("%s missing" % k)
 if len(r.get("by_range", [])) != 5:

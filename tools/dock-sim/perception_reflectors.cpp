@@ -143,7 +143,20 @@ struct FreeRecord {
   int hits[kCases] = {};     // Scans with a detection.
   int at_look[kCases] = {};  // Of which at the look-alike's place.
   bool confirmed[kCases] = {}, confirmed_at_look[kCases] = {};
+  std::vector<std::string> elsewhere;  // Intensity case: what each detection away from the look-alike lay on.
 };
+
+/// What a detection's dock origin (world) lies on: the first object other than the walls whose bounding circle,
+/// widened by 5 cm, holds it (clutter, reflective objects, the look-alike), else "walls or nothing". O(objects).
+std::string object_at(const docksim::GenScene& s, const Pose2& dock_in_world) {
+  for (const docksim::GenObject& o : s.objects) {
+    if (o.kind == "wall" || o.kind == "second-wall" || o.kind == "room-wall" || o.kind == "skirting") continue;
+    const double d = std::hypot(static_cast<double>(o.centre_m.x() - dock_in_world.x_m),
+                                static_cast<double>(o.centre_m.y() - dock_in_world.y_m));
+    if (d <= o.radius_m + 0.05) return o.kind;
+  }
+  return "walls or nothing";
+}
 
 DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w, int cases, std::uint64_t stream) {
   const docksim::GenScene s = g.draw(i, true, docksim::ScenePath::kSingle);
@@ -193,6 +206,7 @@ FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
       const bool at = is_correct(errors_of(s.dock_in_sensor(static_cast<std::size_t>(k)), mount_inv.compose(e.pose)));
       r.at_look[c] += at ? 1 : 0;
       if (k == 0) first_at_look[c] = at;
+      if (c == 0 && !at) r.elsewhere.push_back(object_at(s, s.robot_path[static_cast<std::size_t>(k)].compose(e.pose)));
     }
   }
   for (int c = 0; c < kCases; ++c) {
@@ -472,6 +486,11 @@ json run_reflectors(const ReflectorOptions& o) {
       refl.push_back(row);
     }
     out["false_positives"] = overall;
+    std::map<std::string, int> on;
+    for (const auto& r : frees)
+      if (r.excluded.empty())
+        for (const std::string& k : r.elsewhere) ++on[k];
+    out["detections_elsewhere_by_object"] = on;
     out["look_alikes"] = looks;
     out["reflective_clutter"] = refl;
   }
@@ -609,6 +628,13 @@ void print_reflectors(const json& j) {
   std::printf("\n-- false positives on dock-less scenes (at look = detections where the look-alike stands)\n");
   print_header(fc);
   fp_rows("all", j["false_positives"]);
+  {
+    std::string line = "intensity usable, single-scan detections away from the look-alike, by what they lay on:";
+    if (j["detections_elsewhere_by_object"].empty()) line += " none";
+    for (const auto& [what, n] : j["detections_elsewhere_by_object"].items())
+      line += " " + what + " " + std::to_string(n.get<int>()) + ";";
+    std::printf("%s\n", line.c_str());
+  }
   std::printf("\n-- by look-alike\n");
   print_header(fc);
   for (const auto& row : j["look_alikes"]) fp_rows(row["look_alike"].get<std::string>(), row);
