@@ -299,7 +299,7 @@ double cue(const DockEstimate& e, EvidenceCue c) {
 
 // A gap seen by one beam that reads bright is a glint or another dock's stripe: the pattern is then not known whole,
 // and a pattern known in part could be another dock's, so the dock is refused as unread rather than taken on the
-// stripes alone. Regions too narrow to hold a beam at this range (the 1.5 cm end gap) are not needed.
+// stripes alone. A gap under 3 cm (the 1.5 cm one at the segment's start) is no region of the code.
 TEST(DockPoseEstimator, AGapSeenByOneBrightBeamLeavesTheCodeUnread) {
   const DockProfile code = coded_plate({{0.015, 0.13}, {0.17, 0.30}});  // a 4 cm gap: one beam inside it at 1 m
   const Truth t = simulate(code, 1.0, 0.0, 0.0, ld06(0.002), 3);
@@ -335,8 +335,8 @@ TEST(DockPoseEstimator, AGapSeenByOneBrightBeamLeavesTheCodeUnread) {
 // evidence, the same shape with another pattern (another dock's code) or without tape loses so much that it is
 // refused, and without usable intensity the decision is geometric (the cue is 0).
 TEST(DockPoseEstimator, ReflectorStripesTellDocksOfOneShapeApart) {
-  const DockProfile code_a = coded_plate({{0.02, 0.08}, {0.12, 0.18}, {0.22, 0.28}});
-  const DockProfile code_b = coded_plate({{0.02, 0.08}, {0.22, 0.28}});
+  const DockProfile code_a = coded_plate({{0.0, 0.10}, {0.20, 0.30}});  // tape on the outer thirds
+  const DockProfile code_b = coded_plate({{0.10, 0.20}});               // on the middle third
   const DockProfile plain = profile("plate-v");
   docksim::LidarModel m = ld06(0.005);
   int a_found = 0, b_found = 0, plain_found = 0, n = 0;

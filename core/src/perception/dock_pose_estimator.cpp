@@ -81,8 +81,9 @@ constexpr Real kRegionMatchNats = static_cast<Real>(0.683);      // ln(0.99 / 0.
 constexpr Real kRegionMismatchNats = static_cast<Real>(-3.912);  // ln(0.01 / 0.5)
 // A beam this close to a stripe's end (plus half its footprint) is left out: its footprint may straddle the edge.
 constexpr Real kStripeEdgeMarginM = static_cast<Real>(0.005);
-// A gap beside a stripe shorter than a stripe may be (add_reflector's 1 cm) is no region of the pattern.
-constexpr Real kMinRegionM = static_cast<Real>(0.01);
+// A stripe or gap shorter than this is no region of the pattern (a stripe cut a little short of a corner leaves such
+// a gap): none is read beyond a few decimetres, so a code must not rest on one.
+constexpr Real kMinRegionM = static_cast<Real>(0.03);
 // Between two verified objects, evidence stronger by this much (a likelihood ratio of e^3 = 20) decides over
 // nearness; closer than that, both are taken for docks and the nearest is chosen.
 constexpr Real kSelectMarginNats = static_cast<Real>(3);
@@ -745,18 +746,13 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   if (read_stripes) {
     // A stripe reads as tape when half its beams or more are bright, else as bare. A gap reads bare when at most a
     // quarter of its beams are bright, as tape when two or more and over a quarter are; one bright beam among
-    // fewer than four is either a glint or another dock's stripe seen by one beam, so that gap is not read.
-    // A region wide enough at this pose to hold a beam inside its edge margins must be read: a pattern known in part
-    // could be another dock's. Narrower ones (an end gap of a centimetre or two, fine regions at range) count when
-    // read and are not needed.
-    auto read = [&](std::uint16_t n, std::uint16_t bright, bool tape_expected, std::uint8_t seg, Real from_m,
-                    Real to_m) {
-      const Vec2 mid = placed_.v_m[seg] + placed_.d_m[seg] * ((from_m + to_m) * R(0.5) / placed_.len_m[seg]);
-      const Real dist_m = mid.norm();
-      Real cos_inc = dist_m > 0 ? std::fabs(placed_.n[seg].dot(mid)) / dist_m : R(1);
-      cos_inc = cos_inc > kMinCosIncidence ? cos_inc : kMinCosIncidence;
-      const Real spacing_m = dist_m * angle_inc_rad_ / cos_inc;
-      const bool needed = to_m - from_m >= 2 * kStripeEdgeMarginM + 2 * spacing_m;
+    // fewer than four is either a glint or another dock's stripe seen by one beam, so that gap is not read. The code
+    // is read only when every stripe and every gap between stripes of kMinRegionM or more is: one with no beam well
+    // inside it (too narrow for the range, hidden) or read neither way leaves the pattern unknown, and a pattern
+    // known in part could be another dock's. A bare end of a segment is needed only where it is wide enough at this
+    // pose to hold a beam inside its margins (a margin the tape was kept off a corner is no part of the code at
+    // range).
+    auto read = [&](std::uint16_t n, std::uint16_t bright, bool tape_expected, bool needed) {
       bool reads_tape = 2 * bright >= n;
       if (!tape_expected && n > 0) {
         if (bright >= 2 && 4 * bright > n) {
@@ -776,6 +772,14 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
       if (tape_expected) f.stripe_beams = static_cast<std::uint16_t>(f.stripe_beams + n);
       f.bright_beams = static_cast<std::uint16_t>(f.bright_beams + bright);
     };
+    // Whether an end region [from_m, to_m] of segment `seg` holds a beam inside its margins at this pose.
+    auto wide_enough = [&](std::uint8_t seg, Real from_m, Real to_m) {
+      const Vec2 mid = placed_.v_m[seg] + placed_.d_m[seg] * ((from_m + to_m) * R(0.5) / placed_.len_m[seg]);
+      const Real dist_m = mid.norm();
+      Real cos_inc = dist_m > 0 ? std::fabs(placed_.n[seg].dot(mid)) / dist_m : R(1);
+      cos_inc = cos_inc > kMinCosIncidence ? cos_inc : kMinCosIncidence;
+      return to_m - from_m >= 2 * kStripeEdgeMarginM + 2 * dist_m * angle_inc_rad_ / cos_inc;
+    };
     for (std::size_t q = 0; q < profile_.reflector_count; ++q) {
       const ReflectorStripe& st = profile_.reflectors[q];
       const bool first_on_segment = q == 0 || profile_.reflectors[q - 1].segment != st.segment;
@@ -783,11 +787,12 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
           q + 1 == profile_.reflector_count || profile_.reflectors[q + 1].segment != st.segment;
       const Real gap_from = first_on_segment ? R(0) : profile_.reflectors[q - 1].to_m;
       const Real seg_len = placed_.len_m[st.segment];
-      // Gaps shorter than a stripe may be (a stripe laid to a segment's end) are no regions.
-      if (st.from_m - gap_from >= kMinRegionM) read(gap_n[q], gap_bright[q], false, st.segment, gap_from, st.from_m);
-      read(stripe_n[q], stripe_bright[q], true, st.segment, st.from_m, st.to_m);
+      if (st.from_m - gap_from >= kMinRegionM) {
+        read(gap_n[q], gap_bright[q], false, !first_on_segment || wide_enough(st.segment, gap_from, st.from_m));
+      }
+      if (st.to_m - st.from_m >= kMinRegionM) read(stripe_n[q], stripe_bright[q], true, true);
       if (last_on_segment && seg_len - st.to_m >= kMinRegionM) {
-        read(after_n[q], after_bright[q], false, st.segment, st.to_m, seg_len);
+        read(after_n[q], after_bright[q], false, wide_enough(st.segment, st.to_m, seg_len));
       }
     }
   }
