@@ -434,7 +434,7 @@ TEST(WorldGen, ReflectorModeTapesTheLongestSegmentWithAValidCode) {
     CHECK_TRUE(s.reflective_wanted >= 0 && s.reflective_wanted <= 3);
     CHECK_TRUE(static_cast<int>(s.reflective.size()) <= s.reflective_wanted);
     reflective += static_cast<int>(s.reflective.size());
-    for (const Segment& seg : s.world.segments) chrome += seg.retro && seg.retro_cutoff_rad >= 0 ? 1 : 0;
+    for (const Segment& seg : s.world.segments) chrome += seg.retro && seg.retro_cutoff_rad > 0 ? 1 : 0;
     double len = 0;
     const std::size_t seg = longest_segment(s.profile, &len);
     if (len < kCodeMinSegmentM) {
@@ -460,7 +460,7 @@ TEST(WorldGen, ReflectorModeTapesTheLongestSegmentWithAValidCode) {
     }
     LONGS_EQUAL(static_cast<long>(st), static_cast<long>(s.profile.reflector_count));
     bool retro = false;  // The world's dock is taped as the profile says.
-    for (const Segment& w : s.world.segments) retro = retro || (w.retro && w.retro_cutoff_rad < 0);
+    for (const Segment& w : s.world.segments) retro = retro || (w.retro && w.retro_cutoff_rad <= 0);
     CHECK_TRUE(retro);
     // No other surface lies on a stripe (a wall flush with a face in its plane would hide the tape from the rays).
     for (std::size_t k = 0; k < s.profile.reflector_count; ++k) {
