@@ -363,14 +363,16 @@ json run_reflectors(const ReflectorOptions& o) {
     }
     out["detection"] = det;
   }
-  {
+  // One row per bin of a factor: detection per case and the code outcomes, over the envelope's scenes with the
+  // factor's own condition (range, bearing) replaced by its bin.
+  auto table = [&](int bins, bool free_range, bool free_bearing, const auto& name_of, const auto& bin_of) {
     json rows = json::array();
-    for (int b = 0; b < kRangeBins; ++b) {
+    for (int b = 0; b < bins; ++b) {
       json row;
-      row["bin"] = range_name(b);
+      row["bin"] = name_of(b);
       std::vector<const DockRecord*> in;
       for (const auto& r : docks)
-        if (in_env(r, true, false) && r.range_bin == b) in.push_back(&r);
+        if (in_env(r, free_range, free_bearing) && bin_of(r) == b) in.push_back(&r);
       for (int c = 0; c < kCases; ++c) {
         Rate d;
         for (const DockRecord* r : in) d.add(r->code[c] == Code::kRight);
@@ -379,64 +381,35 @@ json run_reflectors(const ReflectorOptions& o) {
       row["code"] = code_outcomes(in);
       rows.push_back(row);
     }
-    out["by_range"] = rows;
-  }
-  {
-    json rows = json::array();
-    for (int b = 0; b < kBearingBins; ++b) {
-      char buf[32];
-      std::snprintf(buf, sizeof buf, "|b| %.0f-%.0f°", kBearingEdgesDeg[b], kBearingEdgesDeg[b + 1]);
-      json row;
-      row["bin"] = buf;
-      std::vector<const DockRecord*> in;
-      for (const auto& r : docks)
-        if (in_env(r, false, true) && r.bearing_bin == b) in.push_back(&r);
-      for (int c = 0; c < kCases; ++c) {
-        Rate d;
-        for (const DockRecord* r : in) d.add(r->code[c] == Code::kRight);
-        row[kCaseNames[c]] = d.to_json();
-      }
-      row["code"] = code_outcomes(in);
-      rows.push_back(row);
-    }
-    out["by_bearing"] = rows;
-  }
-  {  // Code outcomes in the envelope by the incidence on the taped segment and by the face's reflectivity.
-    auto table = [&](int bins, const auto& name_of, const auto& bin_of) {
-      json rows = json::array();
-      for (int b = 0; b < bins; ++b) {
-        json row;
-        row["bin"] = name_of(b);
-        std::vector<const DockRecord*> in;
-        for (const auto& r : docks)
-          if (in_env(r, false, false) && bin_of(r) == b) in.push_back(&r);
-        for (int c = 0; c < kCases; ++c) {
-          Rate d;
-          for (const DockRecord* r : in) d.add(r->code[c] == Code::kRight);
-          row[kCaseNames[c]] = d.to_json();
-        }
-        row["code"] = code_outcomes(in);
-        rows.push_back(row);
-      }
-      return rows;
-    };
-    out["by_incidence"] = table(
-        kIncidenceBins,
-        [](int b) {
-          char buf[32];
-          std::snprintf(buf, sizeof buf, "inc %.0f-%.0f°", kIncidenceEdgesDeg[b], kIncidenceEdgesDeg[b + 1]);
-          return std::string(buf);
-        },
-        [](const DockRecord& r) { return r.incidence_bin; });
-    out["by_face_reflectivity"] = table(
-        kFaceBins,
-        [](int b) {
-          char buf[32];
-          std::snprintf(buf, sizeof buf, "face %.2f-%.2f", kFaceEdges[b], kFaceEdges[b + 1]);
-          return std::string(buf);
-        },
-        [](const DockRecord& r) { return r.face_bin; });
-  }
+    return rows;
+  };
+  out["by_range"] = table(
+      kRangeBins, true, false, [](int b) { return range_name(b); }, [](const DockRecord& r) { return r.range_bin; });
+  out["by_bearing"] = table(
+      kBearingBins, false, true,
+      [](int b) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "|b| %.0f-%.0f°", kBearingEdgesDeg[b], kBearingEdgesDeg[b + 1]);
+        return std::string(buf);
+      },
+      [](const DockRecord& r) { return r.bearing_bin; });
+  // Code outcomes in the envelope by the incidence on the taped segment and by the face's reflectivity.
+  out["by_incidence"] = table(
+      kIncidenceBins, false, false,
+      [](int b) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "inc %.0f-%.0f°", kIncidenceEdgesDeg[b], kIncidenceEdgesDeg[b + 1]);
+        return std::string(buf);
+      },
+      [](const DockRecord& r) { return r.incidence_bin; });
+  out["by_face_reflectivity"] = table(
+      kFaceBins, false, false,
+      [](int b) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "face %.2f-%.2f", kFaceEdges[b], kFaceEdges[b + 1]);
+        return std::string(buf);
+      },
+      [](const DockRecord& r) { return r.face_bin; });
   {  // Misses in the envelope by cause, intensity case, most frequent first.
     std::map<std::string, int> count;
     int n = 0;
