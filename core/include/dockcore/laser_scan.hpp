@@ -15,6 +15,15 @@ constexpr std::size_t kMaxScanPoints = 4096;
 /// True when a range sample is a real return: finite and > 0. 0, NaN and inf all mean "no return".
 inline bool is_valid_range(Real range_m) { return range_m > 0 && std::isfinite(range_m); }
 
+/// Index of the beam nearest `angle_rad` in a scan of `count` beams from `angle_min_rad` every `angle_increment_rad`
+/// (> 0). The angle is taken within ±π of the scan's centre, so a partial scan gets the unambiguous index; it may lie
+/// outside [0, count) for an angle outside a partial scan (a full turn's caller wraps it). O(1).
+inline long nearest_beam_index(Real angle_min_rad, Real angle_increment_rad, std::size_t count, Real angle_rad) {
+  const Real half_span = static_cast<Real>(count) * angle_increment_rad * static_cast<Real>(0.5);
+  const Real rel = wrap_angle(angle_rad - angle_min_rad - half_span) + half_span;
+  return static_cast<long>(std::floor(rel / angle_increment_rad + static_cast<Real>(0.5)));
+}
+
 /// Read-only view of one scan. Sample i was taken at angle_min_rad + i * angle_increment_rad in the lidar frame
 /// (counter-clockwise, x forward). A range of 0 / NaN / inf is "no return". intensities may be null.
 struct ScanView {

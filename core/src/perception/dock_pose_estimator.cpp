@@ -402,10 +402,7 @@ int DockPoseEstimatorBase::continues_past_end(const Vec2& p, const Vec2& box_lo,
 }
 
 long DockPoseEstimatorBase::first_beam(Real angle_rad) const {
-  // Express the angle within ±pi of the scan's centre so a non-wrapping scan gets the unambiguous index.
-  const Real half_span = static_cast<Real>(beams_) * angle_inc_rad_ * R(0.5);
-  const Real rel = wrap_angle(angle_rad - angle_min_rad_ - half_span) + half_span;
-  return static_cast<long>(std::floor(rel / angle_inc_rad_ + R(0.5)));
+  return nearest_beam_index(angle_min_rad_, angle_inc_rad_, beams_, angle_rad);
 }
 
 DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initial, bool rough, const Pose2* verified,

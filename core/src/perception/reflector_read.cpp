@@ -110,13 +110,6 @@ class RunCollector {
   std::size_t found_ = 0;
 };
 
-/// Index of the beam nearest `angle_rad` in `scan`, unwrapped: may lie outside [0, count) for a partial scan.
-long nearest_beam(const ScanView& scan, Real angle_rad) {
-  const Real half_span = static_cast<Real>(scan.count) * scan.angle_increment_rad * kHalf;
-  const Real rel = wrap_angle(angle_rad - scan.angle_min_rad - half_span) + half_span;
-  return static_cast<long>(std::floor(rel / scan.angle_increment_rad + kHalf));
-}
-
 }  // namespace
 
 const char* to_string(StripeReadStatus s) {
@@ -153,7 +146,7 @@ StripeRead read_reflector_stripes(const ScanView& scan, const Pose2& lidar_mount
   Real hi = 0;
   placed.angular_span(&lo, &hi);
   // A beam of slack either side for rounding.
-  const long first = nearest_beam(scan, lo) - 1;
+  const long first = nearest_beam_index(scan.angle_min_rad, scan.angle_increment_rad, scan.count, lo) - 1;
   const std::size_t n_beams = static_cast<std::size_t>((hi - lo) / scan.angle_increment_rad) + 3;
   const long count = static_cast<long>(scan.count);
   const bool wraps = scan.wraps();
