@@ -138,6 +138,7 @@ struct DockRecord {
 
 struct FreeRecord {
   std::string excluded;
+  std::uint64_t index = 0;  // The dock-less scene's index (WorldGenerator::draw), to re-generate it.
   int look_alike = 0;
   unsigned reflective = 0;   // Bit k: a ReflectiveClass k object was placed.
   int hits[kCases] = {};     // Scans with a detection.
@@ -187,6 +188,7 @@ DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
 FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w) {
   const docksim::GenScene s = g.draw(i, false, docksim::ScenePath::kConfirm);
   FreeRecord r;
+  r.index = i;
   r.look_alike = static_cast<int>(s.look_alike);
   for (const docksim::ReflectiveClass k : s.reflective) r.reflective |= 1u << static_cast<unsigned>(k);
   r.excluded = excluded_why(s, 0);
@@ -471,14 +473,20 @@ json run_reflectors(const ReflectorOptions& o) {
     json cw;
     for (int c = 0; c < kCases; ++c) {
       FpCell cell;
+      // Intensity case: the dock-less scenes with a scan accepted at the look-alike, to re-generate them (geometry
+      // alone takes most; for it the list stays empty).
+      json scenes = json::array();
       for (const auto& r : frees) {
         if (!r.excluded.empty()) continue;
         const auto la = static_cast<docksim::LookAlike>(r.look_alike);
-        if (la == docksim::LookAlike::kOtherCode || la == docksim::LookAlike::kUntaped) cell.add(r, c);
+        if (la != docksim::LookAlike::kOtherCode && la != docksim::LookAlike::kUntaped) continue;
+        cell.add(r, c);
+        if (c == 0 && r.at_look[c] > 0) scenes.push_back(r.index);
       }
       const json j = cell.to_json();
       cw[kCaseNames[c]] = {{"per_scan", j["at_look_alike_per_scan"]},
-                           {"per_confirmation", j["at_look_alike_per_confirmation"]}};
+                           {"per_confirmation", j["at_look_alike_per_confirmation"]},
+                           {"scene_indices", scenes}};
     }
     out["confident_wrong_id"] = cw;
   }
@@ -579,6 +587,11 @@ void print_reflectors(const json& j) {
     std::printf("%-9s per scan %s (ub95 %s), per confirmation %s (ub95 %s)\n", kCaseNames[c],
                 hits_of(x["per_scan"]).c_str(), upper_of(x["per_scan"]).c_str(), hits_of(x["per_confirmation"]).c_str(),
                 upper_of(x["per_confirmation"]).c_str());
+    if (!x["scene_indices"].empty()) {
+      std::string idx;
+      for (const json& i : x["scene_indices"]) idx += (idx.empty() ? "" : " ") + std::to_string(i.get<std::uint64_t>());
+      std::printf("%-9s dock-less scenes (index): %s\n", "", idx.c_str());
+    }
   }
 
   const std::vector<Column> fc = {{"", 12, false},
