@@ -331,6 +331,48 @@ TEST(DockPoseEstimator, AGapSeenByOneBrightBeamLeavesTheCodeUnread) {
   CHECK(glint.evidence.features.regions_unread >= 1);
 }
 
+// A bare end of the taped segment too narrow at the range to be needed for the code, but seen by one beam well inside
+// it that reads bright: that beam may be another code's stripe (another dock of the shape taped there), so the code
+// is unread rather than taken on the regions read elsewhere.
+TEST(DockPoseEstimator, ABrightBeamOnANarrowBareEndLeavesTheCodeUnread) {
+  const DockProfile code = coded_plate({{0.0, 0.26}});  // a 4 cm bare end: not wide enough beyond about 1.07 m
+  int tried = 0;
+  for (int cm = 110; cm <= 160 && tried < 3; ++cm) {
+    const Truth t = simulate(code, cm / 100.0, 0.0, 0.0, ld06(0.002), 5);
+    PlacedProfile placed;
+    placed.place(code, t.dock_in_lidar);
+    const ScanView v = g_scan.view();
+    // The beams landing on the bare end more than the estimator's edge margin (5 mm + half a footprint) inside it,
+    // by 2 mm more for the fitted pose's error.
+    std::size_t inside = 0;
+    std::size_t beam = 0;
+    for (std::size_t i = 0; i < v.count; ++i) {
+      const Real a = v.angle_rad(i);
+      const Vec2 dir(std::cos(a), std::sin(a));
+      Real r = 0;
+      std::size_t seg = 0;
+      if (!placed.raycast(dir, &r, &seg) || seg != 1) continue;
+      const Real s = placed.along_m(1, r * dir);
+      const Real edge = static_cast<Real>(0.007) + static_cast<Real>(0.5) * r * v.angle_increment_rad;
+      if (s > static_cast<Real>(0.26) + edge && s < static_cast<Real>(0.30) - edge) {
+        ++inside;
+        beam = i;
+      }
+    }
+    if (inside != 1) continue;
+    ++tried;
+    g_est.configure(code, EstimatorParams{});
+    g_est.set_intensity_usable(true);
+    const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+    CHECK_TRUE(clean.found);
+    g_scan.intensities[beam] = 255;  // another code's stripe on the end, seen by this one beam
+    const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
+    CHECK_FALSE(lit.found);
+    CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+  }
+  CHECK_EQUAL(3, tried);
+}
+
 // A reflector dock's stripes are read from the LD06's intensities: the dock with its own stripe pattern gains
 // evidence, the same shape with another pattern (another dock's code) or without tape loses so much that it is
 // refused, and without usable intensity the decision is geometric (the cue is 0).

@@ -84,6 +84,13 @@ constexpr Real kStripeEdgeMarginM = static_cast<Real>(0.005);
 // A stripe or gap shorter than this is no region of the pattern (a stripe cut a little short of a corner leaves such
 // a gap): none is read beyond a few decimetres, so a code must not rest on one.
 constexpr Real kMinRegionM = static_cast<Real>(0.03);
+// A code is read only where the fit fixes each region along the face to this many standard deviations of its width:
+// a pose off along the face by a region reads another code's stripe where this code's should be. The fit's errors
+// along a face have heavy tails (1 % of right poses on generated docks are off by 4 sigma), hence the wide bound.
+constexpr Real kRegionAlongSigmas = static_cast<Real>(4.5);
+// A bright run reaching this many standard deviations of the pose's along-face uncertainty (past the edge margin)
+// into a gap is another code's stripe, not this code's stripe seen from a pose a little off along the face.
+constexpr Real kRunAlongSigmas = static_cast<Real>(3);
 // Between two verified objects, evidence stronger by this much (a likelihood ratio of e^3 = 20) decides over
 // nearness; closer than that, both are taken for docks and the nearest is chosen.
 constexpr Real kSelectMarginNats = static_cast<Real>(3);
@@ -652,6 +659,40 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   std::uint16_t gap_bright[kMaxReflectors] = {};
   std::uint16_t after_n[kMaxReflectors] = {};
   std::uint16_t after_bright[kMaxReflectors] = {};
+  // A bright beam deep inside a gap next to another bright beam is tape, not a glint: another code's stripe reaching
+  // into the gap. Neighbours are consecutive inlier beams on one segment, as the stripe reader's runs.
+  bool gap_run[kMaxReflectors] = {};
+  bool after_run[kMaxReflectors] = {};
+  std::size_t run_prev_seg = kMaxProfileVertices;
+  bool run_prev_bright = false;
+  bool* run_prev_gap = nullptr;
+  // The fit's covariance (as estimate() reports it), for how far along a taped segment a beam's hit may lie from
+  // where this pose puts it.
+  Mat3 pose_cov = Mat3::Zero();
+  bool pose_fixed = false;
+  if (read_stripes) {
+    Mat3 h_inv;
+    const Real fit_sigma = r.rms_m > params_.range_sigma_m ? r.rms_m : params_.range_sigma_m;
+    pose_fixed = invert_sym3(r.h, &h_inv) && h_inv.allFinite();
+    pose_cov = fit_sigma * fit_sigma * h_inv;
+  }
+  const Vec2 t_pose(r.pose.x_m, r.pose.y_m);
+  // Standard deviation of the along-segment position of the ray's hit at point p of segment `seg`: a pose error
+  // moves the segment by delta at p, and the ray then meets it (n·delta)·tan(incidence) - d·delta further along.
+  // O(1).
+  auto along_sigma_m = [&](std::size_t seg, const Vec2& p) {
+    const Vec2& n = placed_.n[seg];
+    const Vec2& d = placed_.u[seg];
+    const Real dist = p.norm();
+    if (dist <= 0) return R(0);
+    Real nu = n.dot(p) / dist;
+    if (std::fabs(nu) < kMinCosIncidence) nu = nu < 0 ? -kMinCosIncidence : kMinCosIncidence;
+    const Vec2 a = n * (d.dot(p) / dist / nu) - d;
+    const Vec2 rel = p - t_pose;
+    const Vec3 j(a.x(), a.y(), a.y() * rel.x() - a.x() * rel.y());
+    const Real var = j.dot(pose_cov * j);
+    return var > 0 ? std::sqrt(var) : R(0);
+  };
   for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
     std::size_t i = 0;
     if (!beam_at(first, k, &i)) continue;
@@ -682,6 +723,8 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
           // or the segment's start), or the gap after the segment's last stripe.
           std::size_t last = kMaxReflectors;
           bool placed_in_region = false;
+          bool* in_gap = nullptr;  // The gap this beam lies deep inside, if any.
+          const Real deep_m = edge_m + kRunAlongSigmas * along_sigma_m(seg, expected_m * dir_[i]);
           for (std::size_t q = 0; q < profile_.reflector_count && !placed_in_region; ++q) {
             const ReflectorStripe& st = profile_.reflectors[q];
             if (st.segment != seg) continue;
@@ -690,6 +733,7 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
               if (s >= gap_from + edge_m && s <= st.from_m - edge_m) {
                 ++gap_n[q];
                 if (bright) ++gap_bright[q];
+                if (s >= gap_from + deep_m && s <= st.from_m - deep_m) in_gap = &gap_run[q];
               }
               placed_in_region = true;
             } else if (s <= st.to_m) {
@@ -705,7 +749,15 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
               s <= len - edge_m) {
             ++after_n[last];
             if (bright) ++after_bright[last];
+            if (s >= profile_.reflectors[last].to_m + deep_m && s <= len - deep_m) in_gap = &after_run[last];
           }
+          if (bright && run_prev_bright && seg == run_prev_seg) {
+            if (in_gap != nullptr) *in_gap = true;
+            if (run_prev_gap != nullptr) *run_prev_gap = true;
+          }
+          run_prev_seg = seg;
+          run_prev_bright = bright;
+          run_prev_gap = in_gap;
         }
         ++r.inliers;
         ++seg_expected[seg];
@@ -749,10 +801,10 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     // known in part could be another dock's. A bare end of a segment is needed only where it is wide enough at this
     // pose to hold a beam inside its margins (a margin the tape was kept off a corner is no part of the code at
     // range).
-    auto read = [&](std::uint16_t n, std::uint16_t bright, bool tape_expected, bool needed) {
+    auto read = [&](std::uint16_t n, std::uint16_t bright, bool tape_expected, bool needed, bool run) {
       bool reads_tape = 2 * bright >= n;
       if (!tape_expected && n > 0) {
-        if (bright >= 2 && 4 * bright > n) {
+        if (run || (bright >= 2 && 4 * bright > n)) {
           reads_tape = true;
         } else if (4 * bright <= n) {
           reads_tape = false;
@@ -777,19 +829,29 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
       cos_inc = cos_inc > kMinCosIncidence ? cos_inc : kMinCosIncidence;
       return to_m - from_m >= 2 * kStripeEdgeMarginM + 2 * dist_m * angle_inc_rad_ / cos_inc;
     };
+    // Whether the pose fixes a region [from_m, to_m] of segment `seg` along the face well within its width.
+    auto pinned = [&](std::uint8_t seg, Real from_m, Real to_m) {
+      const Vec2 mid = placed_.v_m[seg] + placed_.d_m[seg] * ((from_m + to_m) * R(0.5) / placed_.len_m[seg]);
+      return pose_fixed && to_m - from_m >= kRegionAlongSigmas * along_sigma_m(seg, mid);
+    };
     for (std::size_t q = 0; q < profile_.reflector_count; ++q) {
       const ReflectorStripe& st = profile_.reflectors[q];
+      if (st.to_m - st.from_m >= kMinRegionM && !pinned(st.segment, st.from_m, st.to_m)) ++f.regions_unread;
       const bool first_on_segment = q == 0 || profile_.reflectors[q - 1].segment != st.segment;
       const bool last_on_segment =
           q + 1 == profile_.reflector_count || profile_.reflectors[q + 1].segment != st.segment;
       const Real gap_from = first_on_segment ? R(0) : profile_.reflectors[q - 1].to_m;
       const Real seg_len = placed_.len_m[st.segment];
       if (st.from_m - gap_from >= kMinRegionM) {
-        read(gap_n[q], gap_bright[q], false, !first_on_segment || wide_enough(st.segment, gap_from, st.from_m));
+        // An end seen by a beam must read as the profile says, wide enough or not: a bright beam there may be
+        // another code's stripe.
+        read(gap_n[q], gap_bright[q], false,
+             !first_on_segment || gap_n[q] > 0 || wide_enough(st.segment, gap_from, st.from_m), gap_run[q]);
       }
-      if (st.to_m - st.from_m >= kMinRegionM) read(stripe_n[q], stripe_bright[q], true, true);
+      if (st.to_m - st.from_m >= kMinRegionM) read(stripe_n[q], stripe_bright[q], true, true, false);
       if (last_on_segment && seg_len - st.to_m >= kMinRegionM) {
-        read(after_n[q], after_bright[q], false, wide_enough(st.segment, st.to_m, seg_len));
+        read(after_n[q], after_bright[q], false, after_n[q] > 0 || wide_enough(st.segment, st.to_m, seg_len),
+             after_run[q]);
       }
     }
   }
