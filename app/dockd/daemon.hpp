@@ -33,6 +33,7 @@
 #include "events.hpp"
 #include "host_protocol.hpp"
 #include "state_file.hpp"
+#include "status.hpp"
 #include "teach.hpp"
 
 namespace dockd {
@@ -152,9 +153,11 @@ class Daemon final : private HostActions, private TeachHooks {
   std::uint32_t commands_rejected_total() const { return host_.commands_rejected_total(); }
 
  private:
-  /// The tag fusion's, the stall flag's and the own camera's groups; with only_if_fits each is left out whole when
-  /// `w` has no room for it.
-  void camera_groups(JsonWriter& w, bool only_if_fits) const;
+  /// Every value of the main status at `now_us`, gathered from the members (write_status writes them). As
+  /// code_dock_id().
+  StatusValues status_values(std::uint64_t now_us) const;
+  /// The camera part's values: the groups of the inputs dockd has. O(1).
+  CameraValues camera_values() const;
   /// The dock database id whose reflector code the latest scan read: the active dock when it was found with its
   /// code, another dock of its outline whose code a refused candidate (wrong_code) reads, else -1. O(beams of the
   /// dock's span · profile segments + docks).

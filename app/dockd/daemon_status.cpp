@@ -97,6 +97,17 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
 }
 
 void Daemon::status_fields(JsonWriter& w, std::uint64_t now_us) const {
+  write_status(w, status_values(now_us));
+  // The camera's groups go in only when they fit (the status must stay one datagram); each is dropped whole. The
+  // camera part of the status (camera_fields) always has them.
+  write_camera_groups(w, camera_values(), true);
+}
+
+void Daemon::camera_fields(JsonWriter& w) const {
+  write_camera_groups(w, camera_values(), false);
+}
+
+StatusValues Daemon::status_values(std::uint64_t now_us) const {
   const dockcore::TaskStatus& s = last_out_.status;
   const FaultCode watchdog_fault = chassis_stale() ? FaultCode::kChassisStale
                                    : lidar_stale() ? FaultCode::kLidarStale
@@ -105,119 +116,91 @@ void Daemon::status_fields(JsonWriter& w, std::uint64_t now_us) const {
   const dockcore::hal::ChassisCounters& cc = io_.chassis->counters();
   // The latest scan's detection decision: its evidence and each cue (for a miss, the best refused candidate's).
   const dockcore::DockEstimate& e = core_->last_estimate();
-  double cues[dockcore::kEvidenceCueCount];
-  for (std::size_t i = 0; i < dockcore::kEvidenceCueCount; ++i) cues[i] = static_cast<double>(e.evidence.cue_nats[i]);
   // The wheel deadband the output shaping applies, per wheel, forward and backward.
   const dockcore::WheelDeadband& db = core_->deadband();
-  const std::size_t wheels = dockcore::drive_wheel_count(core_->config().drive.kind);
-  double db_fwd[dockcore::kMaxDriveWheels];
-  double db_rev[dockcore::kMaxDriveWheels];
-  for (std::size_t i = 0; i < wheels; ++i) {
-    db_fwd[i] = static_cast<double>(db.floor_radps(i, false));
-    db_rev[i] = static_cast<double>(db.floor_radps(i, true));
+  StatusValues v;
+  v.stamp_us = now_us;
+  v.state = dockcore::to_string(s.state);
+  v.state_code = static_cast<std::uint8_t>(s.state);
+  v.phase = s.phase;
+  v.phase_name = s.state == TaskState::kAlign ? controller_->phase_name(s.phase) : "";
+  v.fault = static_cast<std::uint16_t>(s.fault);
+  v.fault_name = dockcore::to_string(s.fault);
+  v.watchdog_fault = static_cast<std::uint16_t>(watchdog_fault);
+  v.retries = s.retries;
+  v.dock_id = s.dock_id;
+  v.dock_valid = s.dock_valid;
+  v.dock_x_m = static_cast<double>(s.dock_pose.x_m);
+  v.dock_y_m = static_cast<double>(s.dock_pose.y_m);
+  v.dock_yaw_deg = deg(s.dock_pose.yaw_rad);
+  v.last_command = dockcore::to_string(s.last_command);
+  v.last_result = to_string_result(s.last_result);
+  v.charge_enable = s.charge_enable;
+  v.contact = fb_.charging_contact;
+  v.charge_current_a = static_cast<double>(fb_.battery_current_a);
+  v.battery_v = static_cast<double>(fb_.battery_voltage_v);
+  v.soc = static_cast<double>(fb_.soc);
+  v.estop = fb_.estop;
+  v.lidar_stale = lidar_stale();
+  v.chassis_stale = chassis_stale();
+  v.odom_x_m = static_cast<double>(odom_pose().x_m);
+  v.odom_y_m = static_cast<double>(odom_pose().y_m);
+  v.odom_yaw_deg = deg(odom_pose().yaw_rad);
+  v.cmd_vx_mps = static_cast<double>(core_->drive_cmd().vx_mps);
+  v.cmd_wz_radps = static_cast<double>(core_->drive_cmd().wz_radps);
+  v.wheels = dockcore::drive_wheel_count(core_->config().drive.kind);
+  for (std::size_t i = 0; i < v.wheels; ++i) {
+    v.deadband_fwd_radps[i] = static_cast<double>(db.floor_radps(i, false));
+    v.deadband_rev_radps[i] = static_cast<double>(db.floor_radps(i, true));
   }
-  w.str("type", "status")
-      .uint("stamp_us", now_us)
-      .str("state", dockcore::to_string(s.state))
-      .uint("state_code", static_cast<unsigned>(s.state))
-      .uint("phase", s.phase)
-      .str("phase_name", s.state == TaskState::kAlign ? controller_->phase_name(s.phase) : "")
-      .uint("fault", static_cast<unsigned>(s.fault))
-      .str("fault_name", dockcore::to_string(s.fault))
-      .uint("watchdog_fault", static_cast<unsigned>(watchdog_fault))
-      .uint("retries", s.retries)
-      .uint("dock_id", s.dock_id)
-      .boolean("dock_valid", s.dock_valid)
-      .real("dock_x_m", static_cast<double>(s.dock_pose.x_m), 4)
-      .real("dock_y_m", static_cast<double>(s.dock_pose.y_m), 4)
-      .real("dock_yaw_deg", deg(s.dock_pose.yaw_rad), 2)
-      .str("last_command", dockcore::to_string(s.last_command))
-      .str("last_result", to_string_result(s.last_result))
-      .boolean("charge_enable", s.charge_enable)
-      .boolean("contact", fb_.charging_contact)
-      .real("charge_current_a", static_cast<double>(fb_.battery_current_a), 2)
-      .real("battery_v", static_cast<double>(fb_.battery_voltage_v), 2)
-      .real("soc", static_cast<double>(fb_.soc), 3)
-      .boolean("estop", fb_.estop)
-      .boolean("lidar_stale", lidar_stale())
-      .boolean("chassis_stale", chassis_stale())
-      .real("odom_x_m", static_cast<double>(odom_pose().x_m), 4)
-      .real("odom_y_m", static_cast<double>(odom_pose().y_m), 4)
-      .real("odom_yaw_deg", deg(odom_pose().yaw_rad), 2)
-      .real("cmd_vx_mps", static_cast<double>(core_->drive_cmd().vx_mps), 3)
-      .real("cmd_wz_radps", static_cast<double>(core_->drive_cmd().wz_radps), 3)
-      .reals("deadband_fwd_radps", db_fwd, wheels, 2)
-      .reals("deadband_rev_radps", db_rev, wheels, 2)
-      .uint("deadband_raises", db.raises())
-      .boolean("teaching", teach_.active())
-      .boolean("taught", state_.find(s.dock_id) != nullptr)
-      .uint("ticks", stats_.ticks)
-      .uint("tick_worst_us", stats_.worst_period_us)
-      .uint("tick_overruns", stats_.overruns)
-      .uint("tick_work_worst_us", stats_.worst_work_us)
-      .uint("scans", counters_.scans)
-      .uint("detections", counters_.detections)
-      .uint("lidar_crc_errors", lc.crc_errors)
-      .uint("lidar_resyncs", lc.resyncs)
-      .uint("lidar_dropped_bytes", lc.dropped_bytes)
-      .uint("lidar_foreign_datagrams", lc.foreign_datagrams)
-      .uint("lidar_reconnects", lc.reconnects)
-      .uint("lidar_late_scans", core_->inputs().late_scans())
-      .str("lidar_intensity", dockcore::to_string(core_->intensity().verdict()))
-      .uint("can_bad_frames", cc.bad_frames)
-      .uint("can_send_failures", cc.send_failures)
-      .uint("commands", counters_.commands)
-      .uint("commands_rejected", commands_rejected_total())
-      .uint("resumes", counters_.resumes)
-      .uint("can_host_rejected", host_.can_rejected())
-      .uint("udp_not_allowed", host_.udp_not_allowed())
-      .uint("config_reloads", counters_.config_reloads)
-      .uint("config_reloads_rejected", counters_.config_reloads_rejected)
-      .boolean("config_reload_pending", pending_cfg_ != nullptr)
-      .boolean("det_found", e.found)
-      .real("det_evidence_nats", static_cast<double>(e.evidence.total_nats), 1)
-      .reals("det_cues_nats", cues, dockcore::kEvidenceCueCount, 1)
-      .str("det_reject", e.found ? "none" : dockcore::to_string(e.reject))
-      .str("det_code", code_reading(*core_))
-      .sint("det_code_dock", code_dock_id())
-      .real("dock_evidence_nats", static_cast<double>(core_->filter().evidence_nats()), 1)
-      .boolean("dock_confirmed", core_->filter().confirmed());
-  // The camera's groups go in only when they fit (the status must stay one datagram); each is dropped whole. The
-  // camera part of the status (camera_fields) always has them.
-  camera_groups(w, true);
+  v.deadband_raises = db.raises();
+  v.teaching = teach_.active();
+  v.taught = state_.find(s.dock_id) != nullptr;
+  v.ticks = stats_.ticks;
+  v.tick_worst_us = stats_.worst_period_us;
+  v.tick_overruns = stats_.overruns;
+  v.tick_work_worst_us = stats_.worst_work_us;
+  v.scans = counters_.scans;
+  v.detections = counters_.detections;
+  v.lidar_crc_errors = lc.crc_errors;
+  v.lidar_resyncs = lc.resyncs;
+  v.lidar_dropped_bytes = lc.dropped_bytes;
+  v.lidar_foreign_datagrams = lc.foreign_datagrams;
+  v.lidar_reconnects = lc.reconnects;
+  v.lidar_late_scans = core_->inputs().late_scans();
+  v.lidar_intensity = dockcore::to_string(core_->intensity().verdict());
+  v.can_bad_frames = cc.bad_frames;
+  v.can_send_failures = cc.send_failures;
+  v.commands = counters_.commands;
+  v.commands_rejected = commands_rejected_total();
+  v.resumes = counters_.resumes;
+  v.can_host_rejected = host_.can_rejected();
+  v.udp_not_allowed = host_.udp_not_allowed();
+  v.config_reloads = counters_.config_reloads;
+  v.config_reloads_rejected = counters_.config_reloads_rejected;
+  v.config_reload_pending = pending_cfg_ != nullptr;
+  v.det_found = e.found;
+  v.det_evidence_nats = static_cast<double>(e.evidence.total_nats);
+  for (std::size_t i = 0; i < dockcore::kEvidenceCueCount; ++i) {
+    v.det_cues_nats[i] = static_cast<double>(e.evidence.cue_nats[i]);
+  }
+  v.det_reject = e.found ? "none" : dockcore::to_string(e.reject);
+  v.det_code = code_reading(*core_);
+  v.det_code_dock = code_dock_id();
+  v.dock_evidence_nats = static_cast<double>(core_->filter().evidence_nats());
+  v.dock_confirmed = core_->filter().confirmed();
+  return v;
 }
 
-void Daemon::camera_fields(JsonWriter& w) const {
-  camera_groups(w, false);
-}
-
-void Daemon::camera_groups(JsonWriter& w, bool only_if_fits) const {
-  const auto group = [&w, only_if_fits](auto&& write) {
-    const std::size_t m = w.mark();
-    write();
-    if (only_if_fits && !w.ok()) w.rollback(m);
-  };
-  // The tag fusion's counters (docs/camera.md, "Status").
-  if (io_.tags != nullptr) {
-    group([&] {
-      w.uint("tag_fused", counters_.tags[0]).uints("tag_refused", counters_.tags + 1, dockcore::kTagStatusCount - 1);
-    });
-  }
-  // The stall watchdog's flag only, as for the lidar: the count is in the watchdog event.
-  if (io_.camera_frames != nullptr) group([&] { w.boolean("camera_stalled", camera_stalled_); });
-  // The own camera's fields (camera-check reports the rest).
-  if (io_.camera_status != nullptr) {
-    const dockcore::hal::CameraStatus c = io_.camera_status->camera_status();
-    group([&] {
-      w.boolean("camera_connected", c.connected)
-          .uint("camera_frames", c.capture.frames)
-          .uint("camera_dropped", c.capture.dropped)
-          .uint("camera_late", c.capture.late)
-          .uint("camera_corrupt", c.capture.corrupt)
-          .uint("camera_reconnects", c.capture.reconnects)
-          .sint("camera_tag_id", c.tag_id);
-    });
-  }
+CameraValues Daemon::camera_values() const {
+  CameraValues v;
+  v.has_tags = io_.tags != nullptr;
+  for (std::size_t i = 0; i < dockcore::kTagStatusCount; ++i) v.tags[i] = counters_.tags[i];
+  v.has_stall_watch = io_.camera_frames != nullptr;
+  v.stalled = camera_stalled_;
+  v.has_camera = io_.camera_status != nullptr;
+  if (v.has_camera) v.camera = io_.camera_status->camera_status();
+  return v;
 }
 
 }  // namespace dockd
