@@ -33,9 +33,10 @@ class JsonWriter {
   /// Fields another writer made (its body(): `"k":v,...` without braces), copied as they are; nothing when empty.
   JsonWriter& fields(const char* body, std::size_t len);
 
-  /// Where the object stands now, for rollback().
-  std::size_t mark() const { return len_; }
-  /// Drops everything written after `m` (a mark()) and clears the overflow.
+  /// Where the object stands now, for rollback(); 0 once a field did not fit, so a rollback to it never clears an
+  /// overflow that happened before the mark (the object stays refused).
+  std::size_t mark() const { return ok_ ? len_ : 0; }
+  /// Drops everything written after `m` (a mark()) and clears the overflow; nothing for a mark() of 0.
   void rollback(std::size_t m);
   /// False once a field did not fit (until a rollback).
   bool ok() const { return ok_; }

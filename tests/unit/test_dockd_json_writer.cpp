@@ -49,6 +49,15 @@ TEST(JsonWriter, NeverLeavesACutObjectAndRollsBackOptionalGroups) {
   const std::size_t n = w.finish(true);
   CHECK_EQUAL(14u, n);
   STRCMP_EQUAL("{\"a\":1,\"c\":3}\n", buf);
+  // A group marked after an overflow cannot clear it: the object cut before the group stays refused.
+  char cut[24];
+  dockd::JsonWriter g(cut, sizeof cut);
+  g.str("long", "0123456789012345678901234567890");
+  const std::size_t gm = g.mark();
+  g.uint("opt", 1);
+  g.rollback(gm);
+  CHECK_FALSE(g.ok());
+  CHECK_EQUAL(0u, g.finish());
   // Without a rollback the object is refused whole.
   char small[16];
   dockd::JsonWriter s(small, sizeof small);
