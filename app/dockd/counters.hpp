@@ -38,6 +38,8 @@ struct DaemonCounters {
   std::uint32_t config_reloads = 0;           ///< Reloads applied.
   std::uint32_t config_reloads_rejected = 0;  ///< Reloads refused (invalid file, restart-only key changed).
   std::uint32_t events_too_long = 0;          ///< Event lines that did not fit EventLine and were not written.
+  /// UDP replies and status stream objects that did not fit one datagram: a reply_too_long error went instead.
+  std::uint32_t replies_too_long = 0;
   /// Tag poses handed to the core, by what became of them (index: dockcore::TagStatus; kFused = fused).
   std::uint32_t tags[dockcore::kTagStatusCount] = {};
   UdpRequestCounters udp{};  ///< The UDP request datagrams, by what became of them.

@@ -176,6 +176,7 @@ StatusValues Daemon::status_values(std::uint64_t now_us) const {
   v.resumes = counters_.resumes;
   v.can_host_rejected = host_.can_rejected();
   v.udp_not_allowed = host_.udp_not_allowed();
+  v.replies_too_long = counters_.replies_too_long;
   v.config_reloads = counters_.config_reloads;
   v.config_reloads_rejected = counters_.config_reloads_rejected;
   v.config_reload_pending = pending_cfg_ != nullptr;

@@ -60,6 +60,8 @@ const char* to_string(HostErrorCode e) {
       return "subscribers_full";
     case HostErrorCode::kBusy:
       return "busy";
+    case HostErrorCode::kReplyTooLong:
+      return "reply_too_long";
   }
   return "?";
 }
@@ -197,8 +199,29 @@ SubmitResult HostProtocol::submit(HostCommandType type, std::uint16_t dock_id, s
   return res;
 }
 
+namespace {
+
+/// The error object that goes instead of a reply or status object that did not fit one datagram (seq as `has_seq`).
+std::size_t too_long_error(char* buf, std::size_t size, bool has_seq, std::uint32_t seq, const char* what) {
+  char msg[96];
+  std::snprintf(msg, sizeof msg, "the %s did not fit one datagram (%zu bytes)", what, dockcore::hal::kMaxHostReply);
+  return format_host_error(buf, size, has_seq, seq, HostErrorCode::kReplyTooLong, msg);
+}
+
+}  // namespace
+
 void HostProtocol::reply(const HostRequest& r, const char* json, std::size_t len) {
-  if (udp_ != nullptr) udp_->reply(r.peer, json, len);
+  if (udp_ == nullptr) return;
+  if (len == 0 || len + 1 > dockcore::hal::kMaxHostReply) {
+    // Silence would look like a lost datagram to the host: it gets an error it can act on.
+    ++counters_.replies_too_long;
+    char buf[256];
+    char what[32];
+    std::snprintf(what, sizeof what, "%s reply", to_string(r.kind));
+    udp_->reply(r.peer, buf, too_long_error(buf, sizeof buf, r.has_seq, r.seq, what));
+    return;
+  }
+  udp_->reply(r.peer, json, len);
 }
 
 void HostProtocol::reply_error(const HostRequest& r, HostErrorCode code, const char* message) {
@@ -404,8 +427,12 @@ void HostProtocol::publish_status(const dockcore::hal::StatusMessage& can_status
     char buf[dockcore::hal::kMaxHostReply];
     JsonWriter w(buf, sizeof buf);
     actions_.status_fields(w, now_us);
-    const std::size_t n = w.finish();
-    if (n > 0) udp_->publish(buf, n, now_us);
+    std::size_t n = w.finish();
+    if (n == 0) {
+      ++counters_.replies_too_long;
+      n = too_long_error(buf, sizeof buf, false, 0, "status");
+    }
+    udp_->publish(buf, n, now_us);
   }
   ++counters_.status_sent;
 }

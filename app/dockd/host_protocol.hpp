@@ -66,6 +66,7 @@ enum class HostErrorCode : std::uint16_t {
   kTeachFailed = 7,      ///< Teaching could not start or finish (not on the contacts, no dock seen, state file).
   kSubscribersFull = 8,  ///< The subscriber table is full.
   kBusy = 9,             ///< Another request of this kind is still running (teach), or the command queue is full.
+  kReplyTooLong = 10,    ///< The reply (or a status stream object) did not fit one datagram: this error went instead.
 };
 
 /// Stable snake_case name ("malformed", ...). Never null. O(1).
@@ -130,11 +131,12 @@ class HostProtocol {
   void command_taken(const dockcore::TickOutput& out, dockcore::TaskState before, std::uint64_t now_us);
   /// Logs how many refusal events the rate limit held back, once their window has ended. O(1).
   void report_held_events(std::uint64_t now_us);
-  /// The status: `can_status` to the CAN host link, the status object to the UDP subscribers (when there are any).
+  /// The status: `can_status` to the CAN host link, the status object to the UDP subscribers (when there are any); a
+  /// status object that does not fit one datagram goes as a reply_too_long error object, counted.
   void publish_status(const dockcore::hal::StatusMessage& can_status, std::uint64_t now_us);
 
-  /// Sends `json` (one object, no newline) to the sender of `r`. A reply that did not fit its buffer (len 0) reaches
-  /// the link too, which counts it as a send failure.
+  /// Sends `json` (one object, no newline) to the sender of `r`. A reply that did not fit its buffer (len 0) or one
+  /// datagram is replaced by a reply_too_long error, counted in counters().replies_too_long.
   void reply(const HostRequest& r, const char* json, std::size_t len);
   /// Refuses `r`: the error reply ({"ok":false,…,"code","error","message"}), counted, a command_rejected event.
   void reply_error(const HostRequest& r, HostErrorCode code, const char* message);

@@ -1,18 +1,30 @@
 // dockd: the status object's writer, from values the daemon (or a test) gathered.
 #include "status.hpp"
 
+#include <cmath>
+#include <limits>
+
 namespace dockd {
+
+namespace {
+
+/// `v`, or NaN (written as null) at kStatusRealLimit or beyond.
+double reading(double v) {
+  return std::fabs(v) < kStatusRealLimit ? v : std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
 
 void write_status(JsonWriter& w, const StatusValues& v) {
   double db_fwd[dockcore::kMaxDriveWheels];
   double db_rev[dockcore::kMaxDriveWheels];
   const std::size_t wheels = v.wheels < dockcore::kMaxDriveWheels ? v.wheels : dockcore::kMaxDriveWheels;
   for (std::size_t i = 0; i < wheels; ++i) {
-    db_fwd[i] = v.deadband_fwd_radps[i];
-    db_rev[i] = v.deadband_rev_radps[i];
+    db_fwd[i] = reading(v.deadband_fwd_radps[i]);
+    db_rev[i] = reading(v.deadband_rev_radps[i]);
   }
   double cues[dockcore::kEvidenceCueCount];
-  for (std::size_t i = 0; i < dockcore::kEvidenceCueCount; ++i) cues[i] = v.det_cues_nats[i];
+  for (std::size_t i = 0; i < dockcore::kEvidenceCueCount; ++i) cues[i] = reading(v.det_cues_nats[i]);
   w.str("type", "status")
       .uint("stamp_us", v.stamp_us)
       .str("state", v.state)
@@ -25,24 +37,24 @@ void write_status(JsonWriter& w, const StatusValues& v) {
       .uint("retries", v.retries)
       .uint("dock_id", v.dock_id)
       .boolean("dock_valid", v.dock_valid)
-      .real("dock_x_m", v.dock_x_m, 4)
-      .real("dock_y_m", v.dock_y_m, 4)
-      .real("dock_yaw_deg", v.dock_yaw_deg, 2)
+      .real("dock_x_m", reading(v.dock_x_m), 4)
+      .real("dock_y_m", reading(v.dock_y_m), 4)
+      .real("dock_yaw_deg", reading(v.dock_yaw_deg), 2)
       .str("last_command", v.last_command)
       .str("last_result", v.last_result)
       .boolean("charge_enable", v.charge_enable)
       .boolean("contact", v.contact)
-      .real("charge_current_a", v.charge_current_a, 2)
-      .real("battery_v", v.battery_v, 2)
-      .real("soc", v.soc, 3)
+      .real("charge_current_a", reading(v.charge_current_a), 2)
+      .real("battery_v", reading(v.battery_v), 2)
+      .real("soc", reading(v.soc), 3)
       .boolean("estop", v.estop)
       .boolean("lidar_stale", v.lidar_stale)
       .boolean("chassis_stale", v.chassis_stale)
-      .real("odom_x_m", v.odom_x_m, 4)
-      .real("odom_y_m", v.odom_y_m, 4)
-      .real("odom_yaw_deg", v.odom_yaw_deg, 2)
-      .real("cmd_vx_mps", v.cmd_vx_mps, 3)
-      .real("cmd_wz_radps", v.cmd_wz_radps, 3)
+      .real("odom_x_m", reading(v.odom_x_m), 4)
+      .real("odom_y_m", reading(v.odom_y_m), 4)
+      .real("odom_yaw_deg", reading(v.odom_yaw_deg), 2)
+      .real("cmd_vx_mps", reading(v.cmd_vx_mps), 3)
+      .real("cmd_wz_radps", reading(v.cmd_wz_radps), 3)
       .reals("deadband_fwd_radps", db_fwd, wheels, 2)
       .reals("deadband_rev_radps", db_rev, wheels, 2)
       .uint("deadband_raises", v.deadband_raises)
@@ -68,16 +80,17 @@ void write_status(JsonWriter& w, const StatusValues& v) {
       .uint("resumes", v.resumes)
       .uint("can_host_rejected", v.can_host_rejected)
       .uint("udp_not_allowed", v.udp_not_allowed)
+      .uint("replies_too_long", v.replies_too_long)
       .uint("config_reloads", v.config_reloads)
       .uint("config_reloads_rejected", v.config_reloads_rejected)
       .boolean("config_reload_pending", v.config_reload_pending)
       .boolean("det_found", v.det_found)
-      .real("det_evidence_nats", v.det_evidence_nats, 1)
+      .real("det_evidence_nats", reading(v.det_evidence_nats), 1)
       .reals("det_cues_nats", cues, dockcore::kEvidenceCueCount, 1)
       .str("det_reject", v.det_reject)
       .str("det_code", v.det_code)
       .sint("det_code_dock", v.det_code_dock)
-      .real("dock_evidence_nats", v.dock_evidence_nats, 1)
+      .real("dock_evidence_nats", reading(v.dock_evidence_nats), 1)
       .boolean("dock_confirmed", v.dock_confirmed);
 }
 

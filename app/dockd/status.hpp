@@ -15,6 +15,10 @@
 
 namespace dockd {
 
+/// A status real of this magnitude or more, in its unit, is written as null: no reading of a docking robot comes near
+/// (10^6 m, degrees, volts, amps, rad/s or nats), and it bounds every real's printed width.
+constexpr double kStatusRealLimit = 1e6;
+
 /// Every value of the main status object, in its order. Strings are static names (never null, except phase_name:
 /// null writes ""). Integer types are those of the values' sources.
 struct StatusValues {
@@ -50,6 +54,7 @@ struct StatusValues {
   const char* lidar_intensity = "";
   std::uint32_t can_bad_frames = 0, can_send_failures = 0;
   std::uint32_t commands = 0, commands_rejected = 0, resumes = 0, can_host_rejected = 0, udp_not_allowed = 0;
+  std::uint32_t replies_too_long = 0;
   std::uint32_t config_reloads = 0, config_reloads_rejected = 0;
   bool config_reload_pending = false;
   bool det_found = false;
