@@ -9,9 +9,9 @@
 
 namespace docksim_cli {
 
-namespace {
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
-}  // namespace
+double r6(double v) {
+  return std::round(v * 1e6) / 1e6;
+}
 
 std::string fmt(const char* f, double v) {
   char buf[64];

@@ -28,12 +28,6 @@ using dockcore::Real;
 using dockcore::Vec2;
 using docksim::SvgStyle;
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
-
-double r6(double v) {
-  return std::round(v * 1e6) / 1e6;
-}
-
 std::vector<Vec2> profile_world(const docksim::Scenario& sc) {
   std::vector<Vec2> pts;
   for (std::size_t i = 0; i < sc.profile.vertex_count; ++i)

@@ -47,12 +47,7 @@ using dockcore::Pose2;
 using dockcore::Real;
 using dockcore::TaskState;
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 constexpr int kStepsPerTick = 4;  // 4 x 5 ms = 50 Hz, as run_docking and dockd
-
-double r6(double v) {
-  return std::round(v * 1e6) / 1e6;
-}
 
 struct SoakOptions {
   std::string scenario;
