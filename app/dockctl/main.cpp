@@ -97,8 +97,9 @@ int main(int argc, char** argv) {
   std::string part;
   status
       ->add_option("--part", part,
-                   "camera: the camera's and the tag fusion's fields, which the status leaves out when full")
-      ->check(CLI::IsMember({"main", "camera"}))
+                   "camera: the camera's and the tag fusion's fields; counters: every counter (the status leaves "
+                   "each group out when full)")
+      ->check(CLI::IsMember({"main", "camera", "counters"}))
       ->excludes(follow_opt);
   auto* test =
       app.add_subcommand("test", "recognition-only test mode: report the dock estimate, never move ('stop' ends it)");

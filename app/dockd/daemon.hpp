@@ -142,11 +142,13 @@ class Daemon final : private HostActions, private TeachHooks {
   std::uint16_t active_dock_id() const override { return active_dock_; }
   /// Current status as one JSON object (no newline). Returns the length (0 when it does not fit). O(1).
   std::size_t status_json(char* buf, std::size_t size, std::uint64_t now_us) const;
-  /// The status's fields, written into `w` (status_json and the status reply); optional groups (tag fusion, camera)
-  /// only when they fit.
+  /// The status's fields, written into `w` (status_json and the status reply); optional groups (counters, tag
+  /// fusion, camera) only when they fit.
   void status_fields(JsonWriter& w, std::uint64_t now_us) const override;
   /// The camera part of the status (`"part":"camera"`): the groups status_fields drops when full, always whole.
   void camera_fields(JsonWriter& w) const override;
+  /// The counters part of the status (`"part":"counters"`): the group status_fields drops when full, always whole.
+  void counter_fields(JsonWriter& w, std::uint64_t now_us) const override;
   /// Every host command refused, whatever refused it: dockd and the task manager (counters().commands_rejected)
   /// plus the UDP datagrams that did not parse (malformed, unknown command, bad field, too long). The status field
   /// `commands_rejected`. O(1).

@@ -107,6 +107,10 @@ void Daemon::camera_fields(JsonWriter& w) const {
   write_camera_groups(w, camera_values(), false);
 }
 
+void Daemon::counter_fields(JsonWriter& w, std::uint64_t now_us) const {
+  write_counters(w, status_values(now_us));
+}
+
 StatusValues Daemon::status_values(std::uint64_t now_us) const {
   const dockcore::TaskStatus& s = last_out_.status;
   const FaultCode watchdog_fault = chassis_stale() ? FaultCode::kChassisStale

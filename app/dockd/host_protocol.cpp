@@ -144,12 +144,14 @@ HostErrorCode parse_host_request(const char* data, std::size_t len, HostRequest&
   }
   if (j.has("part")) {
     const char* part = "";
-    const bool camera = j.get_string("part", part) && std::strcmp(part, "camera") == 0;
-    if (r.kind != HostRequestKind::kStatus || (!camera && std::strcmp(part, "main") != 0)) {
-      detail = "part must be \"main\" or \"camera\" and only with status";
+    const bool named = j.get_string("part", part);
+    const bool camera = named && std::strcmp(part, "camera") == 0;
+    const bool counters = named && std::strcmp(part, "counters") == 0;
+    if (r.kind != HostRequestKind::kStatus || (!camera && !counters && std::strcmp(part, "main") != 0)) {
+      detail = "part must be \"main\", \"camera\" or \"counters\" and only with status";
       return HostErrorCode::kBadField;
     }
-    r.part = camera ? StatusPart::kCamera : StatusPart::kMain;
+    r.part = camera ? StatusPart::kCamera : counters ? StatusPart::kCounters : StatusPart::kMain;
   }
   out = r;
   return HostErrorCode::kNone;
@@ -304,14 +306,17 @@ void HostProtocol::handle_subscription(const HostRequest& r, std::uint64_t now_u
 void HostProtocol::handle_udp(const HostRequest& r, std::uint64_t now_us) {
   switch (r.kind) {
     case HostRequestKind::kStatus: {
-      // The reply is the status object (or the camera part, after "part") with {"ok":true,"cmd":"status","seq":N}
-      // in front.
+      // The reply is the status object (or the camera or counters part, after "part") with
+      // {"ok":true,"cmd":"status","seq":N} in front.
       char out[dockcore::hal::kMaxHostReply];
       JsonWriter w(out, sizeof out);
       w.boolean("ok", true).str("cmd", "status").uint("seq", r.seq);
       if (r.part == StatusPart::kCamera) {
         w.str("part", "camera");
         actions_.camera_fields(w);
+      } else if (r.part == StatusPart::kCounters) {
+        w.str("part", "counters");
+        actions_.counter_fields(w, now_us);
       } else {
         actions_.status_fields(w, now_us);
       }

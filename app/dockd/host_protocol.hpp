@@ -37,8 +37,9 @@ const char* to_string(HostRequestKind k);
 
 /// Which part of the status a status request asks for.
 enum class StatusPart : std::uint8_t {
-  kMain = 0,    ///< The status object (task, inputs, counters, detection), as the stream carries it.
-  kCamera = 1,  ///< The camera's and the tag fusion's fields, always whole (the main status drops them when full).
+  kMain = 0,      ///< The status object (task, inputs, detection, counters), as the stream carries it.
+  kCamera = 1,    ///< The camera's and the tag fusion's fields, always whole (the main status drops them when full).
+  kCounters = 2,  ///< The counters, always whole (the main status drops them when full).
 };
 
 /// One parsed UDP request.
@@ -91,6 +92,8 @@ class HostActions {
   /// The camera part's fields: the tag fusion's counters, the stall flag and the capture counters, each group only
   /// when dockd has that input (none without a camera).
   virtual void camera_fields(JsonWriter& w) const = 0;
+  /// The counters part's fields: every counter of the status.
+  virtual void counter_fields(JsonWriter& w, std::uint64_t now_us) const = 0;
   /// The running configuration: the dock database and the default dock.
   virtual const DockdConfig& config() const = 0;
   /// The dock the core is configured for: undock and stop go to it.

@@ -60,7 +60,25 @@ void write_status(JsonWriter& w, const StatusValues& v) {
       .uint("deadband_raises", v.deadband_raises)
       .boolean("teaching", v.teaching)
       .boolean("taught", v.taught)
-      .uint("ticks", v.ticks)
+      .str("lidar_intensity", v.lidar_intensity)
+      .boolean("config_reload_pending", v.config_reload_pending)
+      .boolean("det_found", v.det_found)
+      .real("det_evidence_nats", reading(v.det_evidence_nats), 1)
+      .reals("det_cues_nats", cues, dockcore::kEvidenceCueCount, 1)
+      .str("det_reject", v.det_reject)
+      .str("det_code", v.det_code)
+      .sint("det_code_dock", v.det_code_dock)
+      .real("dock_evidence_nats", reading(v.dock_evidence_nats), 1)
+      .boolean("dock_confirmed", v.dock_confirmed);
+  // The counters are the status's widest group (up to 20 digits each): left out whole when they do not fit, so the
+  // task, the dock and the detection always reach the host. The counters part always carries them.
+  const std::size_t m = w.mark();
+  write_counters(w, v);
+  if (!w.ok()) w.rollback(m);
+}
+
+void write_counters(JsonWriter& w, const StatusValues& v) {
+  w.uint("ticks", v.ticks)
       .uint("tick_worst_us", v.tick_worst_us)
       .uint("tick_overruns", v.tick_overruns)
       .uint("tick_work_worst_us", v.tick_work_worst_us)
@@ -72,7 +90,6 @@ void write_status(JsonWriter& w, const StatusValues& v) {
       .uint("lidar_foreign_datagrams", v.lidar_foreign_datagrams)
       .uint("lidar_reconnects", v.lidar_reconnects)
       .uint("lidar_late_scans", v.lidar_late_scans)
-      .str("lidar_intensity", v.lidar_intensity)
       .uint("can_bad_frames", v.can_bad_frames)
       .uint("can_send_failures", v.can_send_failures)
       .uint("commands", v.commands)
@@ -82,16 +99,7 @@ void write_status(JsonWriter& w, const StatusValues& v) {
       .uint("udp_not_allowed", v.udp_not_allowed)
       .uint("replies_too_long", v.replies_too_long)
       .uint("config_reloads", v.config_reloads)
-      .uint("config_reloads_rejected", v.config_reloads_rejected)
-      .boolean("config_reload_pending", v.config_reload_pending)
-      .boolean("det_found", v.det_found)
-      .real("det_evidence_nats", reading(v.det_evidence_nats), 1)
-      .reals("det_cues_nats", cues, dockcore::kEvidenceCueCount, 1)
-      .str("det_reject", v.det_reject)
-      .str("det_code", v.det_code)
-      .sint("det_code_dock", v.det_code_dock)
-      .real("dock_evidence_nats", reading(v.dock_evidence_nats), 1)
-      .boolean("dock_confirmed", v.dock_confirmed);
+      .uint("config_reloads_rejected", v.config_reloads_rejected);
 }
 
 void write_camera_groups(JsonWriter& w, const CameraValues& v, bool only_if_fits) {

@@ -78,8 +78,13 @@ struct CameraValues {
   dockcore::hal::CameraStatus camera{};
 };
 
-/// Writes the main status fields of `v` into `w` (the caller adds any prefix and finishes it). O(bytes written).
+/// Writes the main status fields of `v` into `w` (the caller adds any prefix and finishes it), its counters
+/// (write_counters) last, left out whole when they do not fit `w` (which then stays ok). O(bytes written).
 void write_status(JsonWriter& w, const StatusValues& v);
+
+/// Writes the counters of `v` (ticks, scans, lidar, CAN, host commands, reloads): the status's counters part, and
+/// the group the main status drops when full. O(bytes written).
+void write_counters(JsonWriter& w, const StatusValues& v);
 
 /// Writes the camera groups present in `v`; with `only_if_fits` each group that does not fit `w` is left out whole
 /// (and `w` stays ok). O(bytes written).

@@ -52,7 +52,8 @@ write_cfg "chassis_stale_ms = 300" 'allowlist = ["127.0.0.2"]' $PORT
 kill -HUP $pid
 wait_event '"event":"config_reload","result":"applied"' 1 || fail "good reload not applied: $(tail -3 "$WORK/rec/events.jsonl")"
 status >"$WORK/s1.json" || fail "no status after the good reload"
-grep -q '"config_reloads":1,"config_reloads_rejected":0,"config_reload_pending":false' "$WORK/s1.json" ||
+grep -qE '"config_reloads":1,"config_reloads_rejected":0[,}]' "$WORK/s1.json" &&
+  grep -q '"config_reload_pending":false' "$WORK/s1.json" ||
   fail "status after good reload: $(cat "$WORK/s1.json")"
 
 # 2. Invalid value on line 13, column 20: rejected with its position; dockd keeps running on the old config.
@@ -63,7 +64,7 @@ grep '"result":"rejected"' "$WORK/rec/events.jsonl" | grep -q "dockd.toml:13:20:
   fail "rejection message: $(grep rejected "$WORK/rec/events.jsonl")"
 grep -q "dockd.toml:13:20: watchdog.chassis_stale_ms = 5 is out of range" "$WORK/dockd.err" || fail "rejection not on stderr"
 status >"$WORK/s2.json" || fail "dockd stopped answering after a bad reload"
-grep -q '"config_reloads":1,"config_reloads_rejected":1,' "$WORK/s2.json" || fail "status after bad reload: $(cat "$WORK/s2.json")"
+grep -qE '"config_reloads":1,"config_reloads_rejected":1[,}]' "$WORK/s2.json" || fail "status after bad reload: $(cat "$WORK/s2.json")"
 
 # 3. A restart-only key (host.port) changed: the whole file is rejected, the old port keeps serving.
 write_cfg "chassis_stale_ms = 250" "" $((PORT + 1))
@@ -72,7 +73,7 @@ wait_event '"result":"rejected"' 2 || fail "restart-only reload not rejected"
 grep '"result":"rejected"' "$WORK/rec/events.jsonl" | tail -1 | grep -q "restart-only keys changed (host.port)" ||
   fail "restart-only message: $(grep rejected "$WORK/rec/events.jsonl" | tail -1)"
 status >"$WORK/s3.json" || fail "old port no longer answers"
-grep -q '"config_reloads":1,"config_reloads_rejected":2,' "$WORK/s3.json" || fail "status after restart-only: $(cat "$WORK/s3.json")"
+grep -qE '"config_reloads":1,"config_reloads_rejected":2[,}]' "$WORK/s3.json" || fail "status after restart-only: $(cat "$WORK/s3.json")"
 
 kill -TERM $pid
 wait $pid; rc=$?

@@ -90,6 +90,7 @@ struct FakeActions final : dockd::HostActions {
     w.str("type", "status").uint("stamp_us", now_us);
   }
   void camera_fields(dockd::JsonWriter& w) const override { w.uint("camera_frames", 42); }
+  void counter_fields(dockd::JsonWriter& w, std::uint64_t) const override { w.uint("ticks", 7); }
   const dockd::DockdConfig& config() const override { return cfg; }
   std::uint16_t active_dock_id() const override { return 3; }
   dockcore::SubmitResult submit(dockcore::HostCommandType type, std::uint16_t dock_id, std::uint32_t token,

@@ -72,6 +72,7 @@ struct FakeActions final : dockd::HostActions {
     dockd::write_camera_groups(w, camera, true);
   }
   void camera_fields(dockd::JsonWriter& w) const override { dockd::write_camera_groups(w, camera, false); }
+  void counter_fields(dockd::JsonWriter& w, std::uint64_t) const override { dockd::write_counters(w, status); }
   const dockd::DockdConfig& config() const override { return cfg; }
   std::uint16_t active_dock_id() const override { return 0; }
   dockcore::SubmitResult submit(dockcore::HostCommandType, std::uint16_t, std::uint32_t, std::uint32_t&) override {
@@ -200,11 +201,11 @@ TEST_GROUP(DockdStatus) {
   dockd::DaemonCounters counters;
 };
 
-TEST(DockdStatus, TheLongestStatusIsMeasuredAndTheReplyAlwaysFitsAndParses) {
+TEST(DockdStatus, TheLongestStatusFitsADatagramWithItsTaskDockAndDetection) {
   actions.status = worst_status();
   actions.camera = worst_camera();
   // The longest status reply as it would be without a datagram's limit: the prefix handle_udp writes, the main
-  // fields, no camera group (those are dropped before the main status is).
+  // fields and the counters, no camera group (those are dropped before the counters are).
   std::vector<char> big(8192);
   dockd::JsonWriter m(big.data(), big.size());
   m.boolean("ok", true).str("cmd", "status").uint("seq", 4294967295u);
@@ -212,32 +213,47 @@ TEST(DockdStatus, TheLongestStatusIsMeasuredAndTheReplyAlwaysFitsAndParses) {
   const std::size_t whole = m.finish() + 1;  // + the newline the link appends
   CHECK(whole > 1);
   CHECK(nlohmann::json::parse(std::string(big.data(), whole - 1), nullptr, false).is_object());
-  std::printf("\nlongest status reply: %zu bytes (one datagram: %zu)\n", whole, kMaxHostReply);
+  std::printf("\nlongest status reply with its counters: %zu bytes (one datagram: %zu)\n", whole, kMaxHostReply);
 
   dockd::HostProtocol p(&link, nullptr, actions, counters);
   link.pending.push_back("{\"cmd\":\"status\",\"seq\":4294967295}");
   p.poll(1000);
   CHECK_EQUAL(1u, link.replies.size());
   const std::string& reply = link.replies[0];
+  std::printf("longest status reply sent: %zu bytes\n", datagram_bytes(reply));
   CHECK(datagram_bytes(reply) <= kMaxHostReply);
   const nlohmann::json j = nlohmann::json::parse(reply, nullptr, false);
   CHECK(!j.is_discarded());
   CHECK(j.is_object());
+  // Whatever the values, the task, the dock and the detection go; the counters go whole or not at all.
+  CHECK(j.at("ok").get<bool>());
   CHECK_EQUAL(4294967295u, j.at("seq").get<std::uint32_t>());
-  if (whole <= kMaxHostReply) {
-    // The whole main status went, and the camera groups only whole.
-    CHECK(j.at("ok").get<bool>());
-    CHECK(j.at("dock_confirmed").is_boolean());
-    CHECK_EQUAL(dockcore::kEvidenceCueCount, j.at("det_cues_nats").size());
-    CHECK(!j.contains("tag_fused") || j.at("tag_refused").size() == dockcore::kTagStatusCount - 1);
-    CHECK(!j.contains("camera_connected") || j.contains("camera_tag_id"));
-    CHECK_EQUAL(0u, counters.replies_too_long);
-  } else {
-    // Larger than a datagram: the host gets the error, never silence or a cut object.
-    CHECK_FALSE(j.at("ok").get<bool>());
-    STRCMP_EQUAL("reply_too_long", j.at("error").get<std::string>().c_str());
-    CHECK_EQUAL(1u, counters.replies_too_long);
-  }
+  CHECK(j.contains("state") && j.contains("fault_name") && j.contains("dock_x_m") && j.contains("det_code_dock"));
+  CHECK(j.at("dock_confirmed").is_boolean());
+  CHECK_EQUAL(dockcore::kEvidenceCueCount, j.at("det_cues_nats").size());
+  CHECK_EQUAL(whole <= kMaxHostReply, j.contains("ticks"));
+  CHECK_EQUAL(j.contains("ticks"), j.contains("config_reloads_rejected"));
+  CHECK(!j.contains("tag_fused") || j.at("tag_refused").size() == dockcore::kTagStatusCount - 1);
+  CHECK(!j.contains("camera_connected") || j.contains("camera_tag_id"));
+  CHECK_EQUAL(0u, counters.replies_too_long);
+}
+
+TEST(DockdStatus, TheLongestCountersPartFitsWhole) {
+  actions.status = worst_status();
+  dockd::HostProtocol p(&link, nullptr, actions, counters);
+  link.pending.push_back("{\"cmd\":\"status\",\"seq\":4294967295,\"part\":\"counters\"}");
+  p.poll(1000);
+  CHECK_EQUAL(1u, link.replies.size());
+  const std::string& reply = link.replies[0];
+  std::printf("\nworst-case counters part reply: %zu bytes\n", datagram_bytes(reply));
+  CHECK(datagram_bytes(reply) <= kMaxHostReply);
+  const nlohmann::json j = nlohmann::json::parse(reply, nullptr, false);
+  CHECK(!j.is_discarded());
+  CHECK(j.at("ok").get<bool>());
+  STRCMP_EQUAL("counters", j.at("part").get<std::string>().c_str());
+  CHECK_EQUAL(actions.status.ticks, j.at("ticks").get<std::uint64_t>());
+  CHECK_EQUAL(actions.status.config_reloads_rejected, j.at("config_reloads_rejected").get<std::uint32_t>());
+  CHECK_FALSE(j.contains("state"));
 }
 
 TEST(DockdStatus, TheLongestCameraPartFitsWhole) {
@@ -264,7 +280,7 @@ TEST(DockdStatus, TheLongestStreamObjectFitsAndParses) {
   CHECK(datagram_bytes(link.published[0]) <= kMaxHostReply);
   const nlohmann::json j = nlohmann::json::parse(link.published[0], nullptr, false);
   CHECK(!j.is_discarded());
-  CHECK(j.contains("type") || j.at("error").get<std::string>() == "reply_too_long");
+  CHECK(j.contains("type") && j.contains("state") && j.contains("det_found"));
 }
 
 TEST(DockdStatus, ARealBeyondTheLimitIsNull) {
