@@ -14,6 +14,7 @@
 
 #include "daemon.hpp"
 #include "dockcore/control/controllers.hpp"
+#include "fake_host_link.hpp"
 #include "host_protocol.hpp"
 #include "status.hpp"
 
@@ -25,38 +26,7 @@ using dockcore::hal::kMaxHostReply;
 using dockd::CameraValues;
 using dockd::StatusValues;
 
-/// Every status request gets one datagram from 127.0.0.1; replies and stream objects are kept as text.
-struct FakeRequestLink final : dockcore::hal::HostRequestLink {
-  std::vector<std::string> pending;
-  std::vector<std::string> replies;
-  std::vector<std::string> published;
-  dockcore::hal::HostRequestCounters c{};
-
-  bool poll_datagram(dockcore::hal::HostDatagram& out, std::uint64_t now_us) override {
-    if (pending.empty()) return false;
-    const std::string d = pending.front();
-    pending.erase(pending.begin());
-    out.len = d.size();
-    std::memcpy(out.data, d.data(), d.size());
-    out.peer = dockcore::hal::HostPeer{0x0100007fu, 0x3930u};
-    out.stamp_us = now_us;
-    ++c.datagrams;
-    return true;
-  }
-  bool reply(const dockcore::hal::HostPeer&, const char* json, std::size_t len) override {
-    replies.emplace_back(json, len);
-    return len > 0;
-  }
-  void publish(const char* json, std::size_t len, std::uint64_t) override { published.emplace_back(json, len); }
-  bool subscribe(const dockcore::hal::HostPeer&, std::uint64_t, std::uint32_t& expires_ms) override {
-    expires_ms = 10000;
-    return true;
-  }
-  void unsubscribe(const dockcore::hal::HostPeer&) override {}
-  std::size_t subscriber_count() const override { return 1; }
-  const dockcore::hal::HostRequestCounters& counters() const override { return c; }
-  bool set_allowlist(const std::vector<std::string>&, std::string&) override { return true; }
-};
+using dockd_test::FakeRequestLink;
 
 /// The daemon's side: the status as write_status writes `status` (and the camera groups that fit, as the daemon
 /// does); `extra_bytes` > 0 adds a field of that many bytes, a status that cannot fit.
@@ -199,6 +169,10 @@ TEST_GROUP(DockdStatus) {
   FakeRequestLink link;
   FakeActions actions;
   dockd::DaemonCounters counters;
+
+  void setup() override {
+    link.subscribers = 1;
+  }  // the stream goes out only with a subscriber
 };
 
 TEST(DockdStatus, TheLongestStatusFitsADatagramWithItsTaskDockAndDetection) {
