@@ -373,6 +373,42 @@ TEST(DockPoseEstimator, ABrightBeamOnANarrowBareEndLeavesTheCodeUnread) {
   CHECK_EQUAL(3, tried);
 }
 
+// A stripe over a quarter of whose beams read dark is lit in part, as where another code's stripe lies half over it
+// or the pose is off along the face by part of a region: it reads neither way, and the code is unread.
+TEST(DockPoseEstimator, AStripeLitInPartLeavesTheCodeUnread) {
+  const DockProfile code = coded_plate({{0.10, 0.20}});
+  const Truth t = simulate(code, 0.5, 0.0, 0.0, ld06(0.002), 7);
+  g_est.configure(code, EstimatorParams{});
+  g_est.set_intensity_usable(true);
+  const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_TRUE(clean.found);
+  PlacedProfile placed;
+  placed.place(code, t.dock_in_lidar);
+  const ScanView v = g_scan.view();
+  // Darken the stripe's first 3.75 cm: about a third of the beams well inside it.
+  int inside = 0;
+  int dark = 0;
+  for (std::size_t i = 0; i < v.count; ++i) {
+    const Real a = v.angle_rad(i);
+    const Vec2 dir(std::cos(a), std::sin(a));
+    Real r = 0;
+    std::size_t seg = 0;
+    if (!placed.raycast(dir, &r, &seg) || seg != 1) continue;
+    const Real s = placed.along_m(1, r * dir);
+    const Real edge = static_cast<Real>(0.005) + static_cast<Real>(0.5) * r * v.angle_increment_rad;
+    if (s > static_cast<Real>(0.10) + edge && s < static_cast<Real>(0.20) - edge) ++inside;
+    if (s < static_cast<Real>(0.1375)) {
+      g_scan.intensities[i] = 0;
+      if (s > static_cast<Real>(0.10) + edge) ++dark;
+    }
+  }
+  CHECK(4 * dark > inside);
+  CHECK(2 * dark < inside);
+  const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_FALSE(lit.found);
+  CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+}
+
 // A reflector dock's stripes are read from the LD06's intensities: the dock with its own stripe pattern gains
 // evidence, the same shape with another pattern (another dock's code) or without tape loses so much that it is
 // refused, and without usable intensity the decision is geometric (the cue is 0).

@@ -793,7 +793,8 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     }
   }
   if (read_stripes) {
-    // A stripe reads as tape when half its beams or more are bright, else as bare. A gap reads bare when at most a
+    // A stripe reads as tape when three quarters of its beams or more are bright, as bare when under half are, and
+    // neither way in between. A gap reads bare when at most a
     // quarter of its beams are bright, as tape when two or more and over a quarter are; one bright beam among
     // fewer than four is either a glint or another dock's stripe seen by one beam, so that gap is not read. The code
     // is read only when every stripe and every gap between stripes of kMinRegionM or more is: one with no beam well
@@ -803,6 +804,9 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     // range).
     auto read = [&](std::uint16_t n, std::uint16_t bright, bool tape_expected, bool needed, bool run) {
       bool reads_tape = 2 * bright >= n;
+      // A stripe with over a quarter of its beams dark is lit in part: another code's stripe half over it, or
+      // this one seen from a pose off along the face by part of a region. Neither way: not read.
+      if (tape_expected && reads_tape && 4 * bright < 3 * n) n = 0;
       if (!tape_expected && n > 0) {
         if (run || (bright >= 2 && 4 * bright > n)) {
           reads_tape = true;
