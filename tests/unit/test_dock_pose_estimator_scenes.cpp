@@ -409,6 +409,55 @@ TEST(DockPoseEstimator, AStripeLitInPartLeavesTheCodeUnread) {
   CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
 }
 
+// A bright run at the outer side of a bare end (the segment's end, where this code has no stripe to spill over) is
+// another code's stripe even when it is not three standard deviations of the pose's along-face error deep: the end
+// reads as tape, and the dock is refused.
+TEST(DockPoseEstimator, ABrightRunAtTheOuterSideOfABareEndReadsAsTape) {
+  const DockProfile code = coded_plate({{0.0, 0.10}});  // the bare end: 0.10-0.30 m
+  const Truth t = simulate(code, 1.0, 0.0, 0.0, ld06(0.002), 4);
+  g_est.configure(code, EstimatorParams{});
+  g_est.set_intensity_usable(true);
+  const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_TRUE(clean.found);
+  PlacedProfile placed;
+  placed.place(code, t.dock_in_lidar);
+  const ScanView v = g_scan.view();
+  // Light the end's outermost beam inside its margins and every beam past it: one bright beam in the end's
+  // dozen, next to another bright one, within a few millimetres of the end's margin.
+  Real outer_s = 0;
+  std::size_t outer = v.count;
+  for (std::size_t i = 0; i < v.count; ++i) {
+    const Real a = v.angle_rad(i);
+    const Vec2 dir(std::cos(a), std::sin(a));
+    Real r = 0;
+    std::size_t seg = 0;
+    if (!placed.raycast(dir, &r, &seg) || seg != 1) continue;
+    const Real s = placed.along_m(1, r * dir);
+    const Real edge = static_cast<Real>(0.005) + static_cast<Real>(0.5) * r * v.angle_increment_rad;
+    if (s < static_cast<Real>(0.30) - edge && s > outer_s) {
+      outer_s = s;
+      outer = i;
+    }
+  }
+  CHECK(outer < v.count);
+  int lit = 0;
+  for (std::size_t i = 0; i < v.count; ++i) {
+    const Real a = v.angle_rad(i);
+    const Vec2 dir(std::cos(a), std::sin(a));
+    Real r = 0;
+    std::size_t seg = 0;
+    if (!placed.raycast(dir, &r, &seg) || seg != 1) continue;
+    if (placed.along_m(1, r * dir) >= outer_s) {
+      g_scan.intensities[i] = 255;
+      ++lit;
+    }
+  }
+  CHECK(lit >= 2);
+  const DockEstimate run = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_FALSE(run.found);
+  CHECK_EQUAL(static_cast<int>(RejectReason::kWrongCode), static_cast<int>(run.reject));
+}
+
 // A reflector dock's stripes are read from the LD06's intensities: the dock with its own stripe pattern gains
 // evidence, the same shape with another pattern (another dock's code) or without tape loses so much that it is
 // refused, and without usable intensity the decision is geometric (the cue is 0).

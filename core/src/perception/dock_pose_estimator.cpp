@@ -733,7 +733,10 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
               if (s >= gap_from + edge_m && s <= st.from_m - edge_m) {
                 ++gap_n[q];
                 if (bright) ++gap_bright[q];
-                if (s >= gap_from + deep_m && s <= st.from_m - deep_m) in_gap = &gap_run[q];
+                // A segment's bare start has no stripe of this code before it to spill over: the margin there is
+                // the edge's alone.
+                const Real from_deep_m = gap_from + (last < kMaxReflectors ? deep_m : edge_m);
+                if (s >= from_deep_m && s <= st.from_m - deep_m) in_gap = &gap_run[q];
               }
               placed_in_region = true;
             } else if (s <= st.to_m) {
@@ -749,7 +752,8 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
               s <= len - edge_m) {
             ++after_n[last];
             if (bright) ++after_bright[last];
-            if (s >= profile_.reflectors[last].to_m + deep_m && s <= len - deep_m) in_gap = &after_run[last];
+            // Nor has a bare end a stripe of this code after it: only the edge margin keeps a run off its end.
+            if (s >= profile_.reflectors[last].to_m + deep_m) in_gap = &after_run[last];
           }
           if (bright && run_prev_bright && seg == run_prev_seg) {
             if (in_gap != nullptr) *in_gap = true;
