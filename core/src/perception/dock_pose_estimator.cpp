@@ -798,14 +798,13 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   }
   if (read_stripes) {
     // A stripe reads as tape when three quarters of its beams or more are bright, as bare when under half are, and
-    // neither way in between. A gap reads bare when at most a
-    // quarter of its beams are bright, as tape when two or more and over a quarter are; one bright beam among
-    // fewer than four is either a glint or another dock's stripe seen by one beam, so that gap is not read. The code
-    // is read only when every stripe and every gap between stripes of kMinRegionM or more is: one with no beam well
-    // inside it (too narrow for the range, hidden) or read neither way leaves the pattern unknown, and a pattern
-    // known in part could be another dock's. A bare end of a segment is needed only where it is wide enough at this
-    // pose to hold a beam inside its margins (a margin the tape was kept off a corner is no part of the code at
-    // range).
+    // neither way in between. A gap reads bare when at most a quarter of its beams are bright, as tape when two or
+    // more and over a quarter are; one bright beam among fewer than four is either a glint or another dock's stripe
+    // seen by one beam, so that gap is not read. The code is read only when every stripe and every gap between
+    // stripes of kMinRegionM or more is: one with no beam well inside it (too narrow for the range, hidden) or read
+    // neither way leaves the pattern unknown, and a pattern known in part could be another dock's. A bare end of a
+    // segment is needed only where it is wide enough at this pose to hold a beam inside its margins (a margin the
+    // tape was kept off a corner is no part of the code at range).
     auto read = [&](std::uint16_t n, std::uint16_t bright, bool tape_expected, bool needed, bool run) {
       bool reads_tape = 2 * bright >= n;
       // A stripe with over a quarter of its beams dark is lit in part: another code's stripe half over it, or
