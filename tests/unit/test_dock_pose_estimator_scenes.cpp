@@ -295,6 +295,22 @@ double cue(const DockEstimate& e, EvidenceCue c) {
   return static_cast<double>(e.evidence.cue_nats[static_cast<std::size_t>(c)]);
 }
 
+/// Where beam `i` of `v` meets the taped face (segment 1) of `placed`: its range and its place along the face (m);
+/// false when it meets another segment or none.
+bool on_taped_face(const PlacedProfile& placed, const ScanView& v, std::size_t i, Real* range_m, Real* along_m) {
+  const Real a = v.angle_rad(i);
+  const Vec2 dir(std::cos(a), std::sin(a));
+  std::size_t seg = 0;
+  if (!placed.raycast(dir, range_m, &seg) || seg != 1) return false;
+  *along_m = placed.along_m(1, *range_m * dir);
+  return true;
+}
+
+/// The estimator's margin inside a code region's edges (m): 5 mm + `extra_m` + half a beam's footprint at `range_m`.
+Real edge_margin_m(const ScanView& v, Real range_m, Real extra_m) {
+  return static_cast<Real>(0.005) + extra_m + static_cast<Real>(0.5) * range_m * v.angle_increment_rad;
+}
+
 }  // namespace
 
 // A gap seen by one beam that reads bright is a glint or another dock's stripe: the pattern is then not known whole,
@@ -347,13 +363,9 @@ TEST(DockPoseEstimator, ABrightBeamOnANarrowBareEndLeavesTheCodeUnread) {
     std::size_t inside = 0;
     std::size_t beam = 0;
     for (std::size_t i = 0; i < v.count; ++i) {
-      const Real a = v.angle_rad(i);
-      const Vec2 dir(std::cos(a), std::sin(a));
-      Real r = 0;
-      std::size_t seg = 0;
-      if (!placed.raycast(dir, &r, &seg) || seg != 1) continue;
-      const Real s = placed.along_m(1, r * dir);
-      const Real edge = static_cast<Real>(0.007) + static_cast<Real>(0.5) * r * v.angle_increment_rad;
+      Real r = 0, s = 0;
+      if (!on_taped_face(placed, v, i, &r, &s)) continue;
+      const Real edge = edge_margin_m(v, r, static_cast<Real>(0.002));
       if (s > static_cast<Real>(0.26) + edge && s < static_cast<Real>(0.30) - edge) {
         ++inside;
         beam = i;
@@ -389,13 +401,9 @@ TEST(DockPoseEstimator, AStripeLitInPartLeavesTheCodeUnread) {
   int inside = 0;
   int dark = 0;
   for (std::size_t i = 0; i < v.count; ++i) {
-    const Real a = v.angle_rad(i);
-    const Vec2 dir(std::cos(a), std::sin(a));
-    Real r = 0;
-    std::size_t seg = 0;
-    if (!placed.raycast(dir, &r, &seg) || seg != 1) continue;
-    const Real s = placed.along_m(1, r * dir);
-    const Real edge = static_cast<Real>(0.005) + static_cast<Real>(0.5) * r * v.angle_increment_rad;
+    Real r = 0, s = 0;
+    if (!on_taped_face(placed, v, i, &r, &s)) continue;
+    const Real edge = edge_margin_m(v, r, 0);
     if (s > static_cast<Real>(0.10) + edge && s < static_cast<Real>(0.20) - edge) ++inside;
     if (s < static_cast<Real>(0.1375)) {
       g_scan.intensities[i] = 0;
@@ -427,13 +435,9 @@ TEST(DockPoseEstimator, ABrightRunAtTheOuterSideOfABareEndReadsAsTape) {
   Real outer_s = 0;
   std::size_t outer = v.count;
   for (std::size_t i = 0; i < v.count; ++i) {
-    const Real a = v.angle_rad(i);
-    const Vec2 dir(std::cos(a), std::sin(a));
-    Real r = 0;
-    std::size_t seg = 0;
-    if (!placed.raycast(dir, &r, &seg) || seg != 1) continue;
-    const Real s = placed.along_m(1, r * dir);
-    const Real edge = static_cast<Real>(0.005) + static_cast<Real>(0.5) * r * v.angle_increment_rad;
+    Real r = 0, s = 0;
+    if (!on_taped_face(placed, v, i, &r, &s)) continue;
+    const Real edge = edge_margin_m(v, r, 0);
     if (s < static_cast<Real>(0.30) - edge && s > outer_s) {
       outer_s = s;
       outer = i;
@@ -442,12 +446,9 @@ TEST(DockPoseEstimator, ABrightRunAtTheOuterSideOfABareEndReadsAsTape) {
   CHECK(outer < v.count);
   int lit = 0;
   for (std::size_t i = 0; i < v.count; ++i) {
-    const Real a = v.angle_rad(i);
-    const Vec2 dir(std::cos(a), std::sin(a));
-    Real r = 0;
-    std::size_t seg = 0;
-    if (!placed.raycast(dir, &r, &seg) || seg != 1) continue;
-    if (placed.along_m(1, r * dir) >= outer_s) {
+    Real r = 0, s = 0;
+    if (!on_taped_face(placed, v, i, &r, &s)) continue;
+    if (s >= outer_s) {
       g_scan.intensities[i] = 255;
       ++lit;
     }
