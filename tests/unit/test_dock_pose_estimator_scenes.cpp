@@ -306,6 +306,19 @@ bool on_taped_face(const PlacedProfile& placed, const ScanView& v, std::size_t i
   return true;
 }
 
+/// Simulates `code` straight ahead at `range_m` (LD06, σ 2 mm, `seed`) into g_scan, configures g_est for it with the
+/// intensity usable, checks the untouched scan finds it, and returns the dock placed at its true pose.
+PlacedProfile found_coded_dock(const DockProfile& code, double range_m, int seed) {
+  const Truth t = simulate(code, range_m, 0.0, 0.0, ld06(0.002), seed);
+  g_est.configure(code, EstimatorParams{});
+  g_est.set_intensity_usable(true);
+  const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_TRUE(clean.found);
+  PlacedProfile placed;
+  placed.place(code, t.dock_in_lidar);
+  return placed;
+}
+
 /// The estimator's margin inside a code region's edges (m): 5 mm + `extra_m` + half a beam's footprint at `range_m`.
 Real edge_margin_m(const ScanView& v, Real range_m, Real extra_m) {
   return static_cast<Real>(0.005) + extra_m + static_cast<Real>(0.5) * range_m * v.angle_increment_rad;
@@ -389,13 +402,7 @@ TEST(DockPoseEstimator, ABrightBeamOnANarrowBareEndLeavesTheCodeUnread) {
 // or the pose is off along the face by part of a region: it reads neither way, and the code is unread.
 TEST(DockPoseEstimator, AStripeLitInPartLeavesTheCodeUnread) {
   const DockProfile code = coded_plate({{0.10, 0.20}});
-  const Truth t = simulate(code, 0.5, 0.0, 0.0, ld06(0.002), 7);
-  g_est.configure(code, EstimatorParams{});
-  g_est.set_intensity_usable(true);
-  const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
-  CHECK_TRUE(clean.found);
-  PlacedProfile placed;
-  placed.place(code, t.dock_in_lidar);
+  const PlacedProfile placed = found_coded_dock(code, 0.5, 7);
   const ScanView v = g_scan.view();
   // Darken the stripe's first 3.75 cm: about a third of the beams well inside it.
   int inside = 0;
@@ -422,13 +429,7 @@ TEST(DockPoseEstimator, AStripeLitInPartLeavesTheCodeUnread) {
 // reads as tape, and the dock is refused.
 TEST(DockPoseEstimator, ABrightRunAtTheOuterSideOfABareEndReadsAsTape) {
   const DockProfile code = coded_plate({{0.0, 0.10}});  // the bare end: 0.10-0.30 m
-  const Truth t = simulate(code, 1.0, 0.0, 0.0, ld06(0.002), 4);
-  g_est.configure(code, EstimatorParams{});
-  g_est.set_intensity_usable(true);
-  const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
-  CHECK_TRUE(clean.found);
-  PlacedProfile placed;
-  placed.place(code, t.dock_in_lidar);
+  const PlacedProfile placed = found_coded_dock(code, 1.0, 4);
   const ScanView v = g_scan.view();
   // Light the end's outermost beam inside its margins and every beam past it: one bright beam in the end's
   // dozen, next to another bright one, within a few millimetres of the end's margin.
