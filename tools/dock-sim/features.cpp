@@ -49,14 +49,14 @@ void print_row(const char* label, const char* profile, const std::string& kind, 
               static_cast<double>(f.wall_seen), static_cast<double>(f.wall_missed), static_cast<double>(f.constraint));
 }
 
-struct Options {
+struct FeaturesOptions {
   int positives = 6000;
   std::uint64_t seed = 11;
   std::string realdata_dir;
   std::vector<std::string> recordings;  // empty: none (positives only)
 };
 
-int run_positives(const Options& o, dockcore::DockPoseEstimator& est, dockcore::LaserScan& scan) {
+int run_positives(const FeaturesOptions& o, dockcore::DockPoseEstimator& est, dockcore::LaserScan& scan) {
   const char* profiles[] = {"plate-v", "v-marker", "breakpoint"};
   const char* lidars[] = {"ld06", "rplidar-a1", "industrial"};
   const char* kinds[] = {"flush", "gap", "glass", "free", "clutter"};
@@ -102,7 +102,7 @@ int run_positives(const Options& o, dockcore::DockPoseEstimator& est, dockcore::
   return 0;
 }
 
-int run_negatives(const Options& o, dockcore::DockPoseEstimator& est, dockcore::LaserScan& scan) {
+int run_negatives(const FeaturesOptions& o, dockcore::DockPoseEstimator& est, dockcore::LaserScan& scan) {
   const docksim::RealDataLocation loc = docksim::locate_realdata(o.realdata_dir);
   if (!loc.found()) {
     std::fprintf(stderr, "dock-sim features: %s; no negatives written\n", loc.describe().c_str());
@@ -138,7 +138,7 @@ int run_negatives(const Options& o, dockcore::DockPoseEstimator& est, dockcore::
 }  // namespace
 
 void register_features(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<FeaturesOptions>();
   auto names = std::make_shared<std::string>();
   CLI::App* sub = app.add_subcommand(
       "features", "Decision features of labelled candidates as CSV (simulated docks, real dock-less scans), for "

@@ -8,12 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "angles.hpp"
 #include "docksim/sim_run.hpp"
 
 namespace docksim_cli {
-
-/// Degrees per radian, for printed figures.
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 /// v rounded to 1e-6, so JSON figures carry no float noise beyond what is measured. O(1).
 double r6(double v);

@@ -14,7 +14,7 @@
 namespace docksim_cli {
 namespace {
 
-struct Options {
+struct ParamsOptions {
   std::string table;
   std::string file_kind = "scenario";
   std::vector<std::string> update, check;
@@ -29,7 +29,7 @@ bool read_text(const std::string& path, std::string& out) {
   return !in.bad();
 }
 
-int run(const Options& o) {
+int run(const ParamsOptions& o) {
   if (o.update.empty() && o.check.empty()) {
     if (o.table.empty()) {
       std::fprintf(stderr, "dock-sim params: give --table, --update or --check\n");
@@ -82,7 +82,7 @@ int run(const Options& o) {
 }  // namespace
 
 void register_params(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<ParamsOptions>();
   CLI::App* sub = app.add_subcommand(
       "params",
       "The parameter table every dockd config and scenario key of dockcore's core structs comes from: print one "

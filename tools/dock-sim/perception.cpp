@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "angles.hpp"
 #include "commands.hpp"
 #include "detectors.hpp"
 #include "dockcore/control/controllers.hpp"
@@ -40,12 +41,11 @@ using dockcore::Pose2;
 using dockcore::Real;
 using json = nlohmann::ordered_json;
 
-constexpr double kDeg = dockcore::kPi / 180.0;
 const double kBandEdges[] = {0.3, 0.6, 1.0, 1.5, 2.0, 2.5};
 constexpr int kBands = 5;
 constexpr int kConfirmScans = 3;
 
-struct Options {
+struct PerceptionOptions {
   std::vector<std::string> profiles{"plate-v", "v-marker", "breakpoint"};
   std::vector<std::string> lidars{"ld06", "rplidar-a1", "industrial"};
   std::vector<double> sigmas{0.005, 0.010, 0.020};
@@ -173,7 +173,7 @@ struct Progress {
 
 // ---------------------------------------------------------------- accuracy over the full grid
 
-json run_accuracy(const Options& o) {
+json run_accuracy(const PerceptionOptions& o) {
   json out = json::array();
   auto scene = std::make_unique<Scene>();
   for (const auto& pname : o.profiles) {
@@ -222,7 +222,7 @@ json run_accuracy(const Options& o) {
 
 // ---------------------------------------------------------------- the perception targets
 
-json run_targets(const Options& o) {
+json run_targets(const PerceptionOptions& o) {
   json out;
   const double sigma = 0.010;
   const docksim::LidarModel m = lidar("ld06", sigma);
@@ -303,7 +303,7 @@ json run_targets(const Options& o) {
 
 // ---------------------------------------------------------------- false positives
 
-json run_false_positives(const Options& o) {
+json run_false_positives(const PerceptionOptions& o) {
   json out;
   auto scan = std::make_unique<dockcore::LaserScan>();
   const double sigma = 0.010;
@@ -370,7 +370,7 @@ json run_false_positives(const Options& o) {
 
 // ---------------------------------------------------------------- cost
 
-json run_cost(const Options& o) {
+json run_cost(const PerceptionOptions& o) {
   json out;
   const dockcore::DockProfile prof = docksim::resolve_profile(o.profiles.front());
   docksim::LidarModel m = lidar("ld06", 0.010);
@@ -454,7 +454,7 @@ constexpr double kTargetSingleFpPct = 1.0;
 constexpr double kTargetConfirmedFpPct = 0.05;
 constexpr double kTargetCompositePct = 98.0;
 
-double pct(std::size_t num, std::size_t den) {
+double percent_of(std::size_t num, std::size_t den) {
   return den ? 100.0 * static_cast<double>(num) / static_cast<double>(den) : 0.0;
 }
 
@@ -470,7 +470,7 @@ struct RealData {
   json load_json;  // one entry per recording: scans, skipped lines, pose match
 };
 
-std::unique_ptr<RealData> load_real_data(const Options& o) {
+std::unique_ptr<RealData> load_real_data(const PerceptionOptions& o) {
   auto d = std::make_unique<RealData>();
   d->where = docksim::locate_realdata(o.realdata_dir);
   // The tables say where it looked; with --json the document does, and stderr tells the person running it.
@@ -540,7 +540,7 @@ json rejections_json(const dockcore::EstimatorCounters& c) {
   return rej;
 }
 
-json run_real_fp(const Options& o, const RealData& d) {
+json run_real_fp(const PerceptionOptions& o, const RealData& d) {
   json out;
   out["data"] = location_json(d.where);
   if (!d.where.found()) return out;
@@ -588,13 +588,13 @@ json run_real_fp(const Options& o, const RealData& d) {
       row["sigma_mm"] = rec.info->sigma_m * 1000;
       row["scans"] = r.scans;
       row["found"] = r.found;
-      row["fp_pct"] = pct(r.found, r.scans);
+      row["fp_pct"] = percent_of(r.found, r.scans);
       row["confirm_frame"] = docksim::to_string(r.frame);
       if (r.frame != docksim::ConfirmFrame::kNone) {
         row["windows"] = r.windows;
         row["attempts"] = r.attempts;
         row["confirmed"] = r.confirmed;
-        row["confirmed_pct"] = pct(r.confirmed, r.windows);
+        row["confirmed_pct"] = percent_of(r.confirmed, r.windows);
         row["confirmed_sequential"] = r.confirmed_sequential;
       } else {
         row["windows"] = nullptr;
@@ -621,17 +621,18 @@ json run_real_fp(const Options& o, const RealData& d) {
       confirmed_seq += r.confirmed_sequential;
       pr.tick();
     }
-    totals.push_back({{"profile", pname},
-                      {"scans", scans},
-                      {"found", found},
-                      {"fp_pct", pct(found, scans)},
-                      {"meets_single_target", pct(found, scans) <= kTargetSingleFpPct},
-                      {"windows", windows},
-                      {"confirmed", confirmed},
-                      {"confirmed_pct", pct(confirmed, windows)},
-                      {"confirmed_sequential", confirmed_seq},
-                      {"confirmed_sequential_pct", pct(confirmed_seq, windows)},
-                      {"meets_confirmed_target", windows > 0 && pct(confirmed, windows) <= kTargetConfirmedFpPct}});
+    totals.push_back(
+        {{"profile", pname},
+         {"scans", scans},
+         {"found", found},
+         {"fp_pct", percent_of(found, scans)},
+         {"meets_single_target", percent_of(found, scans) <= kTargetSingleFpPct},
+         {"windows", windows},
+         {"confirmed", confirmed},
+         {"confirmed_pct", percent_of(confirmed, windows)},
+         {"confirmed_sequential", confirmed_seq},
+         {"confirmed_sequential_pct", percent_of(confirmed_seq, windows)},
+         {"meets_confirmed_target", windows > 0 && percent_of(confirmed, windows) <= kTargetConfirmedFpPct}});
   }
   out["rows"] = rows;
   out["totals"] = totals;
@@ -640,7 +641,7 @@ json run_real_fp(const Options& o, const RealData& d) {
   return out;
 }
 
-json run_real_composite(const Options& o, const RealData& d) {
+json run_real_composite(const PerceptionOptions& o, const RealData& d) {
   json out;
   out["data"] = location_json(d.where);
   if (!d.where.found()) return out;
@@ -691,7 +692,7 @@ json run_real_composite(const Options& o, const RealData& d) {
                         {"detected", r.detected},
                         {"wrong", r.wrong},
                         {"missed", r.missed},
-                        {"detection_pct", r.placed ? json(pct(r.detected, r.placed)) : json(nullptr)},
+                        {"detection_pct", r.placed ? json(percent_of(r.detected, r.placed)) : json(nullptr)},
                         {"pos_mm_p95", mm(r.pos_err_m)},
                         {"yaw_deg_p95", dg(r.yaw_err_rad)},
                         {"wrong_pos_mm_median", mm50(r.wrong_pos_err_m)},
@@ -712,8 +713,8 @@ json run_real_composite(const Options& o, const RealData& d) {
                         {"detected", all.detected},
                         {"wrong", all.wrong},
                         {"missed", all.missed},
-                        {"detection_pct", all.placed ? json(pct(all.detected, all.placed)) : json(nullptr)},
-                        {"meets_target", all.placed > 0 && pct(all.detected, all.placed) >= kTargetCompositePct},
+                        {"detection_pct", all.placed ? json(percent_of(all.detected, all.placed)) : json(nullptr)},
+                        {"meets_target", all.placed > 0 && percent_of(all.detected, all.placed) >= kTargetCompositePct},
                         {"pos_mm_p95", mm(all.pos_err_m)},
                         {"yaw_deg_p95", dg(all.yaw_err_rad)}});
     }
@@ -917,7 +918,7 @@ std::vector<std::string> split_csv(const std::string& s) {
 }  // namespace
 
 void register_perception(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<PerceptionOptions>();
   auto profiles = std::make_shared<std::string>("plate-v,v-marker,breakpoint");
   auto lidars = std::make_shared<std::string>("ld06,rplidar-a1,industrial");
   auto sigmas = std::make_shared<std::string>("5,10,20");

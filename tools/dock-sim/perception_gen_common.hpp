@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "angles.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_profile.hpp"
 #include "docksim/world_gen.hpp"
@@ -20,7 +21,6 @@ namespace docksim_cli::genbench {
 
 using json = nlohmann::ordered_json;
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
 // Target envelope.
 constexpr double kEnvDistanceM = 2.0;
 constexpr double kEnvBearingRad = 45 * kDeg;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "angles.hpp"
 #include "commands.hpp"
 #include "detectors.hpp"
 #include "docksim/cli_checks.hpp"
@@ -28,8 +29,6 @@ using dockcore::Pose2;
 using dockcore::Real;
 using dockcore::Vec2;
 using docksim::SvgStyle;
-
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 const char* const kTrueColour = "#2ca02c";
 const char* const kScanColour = "#1f77b4";
