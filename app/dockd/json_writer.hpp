@@ -38,6 +38,15 @@ class JsonWriter {
   std::size_t mark() const { return ok_ ? len_ : 0; }
   /// Drops everything written after `m` (a mark()) and clears the overflow; nothing for a mark() of 0.
   void rollback(std::size_t m);
+  /// Writes an optional group of fields (`write()` calls this writer) and drops the whole group when it did not fit,
+  /// so the object keeps what came before it. O(bytes written by the group).
+  template <class WriteGroup>
+  JsonWriter& optional_group(WriteGroup&& write) {
+    const std::size_t m = mark();
+    write();
+    if (!ok()) rollback(m);
+    return *this;
+  }
   /// False once a field did not fit (until a rollback).
   bool ok() const { return ok_; }
   /// The fields written so far (after "{"), not terminated; body_len() bytes.

@@ -72,9 +72,7 @@ void write_status(JsonWriter& w, const StatusValues& v) {
       .boolean("dock_confirmed", v.dock_confirmed);
   // The counters are the status's widest group (up to 20 digits each): left out whole when they do not fit, so the
   // task, the dock and the detection always reach the host. The counters part always carries them.
-  const std::size_t m = w.mark();
-  write_counters(w, v);
-  if (!w.ok()) w.rollback(m);
+  w.optional_group([&] { write_counters(w, v); });
 }
 
 void write_counters(JsonWriter& w, const StatusValues& v) {
@@ -104,9 +102,11 @@ void write_counters(JsonWriter& w, const StatusValues& v) {
 
 void write_camera_groups(JsonWriter& w, const CameraValues& v, bool only_if_fits) {
   const auto group = [&w, only_if_fits](auto&& write) {
-    const std::size_t m = w.mark();
-    write();
-    if (only_if_fits && !w.ok()) w.rollback(m);
+    if (only_if_fits) {
+      w.optional_group(write);
+    } else {
+      write();
+    }
   };
   // The tag fusion's counters (docs/camera.md, "Status").
   if (v.has_tags) {

@@ -34,6 +34,19 @@ TEST(JsonWriter, WritesEveryKindOfFieldAndEscapes) {
   CHECK_EQUAL(static_cast<int>(dockcore::drivers::FlatJsonError::kOk), static_cast<int>(p.parse(flat, fn)));
 }
 
+TEST(JsonWriter, AnOptionalGroupIsKeptWholeOrDroppedWhole) {
+  char buf[40];
+  dockd::JsonWriter w(buf, sizeof buf);
+  w.uint("a", 1);
+  w.optional_group([&] { w.uint("g1", 2).uint("g2", 3); });  // fits: kept
+  // The second field of this group does not fit: the first goes with it, and the writer takes fields again.
+  w.optional_group([&] { w.uint("h1", 4).str("h2", "0123456789012345678901234567890"); });
+  CHECK_TRUE(w.ok());
+  w.uint("z", 5);
+  CHECK_TRUE(w.finish() > 0);
+  STRCMP_EQUAL("{\"a\":1,\"g1\":2,\"g2\":3,\"z\":5}", buf);
+}
+
 TEST(JsonWriter, NeverLeavesACutObjectAndRollsBackOptionalGroups) {
   char buf[32];
   dockd::JsonWriter w(buf, sizeof buf);
