@@ -951,7 +951,7 @@ void DockPoseEstimatorBase::decide(Refined& r, const Pose2* hint) {
   }
 }
 
-Real DockPoseEstimatorBase::prescore(const Pose2& pose) {
+Real DockPoseEstimatorBase::prescore(const Pose2& pose, Real floor) {
   placed_.place(profile_, pose);
   Real lo = 0;
   Real hi = 0;
@@ -964,7 +964,13 @@ Real DockPoseEstimatorBase::prescore(const Pose2& pose) {
   // look at all of them. Each ray counts for the beams it stands for, so near and far hypotheses compare fairly.
   const std::size_t step = n_beams > 2 * kPrescoreRays ? n_beams / kPrescoreRays : 2;
   const Real per_ray = static_cast<Real>(step) * R(0.5);
-  for (std::size_t k = 0; k < n_beams && k < beams_; k += step) {
+  const std::size_t limit = n_beams < beams_ ? n_beams : beams_;
+  // The most the rays still to cast can add. Scores are multiples of a half, so the comparison is exact.
+  const std::size_t rays = (limit + step - 1) / step;
+  Real reachable = static_cast<Real>(rays) * per_ray;
+  for (std::size_t k = 0; k < limit; k += step) {
+    if (score + reachable < floor) return score + reachable;
+    reachable -= per_ray;
     std::size_t i = 0;
     if (!beam_at(first, k, &i)) continue;
     Real expected_m = 0;
@@ -994,8 +1000,17 @@ void DockPoseEstimatorBase::push_hypothesis(const Vec2& n_scan, const Vec2& anch
     return;
   }
   hyps_[*n].pose = Pose2{t.x(), t.y(), yaw};
-  hyps_[*n].prescore = prescore(hyps_[*n].pose);
+  // Only the best max_candidates are refined: a hypothesis that cannot reach the current last of them needs no
+  // exact score (it stays below that one, which only rises).
+  const std::size_t keep = params_.max_candidates;
+  const bool full = keep <= kMaxRanked && n_ranked_ == keep;
+  const Real score = prescore(hyps_[*n].pose, full ? ranked_[keep - 1] : -std::numeric_limits<Real>::infinity());
+  hyps_[*n].prescore = score;
   ++*n;
+  if (keep > kMaxRanked || (full && !(score > ranked_[keep - 1]))) return;
+  std::size_t pos = full ? keep - 1 : n_ranked_++;
+  for (; pos > 0 && ranked_[pos - 1] < score; --pos) ranked_[pos] = ranked_[pos - 1];
+  ranked_[pos] = score;
 }
 
 namespace {
@@ -1155,6 +1170,7 @@ void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
 std::size_t DockPoseEstimatorBase::generate_candidates() {
   build_points();
   std::size_t n = 0;
+  n_ranked_ = 0;
   add_window_hypotheses(&n);
   const SegmentStats stats = extract_line_segments(points_, angle_inc_rad_, wraps_, params_.segments, segs_);
   if (stats.truncated()) ++counters_.truncated_segments;

@@ -343,7 +343,9 @@ class DockPoseEstimatorBase {
   /// Robust where split-and-merge merges a short wing into the face. O(points · long profile segments).
   void add_window_hypotheses(std::size_t* n);
   /// Rough support of a hypothesis: +1 per matching beam, -2 per beam seeing through the dock (every other beam).
-  Real prescore(const Pose2& pose);
+  /// Stops early, returning a bound below `floor`, once the score can no longer reach `floor`: a hypothesis that
+  /// ranks below the best max_candidates needs no exact score.
+  Real prescore(const Pose2& pose, Real floor);
   /// The wall cue's counts: of the beams just outside [k_first_hit, k_last_hit] (offsets from `first`, up to 3 per
   /// side) that could meet a wall behind the dock, how many do where the mounting's gap range puts it.
   /// Precondition: placed_ holds the profile placed at `pose`.
@@ -356,6 +358,8 @@ class DockPoseEstimatorBase {
 
   /// Hypotheses collected per scan before ranking; beyond this they are counted as truncated.
   static constexpr std::size_t kMaxHypotheses = 128;
+  /// Most prescores ranked_ holds: with more candidates than this, every prescore is exact.
+  static constexpr std::size_t kMaxRanked = 64;
   struct Hypothesis {
     Pose2 pose{};       // dock in lidar frame
     Real prescore = 0;
@@ -394,6 +398,10 @@ class DockPoseEstimatorBase {
   bool wraps_ = false;
   PlacedProfile placed_{};
   Hypothesis hyps_[kMaxHypotheses];
+  // This scan's best max_candidates prescores so far, best first: the last one is the floor a new hypothesis must
+  // reach to be refined.
+  Real ranked_[kMaxRanked] = {};
+  std::size_t n_ranked_ = 0;
   static_assert(kMaxProfileVertices < 255, "association segments are 8 bits with 0xFF for none");
 };
 
