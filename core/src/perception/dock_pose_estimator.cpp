@@ -469,13 +469,19 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
     Real g2 = 0;
     std::uint16_t used = 0;
     Real sum_sq = 0;
+    // The buffers through locals: a byte store (the association) may alias any member, so members read in the loop
+    // would be loaded again for every beam.
+    const Real* const ranges = ranges_m_;
+    const Vec2* const dirs = dir_;
+    const std::uint16_t* const beams = assoc_beam_;
+    std::uint8_t* const segs = assoc_seg_;
     for (std::size_t k = 0; k < n_assoc; ++k) {
-      const std::size_t i = assoc_beam_[k];
-      const Vec2 p = ranges_m_[i] * dir_[i];  // span_beams() kept only returns within range
+      const std::size_t i = beams[k];
+      const Vec2 p = ranges[i] * dirs[i];  // span_beams() kept only returns within range
       // Its segment in the previous iteration, or (after a full pass) the neighbouring beam's, just found: the
       // shortcut below holds whatever segment it is tried on.
-      std::size_t seg = assoc_seg_[k];
-      if (seg == kNoSegment && k > 0) seg = assoc_seg_[k - 1];
+      std::size_t seg = segs[k];
+      if (seg == kNoSegment && k > 0) seg = segs[k - 1];
       Real dist = 0;
       Real e = 0;
       // A point beyond a segment's end (overhang) belongs to whatever adjoins the dock, e.g. the wall behind it.
@@ -488,13 +494,13 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
         continue;
       }
       // Remembered even when refused now: a beam just outside the gate may come in at the next pose.
-      assoc_seg_[k] = static_cast<std::uint8_t>(seg);
+      segs[k] = static_cast<std::uint8_t>(seg);
       if (dist > gate || overhang > kOverhangM) continue;
       const Vec2& n = placed_.n[seg];
       // Work in range units: the lidar's noise is along the beam, so a residual of e across the surface is a range
       // error of e / cos(incidence). Weighting by that is the maximum-likelihood fit (and what the Cramér–Rao bound
       // assumes); plain point-to-line would under-use oblique surfaces such as wings. Capped at 78° incidence.
-      Real cos_inc = std::fabs(n.dot(dir_[i]));
+      Real cos_inc = std::fabs(n.dot(dirs[i]));
       cos_inc = cos_inc > kMinCosIncidence ? cos_inc : kMinCosIncidence;
       const Real inv_cos = 1 / cos_inc;
       e *= inv_cos;
@@ -580,19 +586,28 @@ std::size_t DockPoseEstimatorBase::span_beams(Real dist_m, const Vec2& t, const 
   const Real band_hi = back_x_m_ + params_.inlier_gate_m;
   const Real band_lo = back_x_m_ - wall_gap_max_m_ - params_.inlier_gate_m;
   std::size_t n = 0;
-  for (std::size_t k = 0; k < n_beams && k < beams_; ++k) {
+  // Members through locals: the byte stores below may alias any of them (see refine()).
+  const Real* const ranges = ranges_m_;
+  const Vec2* const dirs = dir_;
+  std::uint16_t* const beams = assoc_beam_;
+  std::uint8_t* const segs = assoc_seg_;
+  const Real min_m = params_.min_range_m;
+  const Real max_m = params_.max_range_m;
+  const Real half_width_m = half_width_m_;
+  const std::size_t limit = n_beams < beams_ ? n_beams : beams_;
+  for (std::size_t k = 0; k < limit; ++k) {
     std::size_t i = 0;
     if (!beam_at(first, k, &i)) continue;
-    const Real r = range_at(i);
-    if (r == 0) continue;
+    const Real r = ranges[i];  // as range_at()
+    if (!(is_valid_range(r) && r >= min_m && r <= max_m)) continue;
     if (wall_mounted) {
-      const Vec2 pt = r * dir_[i] - t;
+      const Vec2 pt = r * dirs[i] - t;
       const Real qx = nd.dot(pt);
       const Real qy = nd.x() * pt.y() - nd.y() * pt.x();
-      if (std::fabs(qy) > half_width_m_ && qx < band_hi && qx > band_lo) continue;
+      if (std::fabs(qy) > half_width_m && qx < band_hi && qx > band_lo) continue;
     }
-    assoc_beam_[n] = static_cast<std::uint16_t>(i);
-    assoc_seg_[n] = kNoSegment;
+    beams[n] = static_cast<std::uint16_t>(i);
+    segs[n] = kNoSegment;
     ++n;
   }
   return n;
