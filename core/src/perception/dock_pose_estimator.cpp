@@ -303,7 +303,6 @@ bool DockPoseEstimatorBase::load_scan(const ScanView& scan) {
   wraps_ = scan.wraps();
   ranges_m_ = scan.ranges_m;
   intensities_ = scan.intensities;
-  valid_beams_counted_ = false;
   // A lidar's scans keep their geometry from turn to turn: the beam directions are computed again only when it
   // changes, so a tracking scan reads just the beams near the dock.
   if (dir_beams_ == beams_ && dir_angle_min_rad_ == angle_min_rad_ && dir_angle_inc_rad_ == angle_inc_rad_) return true;
@@ -325,15 +324,6 @@ bool DockPoseEstimatorBase::load_scan(const ScanView& scan) {
   dir_angle_min_rad_ = angle_min_rad_;
   dir_angle_inc_rad_ = angle_inc_rad_;
   return true;
-}
-
-std::size_t DockPoseEstimatorBase::valid_beams() {
-  if (!valid_beams_counted_) {
-    valid_beams_ = 0;
-    for (std::size_t i = 0; i < beams_; ++i) valid_beams_ += range_at(i) != 0 ? 1u : 0u;
-    valid_beams_counted_ = true;
-  }
-  return valid_beams_;
 }
 
 void DockPoseEstimatorBase::build_points() {
@@ -594,10 +584,18 @@ std::size_t DockPoseEstimatorBase::span_beams(Real dist_m, const Vec2& t, const 
   const Real min_m = params_.min_range_m;
   const Real max_m = params_.max_range_m;
   const Real half_width_m = half_width_m_;
-  const std::size_t limit = n_beams < beams_ ? n_beams : beams_;
-  for (std::size_t k = 0; k < limit; ++k) {
-    std::size_t i = 0;
-    if (!beam_at(first, k, &i)) continue;
+  // The beams first + k for k below n_beams, as beam_at() gives them: consecutive indices, wrapped on a full-turn
+  // scan, cut at a partial scan's ends.
+  std::size_t k_begin = 0;
+  std::size_t k_end = n_beams < beams_ ? n_beams : beams_;
+  if (!wraps_) {
+    const long room = static_cast<long>(beams_) - first;  // beams from `first` to the scan's end
+    if (first < 0) k_begin = static_cast<std::size_t>(-first);
+    if (room < static_cast<long>(k_end)) k_end = room > 0 ? static_cast<std::size_t>(room) : 0;
+  }
+  std::size_t i = 0;
+  if (k_begin < k_end) beam_at(first, k_begin, &i);
+  for (std::size_t k = k_begin; k < k_end; ++k, i = i + 1 == beams_ ? 0 : i + 1) {
     const Real r = ranges[i];  // as range_at()
     if (!(is_valid_range(r) && r >= min_m && r <= max_m)) continue;
     if (wall_mounted) {
@@ -1183,7 +1181,6 @@ void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
 }
 
 std::size_t DockPoseEstimatorBase::generate_candidates() {
-  build_points();
   std::size_t n = 0;
   n_ranked_ = 0;
   add_window_hypotheses(&n);
@@ -1274,9 +1271,13 @@ DockEstimate DockPoseEstimatorBase::estimate(const ScanView& scan, const Pose2& 
   }
   const bool hint_holds = hint != nullptr && hinted.ok &&
                           dist2(hinted.pose, hint_lidar) <= params_.hint_gate_m * params_.hint_gate_m;
-  if (!hint_holds && valid_beams() < params_.min_inliers) {
-    est.status = EstimateStatus::kNoPoints;
-    return est;
+  // The global search's points are its count of valid returns.
+  if (!hint_holds) {
+    build_points();
+    if (points_.size() < params_.min_inliers) {
+      est.status = EstimateStatus::kNoPoints;
+      return est;
+    }
   }
 
   Refined best{};

@@ -293,9 +293,7 @@ class DockPoseEstimatorBase {
     const Real r = ranges_m_[i];
     return is_valid_range(r) && r >= params_.min_range_m && r <= params_.max_range_m ? r : 0;
   }
-  /// Number of beams with range_at() != 0, counted once per scan on first use. O(B) the first time.
-  std::size_t valid_beams();
-  /// Fills points_ from the loaded beams (global search only).
+  /// Fills points_ from the loaded beams (global search only): one per beam with range_at() != 0. O(B).
   void build_points();
   /// Gauss-Newton registration from `initial` (dock in lidar frame). `rough`: the start may be centimetres off (a
   /// global-search hypothesis), so large steps fit a sample of a dense span; a hint refines on every beam from the
@@ -331,8 +329,8 @@ class DockPoseEstimatorBase {
     *index = static_cast<std::size_t>(i);
     return true;
   }
-  /// Fills hyps_ with ranked pose hypotheses from scan line segments and sliding-window line fits; returns how many
-  /// to refine.
+  /// Fills hyps_ with ranked pose hypotheses from scan line segments and sliding-window line fits (points_ already
+  /// built); returns how many to refine.
   std::size_t generate_candidates();
   /// Appends the hypothesis that puts profile segment `profile_segment` (normal facing the lidar along n_scan) with
   /// its point anchor_dock (dock frame) onto anchor_scan (lidar frame). Counts truncation at kMaxHypotheses.
@@ -391,8 +389,6 @@ class DockPoseEstimatorBase {
   Real dir_angle_min_rad_ = 0;
   Real dir_angle_inc_rad_ = 0;
   std::size_t beams_ = 0;
-  std::size_t valid_beams_ = 0;
-  bool valid_beams_counted_ = false;
   Real angle_min_rad_ = 0;
   Real angle_inc_rad_ = 0;
   bool wraps_ = false;
