@@ -97,6 +97,54 @@ TEST(DockPoseEstimator, CovarianceAboveTheLimitIsRefusedAsUncertain) {
 
 namespace {
 
+// Fills g_scan (count beams from angle_min_rad, 0.8° apart) with the noise-free returns of `prof` placed at `dock`.
+void cast_dock(const DockProfile& prof, const Pose2& dock, std::size_t count, Real angle_min_rad) {
+  static PlacedProfile pp;
+  pp.place(prof, dock);
+  g_scan.reset(count, angle_min_rad, deg_to_rad(0.8), 0);
+  for (std::size_t i = 0; i < count; ++i) {
+    const Real a = g_scan.view().angle_rad(i);
+    Real r = 0;
+    std::size_t seg = 0;
+    if (pp.raycast(Vec2(std::cos(a), std::sin(a)), &r, &seg)) g_scan.ranges_m[i] = r;
+  }
+}
+
+void check_found_at(const DockEstimate& e, const Pose2& truth) {
+  CHECK_TRUE(e.found);
+  DOUBLES_EQUAL(truth.x_m, e.pose.x_m, 0.005);
+  DOUBLES_EQUAL(truth.y_m, e.pose.y_m, 0.005);
+  DOUBLES_EQUAL(0.0, wrap_angle(e.pose.yaw_rad - truth.yaw_rad), 0.01);
+}
+
+}  // namespace
+
+TEST(DockPoseEstimator, GlobalSearchFindsADockAcrossTheWrapOfAFullTurn) {
+  // Behind the lidar: the dock's beams are the scan's last and first, and registration's span runs across the wrap.
+  const DockProfile prof = profile("plate-v");
+  const Pose2 dock = dockcore_test::pose(-1.0, 0.02, 0.1);
+  cast_dock(prof, dock, 450, -kPi);
+  CHECK_TRUE(g_scan.view().wraps());
+  g_est.configure(prof, EstimatorParams{});
+  check_found_at(g_est.estimate(g_scan.view(), Pose2{}), dock);
+}
+
+TEST(DockPoseEstimator, GlobalSearchFindsADockNearEitherEndOfAPartialScan) {
+  // A 180° scan with the dock just inside either end: the spans registration and verification look at (the dock
+  // plus a margin) reach past the scan's ends, where there are no beams.
+  const DockProfile prof = profile("plate-v");
+  for (const Real bearing_deg : {-75.0, 75.0}) {
+    const Real b = deg_to_rad(bearing_deg);
+    const Pose2 dock = dockcore_test::pose(std::cos(b), std::sin(b), b + kPi);
+    cast_dock(prof, dock, 225, -kPi / 2);
+    CHECK_FALSE(g_scan.view().wraps());
+    g_est.configure(prof, EstimatorParams{});
+    check_found_at(g_est.estimate(g_scan.view(), Pose2{}), dock);
+  }
+}
+
+namespace {
+
 // The plain formulas the fast PlacedProfile queries must agree with: a division per segment, no precomputation.
 bool reference_raycast(const PlacedProfile& pp, const Vec2& dir, Real* range_m, std::size_t* segment) {
   bool hit = false;
