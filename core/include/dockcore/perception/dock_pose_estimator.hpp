@@ -357,7 +357,7 @@ class DockPoseEstimatorBase {
   /// Hypotheses collected per scan before ranking; beyond this they are counted as truncated.
   static constexpr std::size_t kMaxHypotheses = 128;
   /// Most prescores ranked_ holds: with more candidates than this, every prescore is exact.
-  static constexpr std::size_t kMaxRanked = 64;
+  static constexpr std::size_t kMaxRanked = 16;
   struct Hypothesis {
     Pose2 pose{};       // dock in lidar frame
     Real prescore = 0;
