@@ -596,8 +596,8 @@ std::size_t DockPoseEstimatorBase::span_beams(Real dist_m, const Vec2& t, const 
   std::size_t i = 0;
   if (k_begin < k_end) beam_at(first, k_begin, &i);
   for (std::size_t k = k_begin; k < k_end; ++k, i = i + 1 == beams_ ? 0 : i + 1) {
-    const Real r = ranges[i];  // as range_at()
-    if (!(is_valid_range(r) && r >= min_m && r <= max_m)) continue;
+    const Real r = usable_range(ranges[i], min_m, max_m);
+    if (r == 0) continue;
     if (wall_mounted) {
       const Vec2 pt = r * dirs[i] - t;
       const Real qx = nd.dot(pt);

@@ -288,11 +288,13 @@ class DockPoseEstimatorBase {
   /// Checks the scan's geometry and takes its ranges (by pointer, valid until estimate() returns); recomputes the
   /// beam directions only when the geometry differs from the last scan's. O(1), or O(B) on a new geometry.
   bool load_scan(const ScanView& scan);
-  /// Range of beam i when it is a return within [min_range_m, max_range_m], else 0. O(1).
-  Real range_at(std::size_t i) const {
-    const Real r = ranges_m_[i];
-    return is_valid_range(r) && r >= params_.min_range_m && r <= params_.max_range_m ? r : 0;
+  /// `r` when it is a return within [min_m, max_m], else 0: the test range_at() applies, for loops that keep the
+  /// limits in locals. O(1).
+  static Real usable_range(Real r, Real min_m, Real max_m) {
+    return is_valid_range(r) && r >= min_m && r <= max_m ? r : 0;
   }
+  /// Range of beam i when it is a return within [min_range_m, max_range_m], else 0. O(1).
+  Real range_at(std::size_t i) const { return usable_range(ranges_m_[i], params_.min_range_m, params_.max_range_m); }
   /// Fills points_ from the loaded beams (global search only): one per beam with range_at() != 0. O(B).
   void build_points();
   /// Gauss-Newton registration from `initial` (dock in lidar frame). `rough`: the start may be centimetres off (a
