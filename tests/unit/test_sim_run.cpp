@@ -519,6 +519,53 @@ TEST(SimRun, ObstacleClearanceIsMeasured) {
   CHECK(r.outcome.min_clearance_m > 0.15 && r.outcome.min_clearance_m < 0.27);
 }
 
+// A passer-by walks across the docking path, 0.8 m in front of the dock, just as the robot gets there: it steps around
+// the robot (never within the give-way distance of its outline), the robot waits or passes, and it docks.
+TEST(SimRun, APasserByStepsAroundTheRobotAndTheRobotDocks) {
+  docksim::Scenario sc = default_scenario();
+  docksim::ScenarioEvent ev;
+  ev.kind = docksim::EventKind::kObstacle;
+  ev.t_s = 2.0;
+  ev.x_m = 0.8;
+  ev.y_m = 1.5;
+  ev.r_m = 0.2;
+  ev.vy_mps = -1.0;
+  ev.duration_s = 3.0;
+  sc.events.push_back(ev);
+  const docksim::StartPose start = docksim::start_from(sc, 1.5, 0, 0);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 5, opt);
+  CHECK(r.outcome.charging_confirmed);
+  CHECK(std::isfinite(r.outcome.min_clearance_m));
+  CHECK(r.outcome.min_clearance_m >= docksim::kPasserGiveWayM - 0.01);
+  CHECK(r.outcome.min_clearance_m < 0.5);  // it did come by
+}
+
+// Furniture where the start envelope would put the robot: every start is drawn again until the robot stands clear.
+TEST(SimRun, StartsAreDrawnClearOfFurniture) {
+  docksim::Scenario sc = default_scenario();
+  docksim::WorldBox b;
+  b.centre = dockcore::Vec2(1.2, 0.0);
+  b.size_x_m = 1.0;
+  b.size_y_m = 1.0;
+  sc.boxes.push_back(b);
+  int redrawn = 0;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    const docksim::StartPose s = docksim::draw_start(sc, seed);
+    const dockcore::Vec2 c =
+        s.robot_world.transform(dockcore::Vec2(static_cast<dockcore::Real>(sc.chassis.footprint.centre_x_m), 0));
+    const double x = static_cast<double>(c.x()), y = static_cast<double>(c.y());
+    // The footprint (0.45 x 0.40 m) holds a disc of 0.2 m about its centre: 0.1 m clear puts that centre 0.3 m from
+    // the box at least.
+    const double dx = std::max(std::abs(x - 1.2) - 0.5, 0.0), dy = std::max(std::abs(y) - 0.5, 0.0);
+    CHECK(std::hypot(dx, dy) >= 0.3);
+    const docksim::StartPose free = docksim::draw_start(default_scenario(), seed);
+    redrawn += free.distance_m != s.distance_m ? 1 : 0;
+  }
+  CHECK(redrawn > 0);
+}
+
 TEST(SimRun, Deterministic) {
   const docksim::Scenario sc = default_scenario();
   const docksim::SimRun a = docksim::run_docking(sc, "smooth", 77);

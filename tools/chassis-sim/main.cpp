@@ -120,6 +120,12 @@ int run(const Options& opt) {
                    opt.scenario_path.c_str(), ev.t_s);
       return 2;
     }
+    if (ev.kind == docksim::EventKind::kObstacle && (ev.vx_mps != 0 || ev.vy_mps != 0)) {
+      // A passer-by gives way to the robot, which needs the true pose on every step of the walk: dock-sim's loop.
+      std::fprintf(stderr, "chassis-sim: %s: a walking obstacle at %.2f s is dock-sim only\n",
+                   opt.scenario_path.c_str(), ev.t_s);
+      return 2;
+    }
     if (ev.after_state) {
       // The task state is dockd's: this program sees only wheel commands, so it cannot time an event on it.
       std::fprintf(stderr, "chassis-sim: %s: an event with in_state at %.2f s is dock-sim only\n",

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -87,7 +88,25 @@ const Factor kFactors[] = {
     {"events", "occlusion_t_s", 0.5, 5.0, "s", "occlusion start after ALIGN began"},
     {"events", "occlusion_s", 0.5, 3.0, "s", "occlusion length"},
     {"robot.motor", "deadband_diff_radps", -0.4, 0.4, "rad/s", "left minus right wheel deadband (not told)"},
+    {"dock", "profile", 0, 1, "", "the dock's shape: the scenario's, or v-marker (seed 004's V)", "scenario's",
+     "v-marker", 0.25},
+    {"dock", "unseen_profile", 0, 1, "", "instead, a shape of its own (profiles/asym-step.toml beside the scenario)",
+     "none", "asym-step", 0.15},
+    {"dock", "clutter", 0, 1, "", "furniture beside the dock", "none", "furniture", 0.3},
+    {"dock", "clutter_kind", 0, 1, "", "the furniture: a 0.4 m box or a round bin (r 0.15 m)", "box", "bin", 0.5},
+    {"dock", "clutter_side", 0, 1, "", "the furniture to the dock's left (+y) or right", "left", "right", 0.5},
+    {"dock", "clutter_gap_m", 0.2, 0.8, "m", "free space between the dock's side and the furniture"},
+    {"events", "passer", 0, 1, "", "a passer-by walks across in front of the dock in ALIGN", "none", "passer", 0.2},
+    {"events", "passer_t_s", 0.0, 6.0, "s", "passer-by start after ALIGN began"},
+    {"events", "passer_side", 0, 1, "", "the passer-by comes from the dock's left or right", "left", "right", 0.5},
+    {"events", "passer_x_m", 0.5, 1.5, "m", "where the passer-by crosses the dock's axis, in front of its face"},
+    {"events", "passer_speed_mps", 0.5, 1.4, "m/s", "walking speed (stands while it would come near the robot)"},
+    {"events", "passer_r_m", 0.15, 0.25, "m", "the passer-by's size (legs and bag as one disc)"},
 };
+/// A run whose robot came closer than this to an obstacle touched it, m.
+constexpr double kTouchM = 0.001;
+/// Where a passer-by starts and stops, m beside the dock's axis.
+constexpr double kPasserReachM = 1.5;
 constexpr std::size_t kFactorCount = sizeof(kFactors) / sizeof(kFactors[0]);
 constexpr std::uint64_t kFamilySalt = 0x63657274696679ull;  // the family's own stream, apart from the run's noise
 
@@ -127,8 +146,9 @@ void append_event(toml::table& w, toml::table ev) {
 
 /// Trial `index`'s world: the base scenario with every factor drawn. `values` receives each factor's value (a
 /// discrete factor: 0 or 1; a factor its drive does not have: NaN). Deterministic in (base_seed, index).
-toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64_t base_seed, std::size_t index,
-                       std::vector<double>* values) {
+toml::table draw_world(const toml::table& base, const dockcore::Pose2& dock, const std::string& unseen_profile,
+                       std::uint64_t base_seed, std::size_t index, std::vector<double>* values) {
+  const double dock_yaw_rad = static_cast<double>(dock.yaw_rad);
   toml::table w = base;
   docksim::Rng rng(docksim::trial_seed(base_seed ^ kFamilySalt, index));
   values->assign(kFactorCount, std::nan(""));
@@ -137,6 +157,9 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
   bool push_turn = false;
   bool occluded = false;
   double occlusion_t_s = 0;
+  bool clutter = false, passer = false;
+  toml::table furniture;
+  double passer_t_s = 0, passer_side = 1, passer_x_m = 0, passer_speed_mps = 0;
   for (std::size_t i = 0; i < kFactorCount; ++i) {
     const Factor& f = kFactors[i];
     const double u = rng.uniform();  // drawn for every factor, used or not: each keeps its own place in the stream
@@ -144,6 +167,9 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
     if (f.first != nullptr) {
       const bool second = u < f.p_second;
       if ((key == "wall_glass" && !wall) || ((key == "push_side" || key == "push_kind") && !push)) continue;
+      if ((key == "clutter_kind" || key == "clutter_side") && !clutter) continue;
+      if (key == "passer_side" && !passer) continue;
+      if (key == "unseen_profile" && unseen_profile.empty()) continue;
       (*values)[i] = second ? 1 : 0;
       if (key == "kinematics") mecanum = second;
       if (key == "wall") {
@@ -159,6 +185,20 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
         push_side = second ? -1 : 1;
       } else if (key == "push_kind") {
         push_turn = second;
+      } else if (key == "profile") {
+        if (second) table_at(w, "dock").insert_or_assign("profile", "v-marker");
+      } else if (key == "unseen_profile") {
+        if (second) table_at(w, "dock").insert_or_assign("profile", unseen_profile);
+      } else if (key == "clutter") {
+        clutter = second;
+      } else if (key == "clutter_kind") {
+        furniture.insert_or_assign("kind", second ? "bin" : "box");
+      } else if (key == "clutter_side") {
+        furniture.insert_or_assign("side", second ? "right" : "left");
+      } else if (key == "passer") {
+        passer = second;
+      } else if (key == "passer_side") {
+        passer_side = second ? -1 : 1;
       } else {
         table_at(w, f.table).insert_or_assign(key, std::string(second ? f.second : f.first));
       }
@@ -168,11 +208,40 @@ toml::table draw_world(const toml::table& base, double dock_yaw_rad, std::uint64
     if (key == "wall_gap_m" && !wall) continue;
     if (key.rfind("push_", 0) == 0 && !push) continue;
     if (key.rfind("occlusion_", 0) == 0 && !occluded) continue;
+    if (key.rfind("clutter_", 0) == 0 && !clutter) continue;
+    if (key.rfind("passer_", 0) == 0 && !passer) continue;
     if ((key == "push_lateral_m" && push_turn) || (key == "push_turn_deg" && !push_turn)) continue;
     const double v = f.lo + (f.hi - f.lo) * u;
     (*values)[i] = v;
     if (key == "push_t_s") {
       push_t_s = v;
+    } else if (key == "clutter_gap_m") {
+      furniture.insert_or_assign("gap_m", v);
+      if (!w["dock"].is_table()) table_at(w, "dock");
+      toml::table& d = table_at(w, "dock");
+      if (!d.contains("furniture") || !d["furniture"].is_array()) d.insert_or_assign("furniture", toml::array{});
+      d["furniture"].as_array()->push_back(furniture);
+    } else if (key == "passer_t_s") {
+      passer_t_s = v;
+    } else if (key == "passer_x_m") {
+      passer_x_m = v;
+    } else if (key == "passer_speed_mps") {
+      passer_speed_mps = v;
+    } else if (key == "passer_r_m") {
+      // From kPasserReachM to one side of the dock's axis, passer_x_m in front of its face, across to the other side.
+      const double c = std::cos(dock_yaw_rad), sn = std::sin(dock_yaw_rad);
+      const double from_y = passer_side * kPasserReachM;
+      toml::table ev;
+      ev.insert_or_assign("type", "obstacle");
+      ev.insert_or_assign("in_state", "ALIGN");
+      ev.insert_or_assign("t_s", passer_t_s);
+      ev.insert_or_assign("x_m", static_cast<double>(dock.x_m) + c * passer_x_m - sn * from_y);
+      ev.insert_or_assign("y_m", static_cast<double>(dock.y_m) + sn * passer_x_m + c * from_y);
+      ev.insert_or_assign("r_m", v);
+      ev.insert_or_assign("vx_mps", sn * passer_side * passer_speed_mps);
+      ev.insert_or_assign("vy_mps", -c * passer_side * passer_speed_mps);
+      ev.insert_or_assign("duration_s", 2 * kPasserReachM / passer_speed_mps);
+      append_event(w, std::move(ev));
     } else if (key == "occlusion_t_s") {
       occlusion_t_s = v;
     } else if (key == "occlusion_s") {
@@ -299,16 +368,24 @@ int run_certify(const CertifyOptions& o) {
   }
   const std::uint64_t seed = o.seed_set ? o.seed : base_sc.seed;
   const std::size_t n = static_cast<std::size_t>(o.trials);
+  // The unseen shape is a profile file beside the base scenario (tools/scenarios/profiles); a base elsewhere without
+  // it keeps its own shape in those trials.
+  // Absolute, so that a trial's file written anywhere (--write) replays.
+  std::error_code ec;
+  const std::filesystem::path unseen_path =
+      std::filesystem::absolute(std::filesystem::path(o.scenario).parent_path() / "profiles" / "asym-step.toml", ec);
+  const std::string unseen_profile = !ec && std::filesystem::is_regular_file(unseen_path, ec)
+                                         ? unseen_path.lexically_normal().string()
+                                         : std::string();
   auto load = [&](std::size_t t, std::vector<double>* values) {
-    const toml::table w = draw_world(base, static_cast<double>(base_sc.dock_pose.yaw_rad), seed, t, values);
+    const toml::table w = draw_world(base, base_sc.dock_pose, unseen_profile, seed, t, values);
     return docksim::parse_scenario_toml(toml_text(w), o.scenario + " (trial " + std::to_string(t) + ")");
   };
 
   if (o.trial >= 0) {  // one trial: its world, written for `dock-sim run`
     std::vector<double> values;
     const std::size_t t = static_cast<std::size_t>(o.trial);
-    const std::string text =
-        toml_text(draw_world(base, static_cast<double>(base_sc.dock_pose.yaw_rad), seed, t, &values));
+    const std::string text = toml_text(draw_world(base, base_sc.dock_pose, unseen_profile, seed, t, &values));
     if (!o.write.empty()) {
       std::ofstream out(o.write, std::ios::binary);
       out << "# dock-sim certify " << o.scenario << " --seed " << seed << ", trial " << t
@@ -355,6 +432,11 @@ int run_certify(const CertifyOptions& o) {
     pushes += p ? 1 : 0;
     pushes_seen += p && ok[t] ? 1 : 0;
     docked_unpushed += !p && ok[t] ? 1 : 0;
+  }
+  // Runs whose robot touched an obstacle (furniture, a passer-by, a world object): the family's bar is none.
+  std::vector<std::size_t> touched;
+  for (std::size_t t = 0; t < n; ++t) {
+    if (runs[t].outcome.min_clearance_m < kTouchM) touched.push_back(t);
   }
   const double rate = static_cast<double>(successes) / static_cast<double>(n);
   const double lower = clopper_pearson_lower(o.trials, successes, 0.05);
@@ -411,6 +493,7 @@ int run_certify(const CertifyOptions& o) {
     j["retries"] = s.retries;
     j["min_clearance_m"] =
         std::isfinite(s.min_clearance_m) ? nlohmann::ordered_json(s.min_clearance_m) : nlohmann::ordered_json();
+    j["obstacle_contacts"] = touched;
     nlohmann::ordered_json fails = nlohmann::ordered_json::array();
     for (std::size_t t = 0; t < n; ++t) {
       if (ok[t]) continue;
@@ -444,6 +527,10 @@ int run_certify(const CertifyOptions& o) {
     std::printf("reversals           %ld in %ld runs; retries %ld in %ld runs; minimum obstacle clearance %s\n",
                 s.reversals, s.runs_with_reversals, s.retries, s.runs_with_retries,
                 std::isfinite(s.min_clearance_m) ? fmt("%.3f m", s.min_clearance_m).c_str() : "- (no obstacle)");
+    std::string trials_touched;
+    for (const std::size_t t : touched) trials_touched += " " + std::to_string(t);
+    std::printf("obstacle contacts   %zu runs%s\n", touched.size(),
+                touched.empty() ? "" : (" (trials" + trials_touched + ")").c_str());
     std::printf("\nfailures (each replays alone):\n");
     int shown = 0;
     for (std::size_t t = 0; t < n; ++t) {

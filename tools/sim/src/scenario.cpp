@@ -567,6 +567,8 @@ Scenario parse_scenario_toml(const std::string& text, const std::string& source_
         h.emplace_back("x_m", p.num(&ev.x_m, -1e3, 1e3));
         h.emplace_back("y_m", p.num(&ev.y_m, -1e3, 1e3));
         h.emplace_back("r_m", p.num(&ev.r_m, 0.005, 10));
+        h.emplace_back("vx_mps", p.num(&ev.vx_mps, -5, 5));
+        h.emplace_back("vy_mps", p.num(&ev.vy_mps, -5, 5));
         h.emplace_back("duration_s", dur);
       } else if (kind == "lidar_dropout") {
         ev.kind = EventKind::kLidarDropout;

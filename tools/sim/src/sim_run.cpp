@@ -24,6 +24,8 @@ namespace {
 
 constexpr double kPiD = 3.14159265358979323846;
 constexpr int kStepsPerTick = 4;  // 4 x 5 ms = 20 ms control period (50 Hz)
+constexpr int kStartDraws = 40;   // draws of a start clear of the furniture before the last one is kept
+constexpr double kStartClearanceM = 0.10;  // a start this close to furniture is drawn again
 
 std::uint64_t mix64(std::uint64_t z) {
   z += 0x9E3779B97F4A7C15ull;
@@ -257,15 +259,6 @@ StartPose start_from(const Scenario& sc, double distance_m, double bearing_rad, 
   return s;
 }
 
-StartPose draw_start(const Scenario& sc, std::uint64_t seed) {
-  Rng rng(mix64(seed ^ 0x5354415254ull));
-  const StartEnvelope& e = sc.start;
-  const double d = rng.uniform(e.distance_min_m, e.distance_max_m);
-  const double b = rng.uniform(e.bearing_min_rad, e.bearing_max_rad);
-  const double h = rng.uniform(e.heading_min_rad, e.heading_max_rad);
-  return start_from(sc, d, b, h);
-}
-
 std::unique_ptr<dockcore::BreakpointDetector> attach_detector(const Scenario& sc, dockcore::DockcoreBase& core) {
   if (sc.detector != dockcore::DockDetector::kBreakpoint) return nullptr;
   auto breakpoint = std::make_unique<dockcore::BreakpointDetector>();
@@ -295,6 +288,57 @@ std::vector<Vec2> footprint_outline(const ChassisParams& c) {
     pts = {v2(cx + hx, hy), v2(cx - hx, hy), v2(cx - hx, -hy), v2(cx + hx, -hy)};
   }
   return pts;
+}
+
+/// The obstacles the robot must keep clear of: [world] objects, furniture and other docks (not the dock or its
+/// wall). `occluders`, when given, receives the same objects as lidar geometry (what may hide the dock's tag).
+Obstacles static_obstacles(const Scenario& sc, World* occluders) {
+  World o;
+  for (const auto& pl : sc.polylines) o.add_polyline(pl.points, pl.closed);
+  for (const auto& b : sc.boxes) o.add_box(b.centre, b.size_x_m, b.size_y_m, b.yaw_rad);
+  for (const auto& d : sc.other_docks) o.add_dock(d.profile, d.pose);
+  Obstacles obs;
+  for (const auto& seg : o.segments) obs.segments.push_back({pd(seg.a), pd(seg.b)});
+  for (const auto& c : sc.circles) obs.discs.push_back({pd(c.centre), c.r_m});
+  for (const auto& c : sc.circles) o.add_circle(c.centre, c.r_m);
+  if (occluders != nullptr) *occluders = std::move(o);
+  return obs;
+}
+
+/// Clearance between the robot's outline (`outline`, robot frame) at `pose` (world) and `obs`, m. O(obstacles).
+double robot_clearance(const Scenario& sc, const std::vector<Vec2>& outline, const Pose2& pose, const Obstacles& obs) {
+  std::vector<P> poly;
+  for (const auto& q : outline) poly.push_back(pd(pose.transform(q)));
+  const P centre = pd(pose.transform(v2(sc.chassis.footprint.centre_x_m, 0)));
+  return clearance(poly, sc.chassis.footprint.shape == FootprintShape::kCircle, centre, sc.chassis.footprint.radius_m,
+                   obs);
+}
+
+StartPose draw_start(const Scenario& sc, std::uint64_t seed) {
+  Rng rng(mix64(seed ^ 0x5354415254ull));
+  const StartEnvelope& e = sc.start;
+  // A start that overlaps furniture (or comes within kStartClearanceM of it) is drawn again: a robot is sent to dock
+  // from where it can stand. Worlds without obstacles keep their first draw.
+  const Obstacles obs = static_obstacles(sc, nullptr);
+  const std::vector<Vec2> outline = footprint_outline(sc.chassis);
+  StartPose s;
+  for (int i = 0; i < kStartDraws; ++i) {
+    const double d = rng.uniform(e.distance_min_m, e.distance_max_m);
+    const double b = rng.uniform(e.bearing_min_rad, e.bearing_max_rad);
+    const double h = rng.uniform(e.heading_min_rad, e.heading_max_rad);
+    s = start_from(sc, d, b, h);
+    if (obs.segments.empty() && obs.discs.empty()) break;
+    // The outlines' distance misses a robot wholly inside a box or a disc: its centre is tested too.
+    const Vec2 c = s.robot_world.transform(v2(sc.chassis.footprint.centre_x_m, 0));
+    bool inside = false;
+    for (const auto& box : sc.boxes) {
+      const Vec2 q = Pose2{box.centre.x(), box.centre.y(), static_cast<Real>(box.yaw_rad)}.inverse_transform(c);
+      inside = inside || (std::abs(dd(q.x())) <= box.size_x_m / 2 && std::abs(dd(q.y())) <= box.size_y_m / 2);
+    }
+    for (const auto& disc : sc.circles) inside = inside || dd((c - disc.centre).norm()) <= disc.r_m;
+    if (!inside && robot_clearance(sc, outline, s.robot_world, obs) >= kStartClearanceM) break;
+  }
+  return s;
 }
 
 bool dock_wall(const Scenario& sc, Vec2* a, Vec2* b) {
@@ -363,21 +407,14 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   // World state driven by events.
   const World world_with_dock = scenario_world(sc, true);
   const World world_no_dock = scenario_world(sc, false);
-  Obstacles static_obs;
   World occluders;  // what may hide the dock's tag from the camera: everything but the dock and its wall
-  {
-    World& o = occluders;
-    for (const auto& pl : sc.polylines) o.add_polyline(pl.points, pl.closed);
-    for (const auto& b : sc.boxes) o.add_box(b.centre, b.size_x_m, b.size_y_m, b.yaw_rad);
-    for (const auto& d : sc.other_docks) o.add_dock(d.profile, d.pose);
-    for (const auto& s : o.segments) static_obs.segments.push_back({pd(s.a), pd(s.b)});
-    for (const auto& c : sc.circles) static_obs.discs.push_back({pd(c.centre), c.r_m});
-    for (const auto& c : sc.circles) o.add_circle(c.centre, c.r_m);
-  }
+  const Obstacles static_obs = static_obstacles(sc, &occluders);
   struct ActiveObstacle {
     Vec2 c;
     double r;
     double until_s;
+    Vec2 v{};                // walking velocity, world m/s
+    double walk_left_s = 0;  // a walking obstacle leaves once it has walked this long
   };
   std::vector<ActiveObstacle> active_obs;
   double occluded_until = -1, dropout_until = -1, silent_until = -1, host_stalled_until = -1;
@@ -400,7 +437,6 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
 
   // Footprint for clearance.
   const std::vector<Vec2> outline = footprint_outline(sc.chassis);
-  const bool disc = sc.chassis.footprint.shape == FootprintShape::kCircle;
 
   // Host state.
   dockcore::TaskState prev_state = dockcore::TaskState::kNotTasking;
@@ -448,9 +484,26 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
           std::snprintf(buf, sizeof buf, "dock occluded for %.2f s", ev.duration_s);
           break;
         case EventKind::kObstacle:
-          active_obs.push_back({v2(ev.x_m, ev.y_m), ev.r_m, ev.duration_s > 0 ? t + ev.duration_s : 1e300});
-          std::snprintf(buf, sizeof buf, "obstacle r %.2f m at (%.2f, %.2f) for %.2f s", ev.r_m, ev.x_m, ev.y_m,
-                        ev.duration_s);
+          if (ev.vx_mps != 0 || ev.vy_mps != 0) {
+            // A passer-by enters where the robot is not: one due to appear at the robot comes from further back on
+            // its way.
+            Vec2 from = v2(ev.x_m, ev.y_m);
+            const Vec2 back = v2(-ev.vx_mps, -ev.vy_mps).normalized() * static_cast<Real>(0.05);
+            for (int i = 0; i < 100; ++i) {
+              Obstacles one;
+              one.discs.push_back({pd(from), ev.r_m});
+              if (robot_clearance(sc, outline, chassis.state().true_pose, one) >= kPasserGiveWayM) break;
+              from = from + back;
+            }
+            active_obs.push_back(
+                {from, ev.r_m, 1e300, v2(ev.vx_mps, ev.vy_mps), ev.duration_s > 0 ? ev.duration_s : 1e300});
+            std::snprintf(buf, sizeof buf, "passer-by r %.2f m from (%.2f, %.2f) at (%.2f, %.2f) m/s for %.2f s",
+                          ev.r_m, ev.x_m, ev.y_m, ev.vx_mps, ev.vy_mps, ev.duration_s);
+          } else {
+            active_obs.push_back({v2(ev.x_m, ev.y_m), ev.r_m, ev.duration_s > 0 ? t + ev.duration_s : 1e300});
+            std::snprintf(buf, sizeof buf, "obstacle r %.2f m at (%.2f, %.2f) for %.2f s", ev.r_m, ev.x_m, ev.y_m,
+                          ev.duration_s);
+          }
           break;
         case EventKind::kLidarDropout:
           dropout_until = std::max(dropout_until, t + ev.duration_s);
@@ -495,6 +548,33 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
     if (host_stalled && t >= host_stalled_until) {
       host_stalled = false;
       add(t, TimelineKind::kEvent, static_cast<int>(EventKind::kHostStall), "host runs again");
+    }
+    // Passers-by walk on; one whose step would bring it near the robot steps around it (turning from its way to the
+    // side away from the robot, back if need be: a step is taken when it keeps the give-way distance or widens the
+    // gap), so that neither waits for the other.
+    for (auto& o : active_obs) {
+      if (o.v.x() == 0 && o.v.y() == 0) continue;
+      const Vec2 robot = chassis.state().true_pose.transform(v2(sc.chassis.footprint.centre_x_m, 0));
+      const Vec2 to_robot = robot - o.c;
+      const double away = dd(o.v.x() * to_robot.y() - o.v.y() * to_robot.x()) > 0 ? -1.0 : 1.0;
+      Obstacles here;
+      here.discs.push_back({pd(o.c), o.r});
+      const double gap_m = robot_clearance(sc, outline, chassis.state().true_pose, here);
+      for (const double turn_deg : {0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0}) {
+        const double a = away * turn_deg * kPiD / 180;
+        const Vec2 step = Vec2(static_cast<Real>(std::cos(a) * dd(o.v.x()) - std::sin(a) * dd(o.v.y())),
+                               static_cast<Real>(std::sin(a) * dd(o.v.x()) + std::cos(a) * dd(o.v.y()))) *
+                          static_cast<Real>(dt);
+        Obstacles one;
+        one.discs.push_back({pd(o.c + step), o.r});
+        const double next_gap_m = robot_clearance(sc, outline, chassis.state().true_pose, one);
+        if (next_gap_m >= kPasserGiveWayM || next_gap_m > gap_m) {
+          o.c = o.c + step;
+          o.walk_left_s -= dt;
+          if (o.walk_left_s <= 0) o.until_s = t;
+          break;
+        }
+      }
     }
     active_obs.erase(
         std::remove_if(active_obs.begin(), active_obs.end(), [&](const ActiveObstacle& o) { return t >= o.until_s; }),
@@ -651,11 +731,7 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
       if (!static_obs.segments.empty() || !static_obs.discs.empty() || !active_obs.empty()) {
         Obstacles obs = static_obs;
         for (const auto& a : active_obs) obs.discs.push_back({pd(a.c), a.r});
-        std::vector<P> poly;
-        for (const auto& q : outline) poly.push_back(pd(cs.true_pose.transform(q)));
-        const P centre = pd(cs.true_pose.transform(v2(sc.chassis.footprint.centre_x_m, 0)));
-        out.min_clearance_m =
-            std::min(out.min_clearance_m, clearance(poly, disc, centre, sc.chassis.footprint.radius_m, obs));
+        out.min_clearance_m = std::min(out.min_clearance_m, robot_clearance(sc, outline, cs.true_pose, obs));
       }
       if (opt.record_trajectory && t + 1e-9 >= next_traj_t) {
         run.trajectory.push_back(

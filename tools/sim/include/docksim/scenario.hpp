@@ -46,7 +46,8 @@ class ScenarioError : public std::runtime_error {
 enum class EventKind : std::uint8_t {
   kPush,                 ///< "push": true pose jumps by (dx, dy) world metres and dyaw; odometry does not see it.
   kOccludeDock,          ///< "occlude_dock": the dock is invisible to lidar and camera for duration_s.
-  kObstacle,             ///< "obstacle": a disc (x, y, r) in the world for duration_s (<= 0: for good).
+  kObstacle,             ///< "obstacle": a disc (x, y, r) in the world for duration_s (<= 0: for good); with a
+                         ///< velocity it walks (a passer-by) and waits while it would come near the robot.
   kLidarDropout,         ///< "lidar_dropout": no scans for duration_s.
   kChargingNeverStarts,  ///< "charging_never_starts": the charger delivers no current from t_s on.
   kChassisSilent,        ///< "chassis_silent": the chassis stops answering for duration_s.
@@ -65,6 +66,9 @@ struct ScenarioEvent {
   double dx_m = 0, dy_m = 0, dyaw_rad = 0;  ///< push (world frame).
   double duration_s = 0;                    ///< occlude_dock, obstacle, lidar_dropout, chassis_silent, host_stall.
   double x_m = 0, y_m = 0, r_m = 0.1;       ///< obstacle: centre (world) and radius.
+  /// obstacle: walking velocity, world m/s (0: it stands). A walking obstacle gives way: it stands while a step would
+  /// bring it within kPasserGiveWayM of the robot, and duration_s counts its walking time only.
+  double vx_mps = 0, vy_mps = 0;
   bool hold_last_command = false;           ///< chassis_silent: motors keep the last command (else they stop).
   /// in_state: t_s counts from the first control tick on which the task is in this state (the event never fires
   /// when the run never gets there); absent: from the start of the run. dock-sim run/montecarlo/certify only.
@@ -162,6 +166,10 @@ struct DockFurniture {
 
 /// Default clearance between furniture and the wall behind it, m (furniture does not stand exactly on the wall line).
 constexpr double kFurnitureWallClearanceM = 0.01;
+
+/// How near a walking obstacle (a passer-by) comes to the robot's outline before it stands and lets the robot pass,
+/// m: people keep about this much from a machine they see.
+constexpr double kPasserGiveWayM = 0.15;
 
 /// Host behaviour around the task manager.
 struct HostSpec {
