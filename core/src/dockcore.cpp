@@ -6,6 +6,15 @@
 
 namespace dockcore {
 
+namespace {
+// A detection this far off the expectation has the room judged (SceneCheck); nearer ones are tracking noise.
+constexpr Real kSceneGateM = static_cast<Real>(0.05);
+constexpr Real kSceneGateRad = static_cast<Real>(0.0873);  // 5°
+// The scene's reference is renewed at most this often: odometry drifts slowly, and each renewal costs a pass over
+// the scan.
+constexpr std::uint64_t kSceneReferencePeriodUs = 500000;
+}  // namespace
+
 const char* to_string(DockDetector d) {
   switch (d) {
     case DockDetector::kEstimator:
@@ -47,6 +56,7 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
   tasks_.configure(config.task, config.footprint, profile);
   pending_count_ = 0;
   pending_dropped_ = 0;
+  scene_.clear();
   for (std::uint32_t& c : tag_counts_) c = 0;
   have_tag_ = false;
   last_tag_us_ = 0;
@@ -204,6 +214,26 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
       d.expectation_confirmed = true;
       d.expected_in_odom = push_ref_in_odom_;
     }
+    // Off the expectation by more than the scene gate: does the room say push or false detection?
+    const Pose2 detected_in_odom = odom_pose.compose(last_estimate_.pose);
+    const bool off_expectation =
+        d.expectation_confirmed &&
+        ((Vec2(detected_in_odom.x_m, detected_in_odom.y_m) - Vec2(d.expected_in_odom.x_m, d.expected_in_odom.y_m))
+                 .norm() > kSceneGateM ||
+         std::fabs(wrap_angle(detected_in_odom.yaw_rad - d.expected_in_odom.yaw_rad)) > kSceneGateRad);
+    if (off_expectation && scene_.reference_points() > 0) {
+      // The push the detection implies, and its shift alone and its turn alone (about the robot): one detection's
+      // yaw at range is noisy enough to blur a pure shove, its position to blur a turn on the spot.
+      const Pose2 full = detected_in_odom.compose(d.expected_in_odom.inverse());
+      const Pose2 shift{detected_in_odom.x_m - d.expected_in_odom.x_m, detected_in_odom.y_m - d.expected_in_odom.y_m,
+                        0};
+      const Pose2 at_robot{odom_pose.x_m, odom_pose.y_m, 0};
+      const Pose2 turn =
+          at_robot.compose(Pose2{0, 0, wrap_angle(detected_in_odom.yaw_rad - d.expected_in_odom.yaw_rad)})
+              .compose(at_robot.inverse());
+      const Pose2 corrections[] = {full, shift, turn};
+      d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, 3, config_.scene);
+    }
     const Pose2 before = filter_.dock_in_odom();
     const std::uint64_t before_us = filter_.last_update_us();
     if (pending_count_ < kMaxDetectionsPerTick) {
@@ -226,6 +256,13 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
       confirmed_ref_set_ = true;
       confirmed_ref_in_odom_ = filter_.dock_in_odom();
       confirmed_ref_us_ = stamp_us;
+      // A scan whose detection agreed with the expectation shows the room where odometry puts it: the reference
+      // for the next off-expectation detection, renewed now and then (the room does not move; odometry drifts).
+      if (!off_expectation && (scene_.reference_points() == 0 || stamp_us < scene_ref_us_ ||
+                               stamp_us - scene_ref_us_ >= kSceneReferencePeriodUs)) {
+        scene_.set_reference(scan, config_.lidar_mount, odom_pose, config_.scene);
+        scene_ref_us_ = stamp_us;
+      }
     }
   }
   return last_estimate_;
@@ -335,6 +372,7 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
     confirmed_ref_set_ = false;
     filter_.reset();
     filter_confirmed_ = false;
+    scene_.clear();
   }
   // A detection in ALIGN agreed with the push test's reference: the reference has done its job (no push), and an
   // earlier restart was no push either (the restarted filter is the reference now). Both end with the task.

@@ -3,8 +3,9 @@
 # (a new failure is a regression, a known one that docks means the list is stale), and the JSON must not depend on
 # --jobs. Then one trial written out and replayed with dock-sim run, and an argument error (exit 2).
 # Known failures (docs/performance.md, "A family of robots"): the v-marker dock never found from where the robot
-# starts (177: 14 18 19 40 51), and furniture beside the dock taken for it while the robot moves (178: 7 54 59).
-set(known_failures "7;14;18;19;40;51;54;59")
+# starts (177: 14 18 19 40 51), and a box beside the dock taken for it while the dock is hidden, where the wall the
+# box stands on is all the room there is to tell a push from it (178: 54).
+set(known_failures "14;18;19;40;51;54")
 # Inputs: -DDOCKSIM=<dock-sim> -DSCENARIO=<default.toml> -DWORK=<scratch dir>.
 file(MAKE_DIRECTORY ${WORK})
 
@@ -34,8 +35,9 @@ if(NOT ok EQUAL want)
   message(FATAL_ERROR "certify: ${ok} of 60 right, want ${want}")
 endif()
 string(JSON lower GET "${two}" lower_bound_95)
-if(NOT lower MATCHES "^0\\.7[5-9]")
-  message(FATAL_ERROR "certify: ${ok} of 60 should demonstrate a lower bound of 0.75-0.8, got ${lower}")
+string(JSON rate GET "${two}" success_rate)
+if(NOT lower MATCHES "^0\\.[5-9]" OR NOT lower LESS rate)
+  message(FATAL_ERROR "certify: ${ok} of 60 should demonstrate a lower bound in 0.5-1, below ${rate}: ${lower}")
 endif()
 execute_process(COMMAND ${DOCKSIM} certify ${SCENARIO} --trials 60 --seed 1 --jobs 1 --json
   RESULT_VARIABLE rc OUTPUT_VARIABLE one ERROR_VARIABLE err)

@@ -89,6 +89,7 @@ struct Sim {
   bool visible_only_when_turned = false;  // detection only with |yaw - start| > 10°
   bool dock_confirmed = true;             // DockInput::confirmed
   std::vector<Pose2> outliers;            // next detections report these dock poses (world frame), in order
+  SceneVerdict outlier_scene = SceneVerdict::kUnknown;  // what the room says on an outlier's scan (SceneCheck)
   double start_yaw = kPi;
   bool charger_works = true;
   int charger_fails_first = 0;  // contacts that get no current (attempts)
@@ -156,6 +157,7 @@ struct Sim {
         det.dock_in_robot = world.inverse().compose(dock);
         if (!outliers.empty()) {
           det.dock_in_robot = world.inverse().compose(outliers.front());
+          det.scene = outlier_scene;
           outliers.erase(outliers.begin());
         }
         det.odom_at_scan = odom;
@@ -387,6 +389,30 @@ TEST(TaskManager, SingleOutlierDetectionIsNotAFault) {
   }
   CHECK(s->outliers.empty());
   CHECK(s->run_until(TaskState::kFinishTasking, 30));
+}
+
+// Furniture taken for the dock scan after scan while the dock is hidden: the detections agree with each other and
+// fail the push test, but the room stands where odometry puts it, so it is no push. The same detections without
+// the room's word are one.
+TEST(TaskManager, ARepeatedOutlierWhileTheRoomStandsStillIsNotAPush) {
+  for (const bool still : {true, false}) {
+    auto s = std::make_unique<Sim>();
+    s->command(HostCommandType::kDock);
+    CHECK(s->run_until(TaskState::kAlign, 5));
+    s->run_for(0.5);
+    s->outlier_scene = still ? SceneVerdict::kStill : SceneVerdict::kUnknown;
+    for (int i = 0; i < 5; ++i) s->outliers.push_back(Pose2{0.1, 0.9, 0});
+    for (int i = 0; i < 30 && s->out.status.state == TaskState::kAlign; ++i) s->step();
+    if (still) {
+      CHECK(s->out.status.state == TaskState::kAlign);
+      LONGS_EQUAL(5, static_cast<long>(s->tm.pushes_overruled()));
+      CHECK(s->run_until(TaskState::kFinishTasking, 30));
+    } else {
+      CHECK(s->out.status.state == TaskState::kFault);
+      LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+      LONGS_EQUAL(0, static_cast<long>(s->tm.pushes_overruled()));
+    }
+  }
 }
 
 TEST(TaskManager, TwoDisagreeingOutliersInARowAreNotAFault) {

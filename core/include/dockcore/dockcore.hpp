@@ -63,6 +63,7 @@
 #include "dockcore/perception/dock_pose_filter.hpp"
 #include "dockcore/perception/dock_profile.hpp"
 #include "dockcore/perception/intensity_check.hpp"
+#include "dockcore/perception/scene_check.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
 #include "dockcore/task/command_queue.hpp"
 #include "dockcore/task/input_watch.hpp"
@@ -124,6 +125,9 @@ struct DockcoreConfig {
   /// When the lidar's intensity counts as usable (IntensityCheck): the estimator reads reflector stripes unless the
   /// verdict is flat or absent.
   IntensityCheckParams intensity{};
+  /// The push test's second opinion (SceneCheck): a detection off the expectation while the room stands where
+  /// odometry puts it is another object taken for the dock, not a push.
+  SceneCheckParams scene{};
 };
 
 /// Per-tick input from the chassis and the host.
@@ -279,6 +283,8 @@ class DockcoreBase {
   Odometry odometry_{};
   InputWatch watch_{};
   IntensityCheck intensity_{};
+  SceneCheck scene_{};              ///< The latest agreeing scan, for the push test's second opinion.
+  std::uint64_t scene_ref_us_ = 0;  ///< When scene_ took its reference.
   CommandQueue queue_{};
   // The resume policy: the dock/undock running now, the one stale input interrupted, resumes this task.
   HostCommand running_{};

@@ -17,6 +17,7 @@
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
 #include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/scene_check.hpp"
 #include "dockcore/task/faults.hpp"
 
 namespace dockcore {
@@ -190,6 +191,9 @@ struct DetectionInput {
   bool expectation_set = false;
   bool expectation_confirmed = false;  ///< The expectation rested on two agreeing detections (DockInput::confirmed).
   Pose2 expected_in_odom{};            ///< Dock in the odometry frame the filter expected (when confirmed).
+  /// Whether the scan shows the room where odometry puts it (SceneCheck, judged when the detection is off the
+  /// expectation): kStill makes a detection that fails the push test another object taken for the dock, not a push.
+  SceneVerdict scene = SceneVerdict::kUnknown;
 };
 
 /// Detections one tick can carry: a host draining a scan backlog after a stall hands several scans to
@@ -264,6 +268,9 @@ class TaskManager {
   TaskState state() const { return state_; }
   /// A detection failed the push test and the next agreeing one would raise 178/179 (ALIGN). O(1).
   bool push_suspected() const { return deviation_count_ > 0; }
+  /// Detections that failed the push test while their scan showed the room standing where odometry puts it
+  /// (DetectionInput::scene kStill): taken for other objects, not counted towards 178/179. Since configure(). O(1).
+  std::uint32_t pushes_overruled() const { return pushes_overruled_; }
   /// Where this attempt aims beside the dock's axis (retry_lateral_step_m), m in the dock frame's y. O(1).
   Real retry_lateral_offset_m() const;
   /// The lateral aim of the current attempt: the dock's remembered aim plus the search's offset, m.
@@ -342,6 +349,7 @@ class TaskManager {
   bool lost_ = false;
   std::uint64_t lost_since_us_ = 0;
   Real start_distance_m_ = 0;
+  std::uint32_t pushes_overruled_ = 0;
   std::uint8_t deviation_count_ = 0;  ///< Consecutive detections failing the push test, each agreeing with the last.
   Pose2 deviation_pose_{};            ///< The last failing detection in the odometry frame.
   bool pushing_ = false;              ///< In the final push (reset on entering ALIGN).

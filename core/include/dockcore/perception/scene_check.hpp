@@ -1,0 +1,83 @@
+#pragma once
+/// @file SceneCheck: did the room move the way odometry says? The push test's second opinion (docs/task-manager.md,
+/// "Push test").
+///
+/// A detection far from where odometry expects the dock is either a push (the robot was moved and odometry did not
+/// see it) or another object taken for the dock (furniture beside it, seen while the dock is hidden). One scan tells
+/// them apart: after a push everything the lidar saw before has moved by the same correction, while after a false
+/// detection the room stands where odometry puts it. So the points of a reference scan (the latest scan whose
+/// detection agreed with the expectation), kept in the odometry frame, are predicted into the current scan under
+/// both hypotheses, and each hypothesis scores the points it explains (a return within the range tolerance) minus
+/// the points it contradicts (a return well beyond the predicted surface, or no return on that beam and both its
+/// neighbours: free space where the hypothesis puts something). A nearer return is an occlusion and a lone missing
+/// return a dropout; they count for neither. A wall parallel to a shove looks the same under both; the dock, the
+/// furniture and the wall's ends decide.
+///
+/// No heap; set_reference() O(count), judge() O(kCapacity).
+
+#include <cstddef>
+#include <cstdint>
+
+#include "dockcore/geometry.hpp"
+#include "dockcore/laser_scan.hpp"
+
+namespace dockcore {
+
+/// Which hypothesis the current scan supports.
+enum class SceneVerdict : std::uint8_t {
+  kUnknown = 0,  ///< No reference, too few points compared, or neither hypothesis clearly ahead.
+  kStill,        ///< The room stands where odometry puts it: the robot was not moved.
+  kMoved,        ///< The room moved by the correction: the robot was moved (a push).
+};
+
+/// "unknown" / "still" / "moved". Never null.
+const char* to_string(SceneVerdict v);
+
+/// The check's thresholds.
+struct SceneCheckParams {
+  Real range_tolerance_m = static_cast<Real>(0.05);     ///< A predicted point is explained within this, m, ...
+  Real range_tolerance_frac = static_cast<Real>(0.02);  ///< ... plus this share of its range.
+  Real max_range_m = static_cast<Real>(6.0);            ///< Reference returns beyond this are not kept, m.
+  std::uint16_t min_margin_points = 10;  ///< A verdict needs this many more net points than the other hypothesis.
+  Real min_explained_share =
+      static_cast<Real>(0.5);       ///< kStill also needs this share of the compared points explained.
+  std::uint16_t min_compared = 20;  ///< kStill needs at least this many reference points seen in the scan.
+};
+
+/// Points each hypothesis explains and contradicts (judge()'s detail, for reports and tests).
+struct SceneVotes {
+  std::uint16_t compared = 0;         ///< Reference points predicted onto a beam with a return (still hypothesis).
+  std::uint16_t still_explained = 0;  ///< Explained under "odometry is right".
+  std::uint16_t still_contradicted = 0;
+  std::uint16_t moved_explained = 0;  ///< Explained under "the room moved by the correction".
+  std::uint16_t moved_contradicted = 0;
+};
+
+/// Reference scan and the two-hypothesis test. Fixed capacity: kCapacity points, taken at an even stride.
+class SceneCheck {
+ public:
+  static constexpr std::size_t kCapacity = 180;
+
+  /// Forgets the reference. O(1).
+  void clear() { count_ = 0; }
+  /// Keeps up to kCapacity of `scan`'s returns (an even stride over the returns) as the reference, in the odometry
+  /// frame: the lidar at `odom_pose` ∘ `lidar_mount`. Returns beyond params.max_range_m are left out. O(scan.count).
+  void set_reference(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose,
+                     const SceneCheckParams& params);
+  /// Reference points kept. O(1).
+  std::size_t reference_points() const { return count_; }
+  /// Judges `scan`, taken at `odom_pose`, against the reference: "still" predicts each reference point where it was
+  /// (odometry right), "moved" at correction ∘ point for each of the `n` candidate corrections (a push by an
+  /// odometry-frame correction: the one the detection implies, detected ∘ expected⁻¹, and the readings of it that a
+  /// noisy detection blurs, e.g. its shift alone or its turn alone), the best of them counting. kStill needs
+  /// min_compared points and a margin over every candidate. `votes`, if given, receives the counts (moved: the best
+  /// candidate's). n ≥ 1. O(n · kCapacity).
+  SceneVerdict judge(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose, const Pose2* corrections,
+                     std::size_t n, const SceneCheckParams& params, SceneVotes* votes = nullptr) const;
+
+ private:
+  Vec2 points_odom_m_[kCapacity];
+  std::size_t count_ = 0;
+};
+
+}  // namespace dockcore

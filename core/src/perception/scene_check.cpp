@@ -1,0 +1,114 @@
+#include "dockcore/perception/scene_check.hpp"
+
+#include <cmath>
+
+namespace dockcore {
+
+const char* to_string(SceneVerdict v) {
+  switch (v) {
+    case SceneVerdict::kStill:
+      return "still";
+    case SceneVerdict::kMoved:
+      return "moved";
+    case SceneVerdict::kUnknown:
+      break;
+  }
+  return "unknown";
+}
+
+void SceneCheck::set_reference(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose,
+                               const SceneCheckParams& params) {
+  count_ = 0;
+  if (scan.ranges_m == nullptr || scan.count == 0) return;
+  const Pose2 lidar_in_odom = odom_pose.compose(lidar_mount);
+  // The stride runs over the returns, not the beams: a room seen over a quarter of the turn keeps all its points.
+  std::size_t returns = 0;
+  for (std::size_t i = 0; i < scan.count; ++i) {
+    const Real r = scan.ranges_m[i];
+    if (is_valid_range(r) && r <= params.max_range_m) ++returns;
+  }
+  const std::size_t stride = (returns + kCapacity - 1) / kCapacity;
+  std::size_t seen = 0;
+  for (std::size_t i = 0; i < scan.count && count_ < kCapacity; ++i) {
+    const Real r = scan.ranges_m[i];
+    if (!is_valid_range(r) || r > params.max_range_m) continue;
+    if (seen++ % stride != 0) continue;
+    const Real a = scan.angle_rad(i);
+    points_odom_m_[count_++] = lidar_in_odom.transform(Vec2(r * std::cos(a), r * std::sin(a)));
+  }
+}
+
+SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose,
+                               const Pose2* corrections, std::size_t n, const SceneCheckParams& params,
+                               SceneVotes* votes) const {
+  SceneVotes v;
+  int best_moved_net = 0;
+  bool have_moved = false;
+  if (scan.ranges_m != nullptr && scan.count > 0 && scan.angle_increment_rad > 0) {
+    const Pose2 lidar_in_odom = odom_pose.compose(lidar_mount);
+    const bool wraps = scan.wraps();
+    const long beams = static_cast<long>(scan.count);
+    // Where the point should show in this scan, and whether that beam explains (1), contradicts (-1) or says nothing
+    // of it (0); `seen` false when the beam has no return or lies outside the scan.
+    auto vote = [&](const Vec2& p_odom, bool* seen) {
+      *seen = false;
+      const Vec2 q = lidar_in_odom.inverse_transform(p_odom);
+      const Real predicted_m = q.norm();
+      long i = nearest_beam_index(scan.angle_min_rad, scan.angle_increment_rad, scan.count, std::atan2(q.y(), q.x()));
+      if (wraps) i = ((i % beams) + beams) % beams;
+      if (i < 0 || i >= beams) return 0;
+      const Real measured_m = scan.ranges_m[i];
+      if (!is_valid_range(measured_m)) {
+        // No return on this beam nor on either neighbour: open space where the hypothesis puts a surface. A lone
+        // missing return is a dropout and says nothing.
+        auto none_at = [&](long j) {
+          if (wraps) j = ((j % beams) + beams) % beams;
+          return j < 0 || j >= beams || !is_valid_range(scan.ranges_m[j]);
+        };
+        if (predicted_m < params.max_range_m && none_at(i - 1) && none_at(i + 1)) {
+          *seen = true;
+          return -1;
+        }
+        return 0;
+      }
+      *seen = true;
+      const Real tol_m = params.range_tolerance_m + params.range_tolerance_frac * predicted_m;
+      if (std::fabs(measured_m - predicted_m) <= tol_m) return 1;
+      return measured_m > predicted_m + tol_m ? -1 : 0;  // free space where a surface should be; nearer: occluded
+    };
+    for (std::size_t k = 0; k < count_; ++k) {
+      bool seen = false;
+      const int still = vote(points_odom_m_[k], &seen);
+      if (seen) ++v.compared;
+      if (still > 0) ++v.still_explained;
+      if (still < 0) ++v.still_contradicted;
+    }
+    for (std::size_t c = 0; c < n; ++c) {
+      std::uint16_t explained = 0, contradicted = 0;
+      for (std::size_t k = 0; k < count_; ++k) {
+        bool seen = false;
+        const int moved = vote(corrections[c].transform(points_odom_m_[k]), &seen);
+        if (moved > 0) ++explained;
+        if (moved < 0) ++contradicted;
+      }
+      const int net = static_cast<int>(explained) - static_cast<int>(contradicted);
+      if (!have_moved || net > best_moved_net) {
+        have_moved = true;
+        best_moved_net = net;
+        v.moved_explained = explained;
+        v.moved_contradicted = contradicted;
+      }
+    }
+  }
+  if (votes != nullptr) *votes = v;
+  const int still_net = static_cast<int>(v.still_explained) - static_cast<int>(v.still_contradicted);
+  const int margin = static_cast<int>(params.min_margin_points);
+  if (v.compared >= params.min_compared && still_net - best_moved_net >= margin &&
+      static_cast<Real>(v.still_explained) >= params.min_explained_share * static_cast<Real>(v.compared)) {
+    return SceneVerdict::kStill;
+  }
+  if (have_moved && best_moved_net - still_net >= margin) return SceneVerdict::kMoved;
+  return SceneVerdict::kUnknown;
+}
+
+}  // namespace dockcore
