@@ -398,6 +398,42 @@ TEST(DockPoseEstimator, ABrightBeamOnANarrowBareEndLeavesTheCodeUnread) {
   CHECK_EQUAL(3, tried);
 }
 
+// A bare end's beam within half a footprint of the corner where an untaped wing adjoins: whatever the pose's error
+// along the face, its footprint can meet tape only on this end, so when it reads bright it is another code's stripe
+// there, and the code is unread even where the end is too narrow at the range to be needed.
+TEST(DockPoseEstimator, ABrightBeamAtABareEndsCornerLeavesTheCodeUnread) {
+  const DockProfile code = coded_plate({{0.0, 0.26}});  // a 4 cm bare end, the wing beyond it untaped
+  int tried = 0;
+  for (int cm = 110; cm <= 160 && tried < 3; ++cm) {
+    const Truth t = simulate(code, cm / 100.0, 0.0, 0.0, ld06(0.002), 5);
+    PlacedProfile placed;
+    placed.place(code, t.dock_in_lidar);
+    const ScanView v = g_scan.view();
+    // No beam inside the end's margins (the estimator's, by 2 mm more for the fitted pose's error), and one between
+    // its outer margin and the corner.
+    std::size_t inside = 0;
+    std::size_t corner = v.count;
+    for (std::size_t i = 0; i < v.count; ++i) {
+      Real r = 0, s = 0;
+      if (!on_taped_face(placed, v, i, &r, &s)) continue;
+      const Real edge = edge_margin_m(v, r, static_cast<Real>(0.002));
+      if (s > static_cast<Real>(0.26) + edge && s < static_cast<Real>(0.30) - edge) ++inside;
+      if (s >= static_cast<Real>(0.30) - edge && s < static_cast<Real>(0.298)) corner = i;
+    }
+    if (inside != 0 || corner == v.count) continue;
+    ++tried;
+    g_est.configure(code, EstimatorParams{});
+    g_est.set_intensity_usable(true);
+    const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+    CHECK_TRUE(clean.found);
+    g_scan.intensities[corner] = 255;  // another code's stripe on the end, seen by the beam at its corner
+    const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
+    CHECK_FALSE(lit.found);
+    CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+  }
+  CHECK_EQUAL(3, tried);
+}
+
 // A stripe over a quarter of whose beams read dark is lit in part, as where another code's stripe lies half over it
 // or the pose is off along the face by part of a region: it reads neither way, and the code is unread.
 TEST(DockPoseEstimator, AStripeLitInPartLeavesTheCodeUnread) {

@@ -374,6 +374,7 @@ class DockPoseEstimatorBase {
   Real wall_gap_max_m_ = 0;    // farthest the wall may lie behind the back plane (the mounting's, or the default)
   // Per segment: the largest line distance at which registration keeps a beam on it unsearched (0: never).
   Real shortcut_max_m_[kMaxProfileVertices] = {};
+  bool seg_taped_[kMaxProfileVertices] = {};  // Per segment: whether it carries a reflector stripe.
   EstimatorCounters counters_{};
 
   // Working buffers (the owner's).
