@@ -434,6 +434,61 @@ TEST(DockPoseEstimator, ABrightBeamAtABareEndsCornerLeavesTheCodeUnread) {
   CHECK_EQUAL(3, tried);
 }
 
+// A bright run on the taped face spanning more tape than the code has there (its span less each end beam's edge
+// margin) is another code's tape, wherever the pose puts the dock along the face: the code is unread, even where
+// neither end of the run reaches three standard deviations of the pose's along-face error into the gap beside it.
+TEST(DockPoseEstimator, ABrightRunLongerThanTheCodesTapeLeavesTheCodeUnread) {
+  const DockProfile code = coded_plate({{0.10, 0.20}});
+  int tried = 0;
+  for (int cm = 50; cm <= 80 && tried < 3; ++cm) {
+    const Truth t = simulate(code, cm / 100.0, 0.0, 0.0, ld06(0.01), 3);
+    g_est.configure(code, EstimatorParams{});
+    g_est.set_intensity_usable(true);
+    const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+    if (!clean.found) continue;
+    PlacedProfile placed;
+    placed.place(code, t.dock_in_lidar);
+    const ScanView v = g_scan.view();
+    // The face's beams in scan order, by their place along it.
+    std::size_t beam[64];
+    Real along[64];
+    Real range[64];
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < v.count && n < 64; ++i) {
+      Real r = 0, s = 0;
+      if (!on_taped_face(placed, v, i, &r, &s) || g_scan.ranges_m[i] == 0) continue;
+      beam[n] = i;
+      along[n] = s;
+      range[n] = r;
+      ++n;
+    }
+    // Light the stripe and two beams past each of its ends: a run a stripe of this code seen from a pose off along
+    // the face would not make, since it reaches past both ends. Kept when the tape it proves is longer than the
+    // stripe by 3 mm more than the fitted pose's error could move the margins.
+    std::size_t first = n;
+    std::size_t last = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (along[k] < static_cast<Real>(0.10) || along[k] > static_cast<Real>(0.20)) continue;
+      first = std::min(first, k);
+      last = std::max(last, k);
+    }
+    if (first == n) continue;
+    // Scan order runs either way along the face: the two beams either side of the stripe's beams.
+    if (first < 2 || last + 2 >= n) continue;
+    const std::size_t lo = first - 2;
+    const std::size_t hi = last + 2;
+    const Real a = std::min(along[lo] + edge_margin_m(v, range[lo], 0), along[hi] + edge_margin_m(v, range[hi], 0));
+    const Real b = std::max(along[lo] - edge_margin_m(v, range[lo], 0), along[hi] - edge_margin_m(v, range[hi], 0));
+    if (!(b - a > static_cast<Real>(0.103))) continue;
+    for (std::size_t k = lo; k <= hi; ++k) g_scan.intensities[beam[k]] = 255;
+    ++tried;
+    const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
+    CHECK_FALSE(lit.found);
+    CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+  }
+  CHECK_EQUAL(3, tried);
+}
+
 // A stripe over a quarter of whose beams read dark is lit in part, as where another code's stripe lies half over it
 // or the pose is off along the face by part of a region: it reads neither way, and the code is unread.
 TEST(DockPoseEstimator, AStripeLitInPartLeavesTheCodeUnread) {

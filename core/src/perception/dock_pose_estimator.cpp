@@ -681,6 +681,32 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   std::size_t run_prev_seg = kMaxProfileVertices;
   bool run_prev_bright = false;
   bool* run_prev_gap = nullptr;
+  // A bright run's length does not depend on where the pose puts the dock along its face: a run of consecutive
+  // bright inlier beams on one segment spanning more tape than this code's longest piece there is tape this code
+  // does not have, however far along the face the pose may be off. The tape a run proves is its span less each end
+  // beam's edge margin. Across a corner a pose error moves the two segments' hits apart, so a corner ends a run.
+  bool long_run_open = false;
+  Real long_run_lo = 0;
+  Real long_run_hi = 0;
+  std::size_t long_run_seg = kMaxProfileVertices;
+  bool long_run_seen = false;
+  auto close_long_run = [&]() {
+    if (long_run_open && seg_taped_[long_run_seg]) {
+      // The longest piece of tape on the run's segment: stripes meeting end to end are one.
+      Real longest_m = 0;
+      Real piece_from_m = 0;
+      Real piece_to_m = -1;
+      for (std::size_t q = 0; q < profile_.reflector_count; ++q) {
+        const ReflectorStripe& st = profile_.reflectors[q];
+        if (st.segment != long_run_seg) continue;
+        if (st.from_m > piece_to_m + kStripeEdgeMarginM) piece_from_m = st.from_m;
+        piece_to_m = st.to_m;
+        longest_m = piece_to_m - piece_from_m > longest_m ? piece_to_m - piece_from_m : longest_m;
+      }
+      if (long_run_hi - long_run_lo > longest_m) long_run_seen = true;
+    }
+    long_run_open = false;
+  };
   // The fit's covariance (as estimate() reports it), for how far along a taped segment a beam's hit may lie from
   // where this pose puts it.
   Mat3 pose_cov = Mat3::Zero();
@@ -782,6 +808,18 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
           run_prev_seg = seg;
           run_prev_bright = bright;
           run_prev_gap = in_gap;
+          if (!bright || seg != long_run_seg) close_long_run();
+          if (bright) {
+            if (!long_run_open) {
+              long_run_open = true;
+              long_run_lo = s + edge_m;
+              long_run_hi = s - edge_m;
+            }
+            // Whichever way the scan runs along the segment.
+            long_run_lo = s + edge_m < long_run_lo ? s + edge_m : long_run_lo;
+            long_run_hi = s - edge_m > long_run_hi ? s - edge_m : long_run_hi;
+          }
+          long_run_seg = seg;
         }
         ++r.inliers;
         ++seg_expected[seg];
@@ -817,6 +855,8 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     }
   }
   if (read_stripes) {
+    close_long_run();
+    if (long_run_seen) ++f.regions_unread;
     // A stripe reads as tape when three quarters of its beams or more are bright, as bare when under half are, and
     // neither way in between. A gap reads bare when at most a quarter of its beams are bright, as tape when two or
     // more and over a quarter are; one bright beam among fewer than four is either a glint or another dock's stripe
