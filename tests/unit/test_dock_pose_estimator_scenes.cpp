@@ -489,6 +489,49 @@ TEST(DockPoseEstimator, ABrightRunLongerThanTheCodesTapeLeavesTheCodeUnread) {
   CHECK_EQUAL(3, tried);
 }
 
+// A bright run between two dark beams closer together (and a beam's slack either side) than the stripe under it is
+// long holds less tape than the stripe: a shorter stripe of another code, or this one lit in part, even where the
+// dark beams lie within the stripe's edge margins, where the stripe's own tally does not look.
+TEST(DockPoseEstimator, ABrightRunShorterThanItsStripeLeavesTheCodeUnread) {
+  const DockProfile code = coded_plate({{0.10, 0.20}});
+  constexpr Real kEps = static_cast<Real>(1e-6);
+  int tried = 0;
+  for (int cm = 50; cm <= 150 && tried < 3; ++cm) {
+    const Truth t = simulate(code, cm / 100.0, 0.0, 0.0, ld06(0.002), 3);
+    g_est.configure(code, EstimatorParams{});
+    g_est.set_intensity_usable(true);
+    const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+    if (!clean.found) continue;
+    PlacedProfile placed;
+    placed.place(code, t.dock_in_lidar);
+    const ScanView v = g_scan.view();
+    // Darken the stripe's beams within its edge margins (by 2 mm less, for the fitted pose's error): the outermost
+    // dark ones must lie more than the 1 cm of slack closer together than the stripe is long.
+    std::size_t dark[8];
+    std::size_t n_dark = 0;
+    Real lo_m = 1;
+    Real hi_m = -1;
+    for (std::size_t i = 0; i < v.count && n_dark < 8; ++i) {
+      Real r = 0, s = 0;
+      if (!on_taped_face(placed, v, i, &r, &s) || g_scan.ranges_m[i] == 0) continue;
+      const Real edge = edge_margin_m(v, r, static_cast<Real>(-0.002));
+      const bool at_from = s > static_cast<Real>(0.10) && s < static_cast<Real>(0.10) + edge;
+      const bool at_to = s < static_cast<Real>(0.20) && s > static_cast<Real>(0.20) - edge;
+      if (!at_from && !at_to) continue;
+      dark[n_dark++] = i;
+      if (at_from) lo_m = std::min(lo_m, s);
+      if (at_to) hi_m = std::max(hi_m, s);
+    }
+    if (lo_m > 1 - kEps || hi_m < 0 || !(hi_m - lo_m + static_cast<Real>(0.01) < static_cast<Real>(0.096))) continue;
+    for (std::size_t k = 0; k < n_dark; ++k) g_scan.intensities[dark[k]] = 0;
+    ++tried;
+    const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
+    CHECK_FALSE(lit.found);
+    CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+  }
+  CHECK_EQUAL(3, tried);
+}
+
 // A stripe over a quarter of whose beams read dark is lit in part, as where another code's stripe lies half over it
 // or the pose is off along the face by part of a region: it reads neither way, and the code is unread.
 TEST(DockPoseEstimator, AStripeLitInPartLeavesTheCodeUnread) {

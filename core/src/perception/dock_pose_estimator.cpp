@@ -681,19 +681,29 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   std::size_t run_prev_seg = kMaxProfileVertices;
   bool run_prev_bright = false;
   bool* run_prev_gap = nullptr;
-  // A bright run's length does not depend on where the pose puts the dock along its face: a run of consecutive
-  // bright inlier beams on one segment spanning more tape than this code's longest piece there is tape this code
-  // does not have, however far along the face the pose may be off. The tape a run proves is its span less each end
-  // beam's edge margin. Across a corner a pose error moves the two segments' hits apart, so a corner ends a run.
+  // A bright run's length does not depend on where the pose puts the dock along its face. A run of consecutive
+  // bright inlier beams on a taped segment proves tape over its span less each end beam's edge margin: more than the
+  // code's longest piece there is tape this code does not have, however far along the face the pose may be off.
+  // Bounded by a dark beam at each end, it holds at most the span between those beams and the slack of a beam's
+  // place either side (a dark beam is not mostly on tape): less than the piece under its middle is that piece lit in
+  // part, or another code's shorter stripe. Across a corner a pose error moves the two segments' hits apart, so a
+  // corner ends a run.
   bool long_run_open = false;
-  Real long_run_lo = 0;
+  Real long_run_lo = 0;  // the tape the run proves, along its segment
   Real long_run_hi = 0;
+  Real long_run_mid = 0;
   std::size_t long_run_seg = kMaxProfileVertices;
-  bool long_run_seen = false;
-  auto close_long_run = [&]() {
+  bool prev_dark = false;  // the previous inlier beam on long_run_seg read dark, at prev_dark_m along it
+  Real prev_dark_m = 0;
+  bool run_bounded = false;  // the open run began next to a dark beam, at run_dark_m
+  Real run_dark_m = 0;
+  bool run_misfit = false;
+  // Closes the open run; `dark_end`: at a dark beam `dark_end_m` along the segment. O(stripes).
+  auto close_run = [&](bool dark_end, Real dark_end_m) {
     if (long_run_open && seg_taped_[long_run_seg]) {
-      // The longest piece of tape on the run's segment: stripes meeting end to end are one.
+      // Stripes meeting end to end are one piece.
       Real longest_m = 0;
+      Real under_m = 0;
       Real piece_from_m = 0;
       Real piece_to_m = -1;
       for (std::size_t q = 0; q < profile_.reflector_count; ++q) {
@@ -701,9 +711,14 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
         if (st.segment != long_run_seg) continue;
         if (st.from_m > piece_to_m + kStripeEdgeMarginM) piece_from_m = st.from_m;
         piece_to_m = st.to_m;
-        longest_m = piece_to_m - piece_from_m > longest_m ? piece_to_m - piece_from_m : longest_m;
+        const Real piece_m = piece_to_m - piece_from_m;
+        longest_m = piece_m > longest_m ? piece_m : longest_m;
+        if (long_run_mid >= piece_from_m && long_run_mid <= piece_to_m) under_m = piece_m;
       }
-      if (long_run_hi - long_run_lo > longest_m) long_run_seen = true;
+      if (long_run_hi - long_run_lo > longest_m) run_misfit = true;
+      if (run_bounded && dark_end && std::fabs(dark_end_m - run_dark_m) + 2 * kStripeEdgeMarginM < under_m) {
+        run_misfit = true;
+      }
     }
     long_run_open = false;
   };
@@ -808,16 +823,40 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
           run_prev_seg = seg;
           run_prev_bright = bright;
           run_prev_gap = in_gap;
-          if (!bright || seg != long_run_seg) close_long_run();
+          // A dark beam well inside a piece of this code's tape is left to the stripe's own tally (which forgives a
+          // quarter of its beams): it neither ends nor bounds a run.
+          bool dark_inside = false;
+          for (std::size_t q = 0; q < profile_.reflector_count && !bright && !dark_inside; ++q) {
+            const ReflectorStripe& st = profile_.reflectors[q];
+            Real to_m = st.to_m;
+            while (q + 1 < profile_.reflector_count && profile_.reflectors[q + 1].segment == st.segment &&
+                   profile_.reflectors[q + 1].from_m <= to_m + kStripeEdgeMarginM) {
+              to_m = profile_.reflectors[++q].to_m;
+            }
+            dark_inside = st.segment == seg && s >= st.from_m + edge_m && s <= to_m - edge_m;
+          }
+          if (seg != long_run_seg) {
+            close_run(false, 0);
+            prev_dark = false;
+          } else if (!bright && !dark_inside) {
+            close_run(true, s);
+          }
           if (bright) {
             if (!long_run_open) {
               long_run_open = true;
               long_run_lo = s + edge_m;
               long_run_hi = s - edge_m;
+              run_bounded = prev_dark;
+              run_dark_m = prev_dark_m;
             }
             // Whichever way the scan runs along the segment.
             long_run_lo = s + edge_m < long_run_lo ? s + edge_m : long_run_lo;
             long_run_hi = s - edge_m > long_run_hi ? s - edge_m : long_run_hi;
+            long_run_mid = R(0.5) * (long_run_lo + long_run_hi);
+          }
+          if (!dark_inside) {
+            prev_dark = !bright;
+            prev_dark_m = s;
           }
           long_run_seg = seg;
         }
@@ -855,8 +894,8 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     }
   }
   if (read_stripes) {
-    close_long_run();
-    if (long_run_seen) ++f.regions_unread;
+    close_run(false, 0);
+    if (run_misfit) ++f.regions_unread;
     // A stripe reads as tape when three quarters of its beams or more are bright, as bare when under half are, and
     // neither way in between. A gap reads bare when at most a quarter of its beams are bright, as tape when two or
     // more and over a quarter are; one bright beam among fewer than four is either a glint or another dock's stripe
