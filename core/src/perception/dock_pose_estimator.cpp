@@ -782,8 +782,9 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
           bool* in_gap = nullptr;  // The gap this beam lies deep inside, if any.
           const Real deep_m = edge_m + kRunAlongSigmas * along_sigma_m(seg, expected_m * dir_[i]);
           // A bare end's margin at a corner with an untaped surface of the dock: a beam there, wherever the pose
-          // error puts it, can find tape only on this end, so a bright one is read; a dark one may lie on the
-          // other surface and tells nothing.
+          // error puts it, can find tape only on this end, so a bright one is read when this code's stripe could
+          // not spill that far (three standard deviations of the pose's along-face error); a dark one may lie on
+          // the other surface and tells nothing.
           const bool bright_at_start = bright && seg > 0 && !seg_taped_[seg - 1];
           const bool bright_at_end = bright && seg + 1 < placed_.segments && !seg_taped_[seg + 1];
           for (std::size_t q = 0; q < profile_.reflector_count && !placed_in_region; ++q) {
@@ -791,7 +792,8 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
             if (st.segment != seg) continue;
             if (s < st.from_m) {
               const Real gap_from = last < kMaxReflectors ? profile_.reflectors[last].to_m : R(0);
-              if ((s >= gap_from + edge_m || (last == kMaxReflectors && bright_at_start)) && s <= st.from_m - edge_m) {
+              const bool corner = last == kMaxReflectors && bright_at_start && s <= st.from_m - deep_m;
+              if ((s >= gap_from + edge_m || corner) && s <= st.from_m - edge_m) {
                 ++gap_n[q];
                 if (bright) ++gap_bright[q];
                 // A segment's bare start has no stripe of this code before it to spill over: the margin there is
@@ -810,7 +812,7 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
             last = q;
           }
           if (!placed_in_region && last < kMaxReflectors && s >= profile_.reflectors[last].to_m + edge_m &&
-              (s <= len - edge_m || bright_at_end)) {
+              (s <= len - edge_m || (bright_at_end && s >= profile_.reflectors[last].to_m + deep_m))) {
             ++after_n[last];
             if (bright) ++after_bright[last];
             // Nor has a bare end a stripe of this code after it: only the edge margin keeps a run off its end.
