@@ -306,13 +306,25 @@ bool on_taped_face(const PlacedProfile& placed, const ScanView& v, std::size_t i
   return true;
 }
 
+/// Configures g_est for `code`, its intensity usable, and estimates g_scan as it is.
+DockEstimate estimate_coded(const DockProfile& code) {
+  g_est.configure(code, EstimatorParams{});
+  g_est.set_intensity_usable(true);
+  return g_est.estimate(g_scan.view(), Pose2{});
+}
+
+/// g_scan as the test has lit or darkened it: the estimator refuses it, the code unread.
+void check_code_unread() {
+  const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_FALSE(lit.found);
+  CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+}
+
 /// Simulates `code` straight ahead at `range_m` (LD06, σ 2 mm, `seed`) into g_scan, configures g_est for it with the
 /// intensity usable, checks the untouched scan finds it, and returns the dock placed at its true pose.
 PlacedProfile found_coded_dock(const DockProfile& code, double range_m, int seed) {
   const Truth t = simulate(code, range_m, 0.0, 0.0, ld06(0.002), seed);
-  g_est.configure(code, EstimatorParams{});
-  g_est.set_intensity_usable(true);
-  const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+  const DockEstimate clean = estimate_coded(code);
   CHECK_TRUE(clean.found);
   PlacedProfile placed;
   placed.place(code, t.dock_in_lidar);
@@ -332,9 +344,7 @@ Real edge_margin_m(const ScanView& v, Real range_m, Real extra_m) {
 TEST(DockPoseEstimator, AGapSeenByOneBrightBeamLeavesTheCodeUnread) {
   const DockProfile code = coded_plate({{0.015, 0.13}, {0.17, 0.30}});  // a 4 cm gap: one beam inside it at 1 m
   const Truth t = simulate(code, 1.0, 0.0, 0.0, ld06(0.002), 3);
-  g_est.configure(code, EstimatorParams{});
-  g_est.set_intensity_usable(true);
-  const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+  const DockEstimate clean = estimate_coded(code);
   CHECK_TRUE(clean.found);
   CHECK_EQUAL(0, clean.evidence.features.regions_unread);
   // Light the beams landing well inside the gap, as another dock's tape there would.
@@ -386,14 +396,10 @@ TEST(DockPoseEstimator, ABrightBeamOnANarrowBareEndLeavesTheCodeUnread) {
     }
     if (inside != 1) continue;
     ++tried;
-    g_est.configure(code, EstimatorParams{});
-    g_est.set_intensity_usable(true);
-    const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+    const DockEstimate clean = estimate_coded(code);
     CHECK_TRUE(clean.found);
     g_scan.intensities[beam] = 255;  // another code's stripe on the end, seen by this one beam
-    const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
-    CHECK_FALSE(lit.found);
-    CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+    check_code_unread();
   }
   CHECK_EQUAL(3, tried);
 }
@@ -428,9 +434,7 @@ TEST(DockPoseEstimator, ABrightBeamAtABareEndsCornerLeavesTheCodeUnread) {
     const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
     CHECK_TRUE(clean.found);
     g_scan.intensities[corner] = 255;  // another code's stripe on the end, seen by the beam at its corner
-    const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
-    CHECK_FALSE(lit.found);
-    CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+    check_code_unread();
   }
   CHECK_EQUAL(3, tried);
 }
@@ -443,9 +447,7 @@ TEST(DockPoseEstimator, ABrightRunLongerThanTheCodesTapeLeavesTheCodeUnread) {
   int tried = 0;
   for (int cm = 50; cm <= 80 && tried < 3; ++cm) {
     const Truth t = simulate(code, cm / 100.0, 0.0, 0.0, ld06(0.01), 3);
-    g_est.configure(code, EstimatorParams{});
-    g_est.set_intensity_usable(true);
-    const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+    const DockEstimate clean = estimate_coded(code);
     if (!clean.found) continue;
     PlacedProfile placed;
     placed.place(code, t.dock_in_lidar);
@@ -483,9 +485,7 @@ TEST(DockPoseEstimator, ABrightRunLongerThanTheCodesTapeLeavesTheCodeUnread) {
     if (!(b - a > static_cast<Real>(0.103))) continue;
     for (std::size_t k = lo; k <= hi; ++k) g_scan.intensities[beam[k]] = 255;
     ++tried;
-    const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
-    CHECK_FALSE(lit.found);
-    CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+    check_code_unread();
   }
   CHECK_EQUAL(3, tried);
 }
@@ -499,9 +499,7 @@ TEST(DockPoseEstimator, ABrightRunShorterThanItsStripeLeavesTheCodeUnread) {
   int tried = 0;
   for (int cm = 50; cm <= 150 && tried < 3; ++cm) {
     const Truth t = simulate(code, cm / 100.0, 0.0, 0.0, ld06(0.002), 3);
-    g_est.configure(code, EstimatorParams{});
-    g_est.set_intensity_usable(true);
-    const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{});
+    const DockEstimate clean = estimate_coded(code);
     if (!clean.found) continue;
     PlacedProfile placed;
     placed.place(code, t.dock_in_lidar);
@@ -526,9 +524,7 @@ TEST(DockPoseEstimator, ABrightRunShorterThanItsStripeLeavesTheCodeUnread) {
     if (lo_m > 1 - kEps || hi_m < 0 || !(hi_m - lo_m + static_cast<Real>(0.01) < static_cast<Real>(0.096))) continue;
     for (std::size_t k = 0; k < n_dark; ++k) g_scan.intensities[dark[k]] = 0;
     ++tried;
-    const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
-    CHECK_FALSE(lit.found);
-    CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+    check_code_unread();
   }
   CHECK_EQUAL(3, tried);
 }
@@ -554,9 +550,7 @@ TEST(DockPoseEstimator, AStripeLitInPartLeavesTheCodeUnread) {
   }
   CHECK(4 * dark > inside);
   CHECK(2 * dark < inside);
-  const DockEstimate lit = g_est.estimate(g_scan.view(), Pose2{});
-  CHECK_FALSE(lit.found);
-  CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
+  check_code_unread();
 }
 
 // A bright run at the outer side of a bare end (the segment's end, where this code has no stripe to spill over) is

@@ -41,6 +41,16 @@ void add_event(docksim::Scenario& sc, docksim::EventKind kind, double t_s, doubl
 }
 
 // The default scenario with a base command timeout and one host_stall event.
+/// One docking of `sc` by `controller` with run seed `seed`, from a fixed start (start_from's distance, bearing and
+/// heading) instead of a drawn one.
+docksim::SimRun run_from(const docksim::Scenario& sc, const char* controller, std::uint64_t seed, double distance_m,
+                         double bearing_rad, double heading_rad) {
+  const docksim::StartPose start = docksim::start_from(sc, distance_m, bearing_rad, heading_rad);
+  docksim::SimOptions opt;
+  opt.start = &start;
+  return docksim::run_docking(sc, controller, seed, opt);
+}
+
 docksim::Scenario host_stall_scenario(double command_timeout_s, double t_s, double duration_s) {
   docksim::Scenario sc = default_scenario();
   sc.chassis.motor.command_timeout_s = command_timeout_s;
@@ -222,10 +232,7 @@ TEST(SimRun, ARobotTurnedAcrossTheDockFaceStillLearnsTheDeadband) {
   const docksim::Scenario sc = docksim::parse_scenario_toml(
       "[robot]\nwheel_radius_m = 0.075\n[robot.footprint]\npads = \"rear\"\n[robot.motor]\ndeadband_radps = 0.8\n",
       "across.toml");
-  const docksim::StartPose start = docksim::start_from(sc, 0.6, 39 * kDeg, -2 * kDeg);
-  docksim::SimOptions opt;
-  opt.start = &start;
-  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 1, opt);
+  const docksim::SimRun r = run_from(sc, "smooth", 1, 0.6, 39 * kDeg, -2 * kDeg);
   CHECK_TEXT(r.outcome.charging_confirmed, "timed out standing beside the dock");
   CHECK(std::fabs(r.outcome.lateral_m) <= 0.010);
   CHECK(r.outcome.time_to_charging_s < 30);
@@ -237,10 +244,7 @@ TEST(SimRun, ARearPadRobotBacksOffForwardsOnARetry) {
   docksim::Scenario sc = docksim::parse_scenario_toml(
       "[robot.footprint]\npads = \"rear\"\n[robot.lidar]\nerror_y_m = 0.016\n", "rear-retry.toml");
   CHECK_TRUE(sc.task.pads_rear);
-  const docksim::StartPose start = docksim::start_from(sc, 1.5, 0, 0);
-  docksim::SimOptions opt;
-  opt.start = &start;
-  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 7, opt);
+  const docksim::SimRun r = run_from(sc, "smooth", 7, 1.5, 0, 0);
   check_docked(r);
   CHECK(r.outcome.retries >= 1);
 }
@@ -253,10 +257,7 @@ TEST(SimRun, PushThenHostRedockRecovers) {
   push.dy_m = 0.5;
   sc.events.push_back(push);
   sc.host.redock_after_fault = 1;
-  const docksim::StartPose start = docksim::start_from(sc, 2.0, 0, 0);
-  docksim::SimOptions opt;
-  opt.start = &start;
-  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 5, opt);
+  const docksim::SimRun r = run_from(sc, "smooth", 5, 2.0, 0, 0);
   CHECK(has_fault(r, 178, 3.0, 3.2));
   CHECK(r.outcome.charging_confirmed);
 }
@@ -264,10 +265,7 @@ TEST(SimRun, PushThenHostRedockRecovers) {
 TEST(SimRun, OneSecondOcclusionIsRecovered) {
   docksim::Scenario sc = default_scenario();
   add_event(sc, docksim::EventKind::kOccludeDock, 2.0, 1.0);
-  const docksim::StartPose start = docksim::start_from(sc, 1.5, 10 * kDeg, 0);
-  docksim::SimOptions opt;
-  opt.start = &start;
-  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 5, opt);
+  const docksim::SimRun r = run_from(sc, "smooth", 5, 1.5, 10 * kDeg, 0);
   check_docked(r);
   CHECK(r.outcome.faults.empty());
   // The occlusion was longer than target_lost_after_s (0.5 s): the task manager held, then resumed.
@@ -332,10 +330,7 @@ TEST(SimRun, AHeavyBaseWithAWideDeadbandDocksOnceTheCoreHasLearnedIt) {
 TEST(SimRun, ALidarMountedAheadAndTurnedDocks) {
   docksim::Scenario sc = default_scenario();
   sc.lidar_mount = dockcore_test::pose(0.12, 0.03, 5 * kDeg);
-  const docksim::StartPose start = docksim::start_from(sc, 1.5, -20 * kDeg, 15 * kDeg);
-  docksim::SimOptions opt;
-  opt.start = &start;
-  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 3, opt);
+  const docksim::SimRun r = run_from(sc, "smooth", 3, 1.5, -20 * kDeg, 15 * kDeg);
   check_docked(r);
   CHECK(r.outcome.faults.empty());
 }
@@ -512,10 +507,7 @@ TEST(SimRun, ObstacleClearanceIsMeasured) {
   c.centre = dockcore::Vec2(1.0, 0.5);
   c.r_m = 0.05;
   sc.circles.push_back(c);
-  const docksim::StartPose start = docksim::start_from(sc, 1.5, 0, 0);
-  docksim::SimOptions opt;
-  opt.start = &start;
-  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 5, opt);
+  const docksim::SimRun r = run_from(sc, "smooth", 5, 1.5, 0, 0);
   CHECK(std::isfinite(r.outcome.min_clearance_m));
   // On the axis the robot's side (y = 0.2) passes the pole's edge (y = 0.45) at about 0.25 m.
   CHECK(r.outcome.min_clearance_m > 0.15 && r.outcome.min_clearance_m < 0.27);
@@ -534,10 +526,7 @@ TEST(SimRun, APasserByStepsAroundTheRobotAndTheRobotDocks) {
   ev.vy_mps = -1.0;
   ev.duration_s = 3.0;
   sc.events.push_back(ev);
-  const docksim::StartPose start = docksim::start_from(sc, 1.5, 0, 0);
-  docksim::SimOptions opt;
-  opt.start = &start;
-  const docksim::SimRun r = docksim::run_docking(sc, "smooth", 5, opt);
+  const docksim::SimRun r = run_from(sc, "smooth", 5, 1.5, 0, 0);
   CHECK(r.outcome.charging_confirmed);
   CHECK(std::isfinite(r.outcome.min_clearance_m));
   CHECK(r.outcome.min_clearance_m >= docksim::kPasserGiveWayM - 0.01);
