@@ -320,14 +320,19 @@ void check_code_unread() {
   CHECK_EQUAL(static_cast<int>(RejectReason::kCodeUnread), static_cast<int>(lit.reject));
 }
 
-/// Simulates `code` straight ahead at `range_m` (LD06, σ 2 mm, `seed`) into g_scan, configures g_est for it with the
-/// intensity usable, checks the untouched scan finds it, and returns the dock placed at its true pose.
+/// Simulates `code` straight ahead at `range_m` (LD06, σ `sigma_m`, `seed`) into g_scan and estimates it
+/// (estimate_coded); when the untouched scan finds the dock, `placed` receives it at its true pose. Returns found.
+bool coded_dock_found(const DockProfile& code, double range_m, double sigma_m, int seed, PlacedProfile* placed) {
+  const Truth t = simulate(code, range_m, 0.0, 0.0, ld06(sigma_m), seed);
+  if (!estimate_coded(code).found) return false;
+  placed->place(code, t.dock_in_lidar);
+  return true;
+}
+
+/// coded_dock_found at σ 2 mm, checked to find the dock; the dock placed at its true pose.
 PlacedProfile found_coded_dock(const DockProfile& code, double range_m, int seed) {
-  const Truth t = simulate(code, range_m, 0.0, 0.0, ld06(0.002), seed);
-  const DockEstimate clean = estimate_coded(code);
-  CHECK_TRUE(clean.found);
   PlacedProfile placed;
-  placed.place(code, t.dock_in_lidar);
+  CHECK_TRUE(coded_dock_found(code, range_m, 0.002, seed, &placed));
   return placed;
 }
 
@@ -446,11 +451,8 @@ TEST(DockPoseEstimator, ABrightRunLongerThanTheCodesTapeLeavesTheCodeUnread) {
   const DockProfile code = coded_plate({{0.10, 0.20}});
   int tried = 0;
   for (int cm = 50; cm <= 80 && tried < 3; ++cm) {
-    const Truth t = simulate(code, cm / 100.0, 0.0, 0.0, ld06(0.01), 3);
-    const DockEstimate clean = estimate_coded(code);
-    if (!clean.found) continue;
     PlacedProfile placed;
-    placed.place(code, t.dock_in_lidar);
+    if (!coded_dock_found(code, cm / 100.0, 0.01, 3, &placed)) continue;
     const ScanView v = g_scan.view();
     // The face's beams in scan order, by their place along it.
     std::size_t beam[64];
@@ -498,11 +500,8 @@ TEST(DockPoseEstimator, ABrightRunShorterThanItsStripeLeavesTheCodeUnread) {
   constexpr Real kEps = static_cast<Real>(1e-6);
   int tried = 0;
   for (int cm = 50; cm <= 150 && tried < 3; ++cm) {
-    const Truth t = simulate(code, cm / 100.0, 0.0, 0.0, ld06(0.002), 3);
-    const DockEstimate clean = estimate_coded(code);
-    if (!clean.found) continue;
     PlacedProfile placed;
-    placed.place(code, t.dock_in_lidar);
+    if (!coded_dock_found(code, cm / 100.0, 0.002, 3, &placed)) continue;
     const ScanView v = g_scan.view();
     // Darken the stripe's beams within its edge margins (by 2 mm less, for the fitted pose's error): the outermost
     // dark ones must lie more than the 1 cm of slack closer together than the stripe is long.
