@@ -97,6 +97,8 @@ TEST(DockPoseEstimator, CovarianceAboveTheLimitIsRefusedAsUncertain) {
   // limit on the position 1-σ, refused as uncertain (and counted) when the limit is far below the range noise.
   const DockProfile prof = profile("plate-v");
   cast_dock(prof, dockcore_test::pose(1.0, 0.05, kPi - 0.1), 450, -kPi);
+  // A round room behind the lidar, 2.5 m out: returns enough for the scan to pass the floor, none of them the dock.
+  for (std::size_t i = 0; i < 100; ++i) g_scan.ranges_m[i] = static_cast<Real>(2.5);
   g_est.configure(prof, EstimatorParams{});
   const DockEstimate ok = g_est.estimate(g_scan.view(), Pose2{});
   CHECK_TRUE(ok.found);
@@ -108,6 +110,27 @@ TEST(DockPoseEstimator, CovarianceAboveTheLimitIsRefusedAsUncertain) {
   CHECK_EQUAL(static_cast<int>(EstimateStatus::kNotVerified), static_cast<int>(e.status));
   CHECK_EQUAL(static_cast<int>(RejectReason::kUncertain), static_cast<int>(e.reject));
   CHECK_EQUAL(1u, g_est.counters().rejected_by[static_cast<std::size_t>(RejectReason::kUncertain)]);
+}
+
+TEST(DockPoseEstimator, ADocksOwnFloorOnInliersReplacesTheParameters) {
+  // The same plate-v scan (noise-free, 1 m ahead): found with the parameters' floor; a profile stating a floor one
+  // above the inliers it gets is refused for too few inliers, whatever the parameters say. The small built-ins
+  // bring 6.
+  DockProfile prof = profile("plate-v");
+  CHECK_EQUAL(0, prof.min_inliers);
+  CHECK_EQUAL(6, profile("v-marker").min_inliers);
+  CHECK_EQUAL(6, profile("breakpoint").min_inliers);
+  cast_dock(prof, dockcore_test::pose(1.0, 0.05, kPi - 0.1), 450, -kPi);
+  // A round room behind the lidar, 2.5 m out: returns enough for the scan to pass the floor, none of them the dock.
+  for (std::size_t i = 0; i < 100; ++i) g_scan.ranges_m[i] = static_cast<Real>(2.5);
+  g_est.configure(prof, EstimatorParams{});
+  const DockEstimate ok = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_TRUE(ok.found);
+  prof.min_inliers = static_cast<std::uint16_t>(ok.inliers + 1);
+  g_est.configure(prof, EstimatorParams{});
+  const DockEstimate e = g_est.estimate(g_scan.view(), Pose2{});
+  CHECK_FALSE(e.found);
+  CHECK_EQUAL(static_cast<int>(RejectReason::kTooFewInliers), static_cast<int>(e.reject));
 }
 
 TEST(DockPoseEstimator, GlobalSearchFindsADockAcrossTheWrapOfAFullTurn) {

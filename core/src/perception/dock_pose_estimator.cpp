@@ -1024,7 +1024,7 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   const Vec2& face = placed_.x_axis;
   const Real cos_view = dist_m > 0 ? -face.dot(t) / dist_m : R(-1);
   r.reject = RejectReason::kNone;
-  if (r.inliers < params_.min_inliers) {
+  if (r.inliers < min_inliers()) {
     r.reject = RejectReason::kTooFewInliers;
   } else if (static_cast<Real>(r.inliers) < params_.min_visible_fraction * expected) {
     r.reject = RejectReason::kMostlyHidden;
@@ -1362,7 +1362,7 @@ DockEstimate DockPoseEstimatorBase::estimate(const ScanView& scan, const Pose2& 
   // The global search's points are its count of valid returns.
   if (!hint_holds) {
     build_points();
-    if (points_.size() < params_.min_inliers) {
+    if (points_.size() < min_inliers()) {
       est.status = EstimateStatus::kNoPoints;
       return est;
     }

@@ -160,7 +160,8 @@ struct EstimatorParams {
   /// occlusion: the space just in front of a dock is empty (a robot docks there), so a surface there means the
   /// hypothesis is wrong — e.g. a flat wall "explaining" a winged dock's face while hiding its wings.
   Real free_space_m = static_cast<Real>(0.15);
-  std::uint16_t min_inliers = 10;  ///< Absolute floor on inliers (a 0.3 m dock 2 m away gives ~13 with LD06).
+  std::uint16_t min_inliers = 10;  ///< Absolute floor on inliers (a 0.3 m dock 2 m away gives ~13 with LD06);
+                                   ///< a profile's own DockProfile::min_inliers replaces it.
   /// Inliers / all beams expected on the dock (occluded included), at least: how much of the dock may be hidden.
   Real min_visible_fraction = static_cast<Real>(0.5);
   /// Distance from a segment's line within which a return 4-12 cm past its end counts as the surface carrying on.
@@ -364,6 +365,9 @@ class DockPoseEstimatorBase {
     Pose2 pose{};       // dock in lidar frame
     Real prescore = 0;
   };
+
+  /// The floor on inliers for this dock: its profile's own, else the parameters'. O(1).
+  std::uint16_t min_inliers() const { return profile_.min_inliers > 0 ? profile_.min_inliers : params_.min_inliers; }
 
   DockProfile profile_{};
   EstimatorParams params_{};

@@ -81,6 +81,10 @@ struct DockProfile {
   /// Retro-reflective stripes, in order along the outline (segment, then from_m); none on the built-ins.
   ReflectorStripe reflectors[kMaxReflectors] = {};
   std::size_t reflector_count = 0;
+  /// This dock's own floor on the beams a detection needs (0: EstimatorParams::min_inliers). A small dock seen from
+  /// afar gives fewer returns than a large one; its floor is the lowest that keeps its false docks on real dock-less
+  /// scans within 1 % (docs/docks.md, "Which floor"): the built-in v-marker and breakpoint 6, plate-v the estimator's.
+  std::uint16_t min_inliers = 0;
 
   std::size_t segment_count() const { return vertex_count > 0 ? vertex_count - 1 : 0; }
   /// Length of the polyline in metres. O(vertices).
