@@ -366,8 +366,12 @@ class DockPoseEstimatorBase {
     Real prescore = 0;
   };
 
-  /// The floor on inliers for this dock: its profile's own, else the parameters'. O(1).
-  std::uint16_t min_inliers() const { return profile_.min_inliers > 0 ? profile_.min_inliers : params_.min_inliers; }
+  /// The floor on inliers for this dock: its profile's own, else the parameters'. A dock with reflector stripes keeps
+  /// the parameters': its code is read from the beams on each stripe and gap, and a lower floor let a look-alike's
+  /// code be read from too few (confident wrong ids). O(1).
+  std::uint16_t min_inliers() const {
+    return profile_.min_inliers > 0 && profile_.reflector_count == 0 ? profile_.min_inliers : params_.min_inliers;
+  }
 
   DockProfile profile_{};
   EstimatorParams params_{};

@@ -84,6 +84,7 @@ struct DockProfile {
   /// This dock's own floor on the beams a detection needs (0: EstimatorParams::min_inliers). A small dock seen from
   /// afar gives fewer returns than a large one; its floor is the lowest that keeps its false docks on real dock-less
   /// scans within 1 % (docs/docks.md, "Which floor"): the built-in v-marker and breakpoint 6, plate-v the estimator's.
+  /// Not used once the profile carries reflector stripes (their code needs the estimator's floor).
   std::uint16_t min_inliers = 0;
 
   std::size_t segment_count() const { return vertex_count > 0 ? vertex_count - 1 : 0; }
