@@ -131,6 +131,16 @@ TEST(DockPoseEstimator, ADocksOwnFloorOnInliersReplacesTheParameters) {
   const DockEstimate e = g_est.estimate(g_scan.view(), Pose2{});
   CHECK_FALSE(e.found);
   CHECK_EQUAL(static_cast<int>(RejectReason::kTooFewInliers), static_cast<int>(e.reject));
+  // With reflector stripes the profile's floor is not used (its code needs the parameters' floor of beams); read by
+  // geometry alone here, the same scan is found again.
+  ReflectorStripe stripe;
+  stripe.segment = 1;
+  stripe.from_m = static_cast<Real>(0.10);
+  stripe.to_m = static_cast<Real>(0.20);
+  CHECK_EQUAL(static_cast<int>(ProfileError::kOk), static_cast<int>(add_reflector(prof, stripe)));
+  g_est.configure(prof, EstimatorParams{});
+  g_est.set_intensity_usable(false);
+  CHECK_TRUE(g_est.estimate(g_scan.view(), Pose2{}).found);
 }
 
 TEST(DockPoseEstimator, GlobalSearchFindsADockAcrossTheWrapOfAFullTurn) {
