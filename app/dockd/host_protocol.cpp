@@ -158,8 +158,9 @@ HostErrorCode parse_host_request(const char* data, std::size_t len, HostRequest&
 }
 
 std::size_t format_host_error(char* buf, std::size_t size, bool has_seq, std::uint32_t seq, HostErrorCode code,
-                              const char* message) {
+                              const char* message, const char* type) {
   JsonWriter w(buf, size);
+  if (type != nullptr) w.str("type", type);
   w.boolean("ok", false);
   if (has_seq) w.uint("seq", seq);
   w.uint("code", static_cast<unsigned>(code)).str("error", to_string(code)).str_cut("message", message, 255);
@@ -203,11 +204,13 @@ SubmitResult HostProtocol::submit(HostCommandType type, std::uint16_t dock_id, s
 
 namespace {
 
-/// The error object that goes instead of a reply or status object that did not fit one datagram (seq as `has_seq`).
-std::size_t too_long_error(char* buf, std::size_t size, bool has_seq, std::uint32_t seq, const char* what) {
+/// The error object that goes instead of a reply or status object that did not fit one datagram (seq as `has_seq`;
+/// `type` as format_host_error's).
+std::size_t too_long_error(char* buf, std::size_t size, bool has_seq, std::uint32_t seq, const char* what,
+                           const char* type = nullptr) {
   char msg[96];
   std::snprintf(msg, sizeof msg, "the %s did not fit one datagram (%zu bytes)", what, dockcore::hal::kMaxHostReply);
-  return format_host_error(buf, size, has_seq, seq, HostErrorCode::kReplyTooLong, msg);
+  return format_host_error(buf, size, has_seq, seq, HostErrorCode::kReplyTooLong, msg, type);
 }
 
 }  // namespace
@@ -435,7 +438,8 @@ void HostProtocol::publish_status(const dockcore::hal::StatusMessage& can_status
     std::size_t n = w.finish();
     if (n == 0) {
       ++counters_.replies_too_long;
-      n = too_long_error(buf, sizeof buf, false, 0, "status");
+      // Marked as a stream object, so a host waiting for its own reply does not take it for one.
+      n = too_long_error(buf, sizeof buf, false, 0, "status", "status");
     }
     udp_->publish(buf, n, now_us);
   }

@@ -80,9 +80,10 @@ const char* to_string(HostErrorCode e);
 HostErrorCode parse_host_request(const char* data, std::size_t len, HostRequest& out, const char*& detail);
 
 /// Writes {"ok":false,"seq":N,"code":C,"error":"name","message":"..."} (seq omitted when has_seq is false; the
-/// message cut at 255 bytes) into `buf`; returns the length (0 when it does not fit). O(size).
+/// message cut at 255 bytes) into `buf`; returns the length (0 when it does not fit). A non-null `type` goes first as
+/// "type" (a status stream object: hosts tell the stream from replies by it). O(size).
 std::size_t format_host_error(char* buf, std::size_t size, bool has_seq, std::uint32_t seq, HostErrorCode code,
-                              const char* message);
+                              const char* message, const char* type = nullptr);
 
 /// What the host protocol asks of the daemon it answers for (Daemon implements it).
 class HostActions {

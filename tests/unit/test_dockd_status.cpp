@@ -295,6 +295,10 @@ TEST(DockdStatus, AStatusThatDoesNotFitIsAnsweredWithAnErrorAndCounted) {
   CHECK_EQUAL(1u, link.published.size());
   const nlohmann::json s = nlohmann::json::parse(link.published[0], nullptr, false);
   CHECK(!s.is_discarded());
+  STRCMP_EQUAL("status", s.at("type").get<std::string>().c_str());  // a stream object, not a reply
+  CHECK(!s.at("ok").get<bool>());
+  CHECK_EQUAL(10, s.at("code").get<int>());
   STRCMP_EQUAL("reply_too_long", s.at("error").get<std::string>().c_str());
+  CHECK(!s.contains("seq"));
   CHECK_EQUAL(2u, counters.replies_too_long);
 }
