@@ -9,6 +9,7 @@
 #include "dockcore/laser_scan.hpp"
 #include "dockcore/perception/dock_profile.hpp"
 #include "dockcore/perception/intensity_check.hpp"
+#include "docksim/angles.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenes.hpp"
@@ -22,7 +23,7 @@ using dockcore::kPi;
 
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = docksim::kDegD;
 
 Vec2 V(double x, double y) { return Vec2(static_cast<Real>(x), static_cast<Real>(y)); }
 Vec2 dir_of(double a) { return V(std::cos(a), std::sin(a)); }

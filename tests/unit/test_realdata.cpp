@@ -16,6 +16,7 @@
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_profile.hpp"
 #include "dockcore/perception/profile_geometry.hpp"
+#include "docksim/angles.hpp"
 #include "docksim/lidar_sim.hpp"
 #include "docksim/real_perception.hpp"
 #include "docksim/realdata.hpp"
@@ -32,7 +33,7 @@ using dockcore_test::pose;
 
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = docksim::kDegD;
 
 dockcore::DockProfile builtin(const char* name) {
   dockcore::DockProfile p;

@@ -9,6 +9,7 @@
 
 #include "dockcore/drivers/apriltag_detector.hpp"
 #include "dockcore/perception/tag_measurement.hpp"
+#include "docksim/angles.hpp"
 #include "docksim/rendered_camera.hpp"
 #include "docksim/rng.hpp"
 #include "docksim/scenario.hpp"
@@ -26,7 +27,7 @@ namespace {
 // The controller-name list is a function-local static: create it before CppUTest starts counting allocations.
 const bool kNamesReady = !docksim::controller_names().empty();
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = docksim::kDegD;
 
 std::string repo_file(const std::string& rel) {
   std::string f = __FILE__;  // .../tests/unit/test_rendered_camera.cpp

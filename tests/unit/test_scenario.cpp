@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "docksim/angles.hpp"
 #include "docksim/scenario.hpp"
 #include "docksim/sim_run.hpp"
 
@@ -16,7 +17,7 @@ namespace {
 // The controller-name list is a function-local static: create it before CppUTest starts counting allocations.
 const bool kNamesReady = !docksim::controller_names().empty();
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = docksim::kDegD;
 
 std::string scenario_dir() {
   std::string f = __FILE__;  // .../tests/unit/test_scenario.cpp

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "dockcore/task/faults.hpp"
+#include "docksim/angles.hpp"
 #include "docksim/camera_sim.hpp"
 #include "docksim/scenario.hpp"
 #include "docksim/sim_run.hpp"
@@ -19,7 +20,7 @@ namespace {
 // The controller-name list is a function-local static: create it before CppUTest starts counting allocations.
 const bool kNamesReady = !docksim::controller_names().empty();
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = docksim::kDegD;
 
 docksim::Scenario scenario_file(const std::string& name) {
   std::string f = __FILE__;  // .../tests/unit/test_sim_run.cpp

@@ -1,13 +1,11 @@
 #include "docksim/chassis.hpp"
+#include "docksim/angles.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace docksim {
 namespace {
-
-constexpr double kPiD = 3.14159265358979323846;
-constexpr double kTwoPiD = 2.0 * kPiD;
 
 double wrap_d(double a) {
   double r = std::remainder(a, kTwoPiD);

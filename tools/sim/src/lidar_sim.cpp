@@ -1,5 +1,6 @@
 // 2D lidar simulator: segment world, ray casting and the lidar error models (see docksim/lidar_sim.hpp).
 #include "docksim/lidar_sim.hpp"
+#include "docksim/angles.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,9 +10,6 @@
 namespace docksim {
 namespace {
 
-constexpr double kPiD = 3.14159265358979323846;
-constexpr double kTwoPiD = 2.0 * kPiD;
-constexpr double kDegD = kPiD / 180.0;
 // Hits closer than this along the ray are ignored so a ray starting on a surface does not hit that surface.
 constexpr double kMinHitT = 1e-9;
 

@@ -1,5 +1,6 @@
 // Scene generators (see docksim/scenes.hpp).
 #include "docksim/scenes.hpp"
+#include "docksim/angles.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +8,6 @@
 namespace docksim {
 namespace {
 
-constexpr double kPiD = 3.14159265358979323846;
 constexpr double kSqrtHalf = 0.70710678118654752440;
 
 Vec2 v2(double x, double y) { return Vec2(static_cast<Real>(x), static_cast<Real>(y)); }

@@ -1,4 +1,5 @@
 #include "docksim/sim_run.hpp"
+#include "docksim/angles.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -22,7 +23,6 @@ using dockcore::Vec2;
 
 namespace {
 
-constexpr double kPiD = 3.14159265358979323846;
 constexpr int kStepsPerTick = 4;  // 4 x 5 ms = 20 ms control period (50 Hz)
 constexpr int kStartDraws = 40;   // draws of a start clear of the furniture before the last one is kept
 constexpr double kStartClearanceM = 0.10;  // a start this close to furniture is drawn again

@@ -1,5 +1,6 @@
 // World generator for generalisation benchmarks (see docksim/world_gen.hpp).
 #include "docksim/world_gen.hpp"
+#include "docksim/angles.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,8 +13,6 @@
 namespace docksim {
 namespace {
 
-constexpr double kPiD = 3.14159265358979323846;
-constexpr double kDegD = kPiD / 180.0;
 constexpr double kFeatureM = 0.02;         // Smallest feature of a random profile.
 constexpr double kWallHalfLengthM = 3.0;   // Walls reach this far either side of the dock.
 constexpr double kLidarClearanceM = 0.30;  // The robot's body around the lidar stays free of clutter.
