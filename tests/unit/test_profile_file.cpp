@@ -80,6 +80,7 @@ TEST(ProfileFile, RoundTripOfBuiltins) {
     // 6 decimals in the file: within 1 µm, so not bit-identical, but the same outline for every purpose.
     LONGS_EQUAL(b.vertex_count, p.vertex_count);
     for (std::size_t i = 0; i < b.vertex_count; ++i) CHECK((b.vertices_m[i] - p.vertices_m[i]).norm() < 1e-6);
+    CHECK_EQUAL(b.min_inliers, p.min_inliers);  // the small built-ins' own floor goes through the file too
   }
 }
 
@@ -278,4 +279,21 @@ TEST(ProfileFile, BadReflectorsArePositioned) {
   check_position(pts + "[[reflectors]]\nsegment = 1\nfrom_m = 0\nto_m = 0.1\nwidth_m = 3\n", 6, 1,
                  "unknown key 'reflectors.width_m'");
   check_position(pts + "reflectors = 3\n", 2, 14, "array of tables");
+}
+
+TEST(ProfileFile, ADocksOwnFloorOnInliersIsReadAndRoundTrips) {
+  const DockProfile none = parse_profile_toml(kWings, "t.toml");
+  CHECK_EQUAL(0, none.min_inliers);  // no key: the estimator's floor
+  const DockProfile p = parse_profile_toml(kWings + "min_inliers = 7\n", "t.toml");
+  CHECK_EQUAL(7, p.min_inliers);
+  CHECK_EQUAL(7, parse_profile_toml(docksim::profile_to_toml(p), "rt.toml").min_inliers);
+}
+
+TEST(ProfileFile, BadFloorsOnInliersArePositioned) {
+  //                                 col: 1234567890123456
+  check_position(kWings + "min_inliers = 2\n", 2, 15, "min_inliers = 2 is out of range [3, 1000]");
+  check_position(kWings + "min_inliers = 6.5\n", 2, 15, "min_inliers must be an integer");
+  // A coded dock's code is read with the estimator's floor: a floor of its own would do nothing, so it is refused.
+  check_position(kWings + "min_inliers = 6\n[[reflectors]]\nsegment = 1\nfrom_m = 0\nto_m = 0.1\n", 2, 15,
+                 "min_inliers has no effect on a dock with [[reflectors]]");
 }

@@ -76,6 +76,10 @@ std::string profile_to_toml(const DockProfile& profile) {
          fmt(static_cast<double>(profile.vertices_m[i].y())) + "],\n";
   }
   s += "]\n";
+  // A coded dock's floor is the estimator's whatever the outline's (DockProfile::min_inliers): not written.
+  if (profile.min_inliers > 0 && profile.reflector_count == 0) {
+    s += "min_inliers = " + std::to_string(profile.min_inliers) + "\n";
+  }
   const dockcore::DockMounting& m = profile.mounting;
   if (m.kind != dockcore::DockMountKind::kUnknown) {
     s += "\n[mounting]\nkind = \"" + std::string(dockcore::to_string(m.kind)) + "\"\n";

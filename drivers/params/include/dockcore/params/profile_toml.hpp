@@ -7,6 +7,9 @@
 ///   name = "my-dock"          # optional, at most 23 characters; default: the caller's default name
 ///   contact_offset_m = 0.02   # optional, metres in [-1, 1]: every point is shifted by -contact_offset_m in x
 ///   points = [[x_m, y_m], ...]  # 2..32 points from the dock's -y side to its +y side, >= 1 mm apart
+///   min_inliers = 6           # optional, 3..1000: this dock's floor on a detection's beams
+///   (DockProfile::min_inliers);
+///                             # default: the estimator's; refused together with [[reflectors]], whose code needs that
 ///   [mounting]                # optional
 ///   kind = "wall"             # "wall" | "free_standing" | "unknown" (default)
 ///   wall_gap_m = [0, 0.10]    # metres, each in [0, 0.5], min <= max; only with kind = "wall"; default [0, 0.10]
@@ -151,6 +154,8 @@ DockProfile parse(const std::string& text, const std::string& source, const std:
   const toml::array* points = nullptr;
   std::string name = default_name;
   double contact_offset_m = 0;
+  std::int64_t min_inliers = 0;
+  const toml::node* min_inliers_node = nullptr;
   DockMounting mounting;
   std::vector<Vec2> v;
   struct StripeEntry {
@@ -213,6 +218,12 @@ DockProfile parse(const std::string& text, const std::string& source, const std:
                   v.push_back(q);
                 }
               }},
+             {"min_inliers",
+              [&](const toml::node& n) {
+                // Three beams fix a pose at all; the estimator's own parameter stops at 1000 too.
+                min_inliers = p.integer(n, 3, 1000);
+                min_inliers_node = &n;
+              }},
              {"mounting", [&](const toml::node& n) { mounting = read_mounting(p, n, "mounting."); }},
              {"reflectors",
               [&](const toml::node& n) {
@@ -260,6 +271,13 @@ DockProfile parse(const std::string& text, const std::string& source, const std:
     p.fail(at, "points: " + check_message(check, kProfileCheckDefaultBeamSpacingRad, kProfileCheckDefaultRangeM));
   }
   out.mounting = mounting;
+  if (min_inliers_node != nullptr && !stripes.empty()) {
+    // The estimator would ignore it (DockProfile::min_inliers): say so rather than keep a setting that does nothing.
+    p.fail(min_inliers_node->source(),
+           "min_inliers has no effect on a dock with [[reflectors]]: its code is read with the estimator's floor "
+           "([estimator] min_inliers)");
+  }
+  out.min_inliers = static_cast<std::uint16_t>(min_inliers);
   for (std::size_t i = 0; i < stripes.size(); ++i) {
     const ReflectorStripe& s = stripes[i].stripe;
     const std::string what = "reflectors[" + std::to_string(i) + "]: ";
