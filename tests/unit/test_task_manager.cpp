@@ -590,10 +590,9 @@ TEST(TaskManager, FarFromTheDockALossKeepsTheApproachGoingForAWhile) {
   for (const bool carry : {true, false}) {
     auto s = std::make_unique<Sim>();
     s->world = s->odom = Pose2{2.4, 0.1, kPi};
-    if (!carry) {
-      s->params.blind_approach_max_s = 0;
-      s->reconfigure();
-    }
+    // 3 s: short enough that the carry ends while the dock is still far (the default runs on to blind_approach_m).
+    s->params.blind_approach_max_s = carry ? 3 : 0;
+    s->reconfigure();
     s->command(HostCommandType::kDock);
     CHECK(s->run_until(TaskState::kAlign, 5));
     s->occluded = true;

@@ -105,7 +105,9 @@ struct TaskParams {
   /// would keep the view that lost it, while a metre of odometry moves the dock by centimetres, which the next
   /// detection on the way in corrects.
   Real blind_approach_m = static_cast<Real>(1.0);
-  Real blind_approach_max_s = static_cast<Real>(3.0);  ///< Longest the approach runs on odometry alone, s (0: off).
+  /// Longest the approach runs on odometry alone, s (0: off). Long enough for a far robot to turn towards the dock
+  /// and then cover some of the way: a slow lidar (RPLIDAR at 5.5 Hz) loses a dock 2–2.5 m out from scan to scan.
+  Real blind_approach_max_s = static_cast<Real>(8.0);
   /// The final push: it starts on the first ALIGN tick on which the estimate puts the robot lined up with the dock
   /// (its axis within 45° of the dock's, pads fore or aft) with its edge (footprint half-length or radius) this close
   /// to the dock's face, m (> 0), and lasts until ALIGN ends. Within it the robot may travel at most max_push_m on
