@@ -1,5 +1,6 @@
 // Dock-detector measurements on real recordings (see docksim/real_perception.hpp).
 #include "docksim/real_perception.hpp"
+#include "docksim/angles.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -24,10 +25,8 @@ using dockcore::Real;
 using dockcore::ScanView;
 using dockcore::Vec2;
 
-constexpr double kTwoPi = 2.0 * dockcore::kPi;
-
 double wrap(double a) {
-  return std::remainder(a, kTwoPi);
+  return std::remainder(a, kTwoPiD);
 }
 
 bool agree(const Pose2& a, const Pose2& b, double max_m, double max_rad) {
@@ -266,7 +265,7 @@ PastedClutter draw_clutter(const ScanView& first, const Pose2& sensor_in_world, 
       const int kind = static_cast<int>(rng.uniform() * 3);
       if (kind == 0) {  // a sign facing the lidar within ±40°
         const double len = rng.uniform(0.2, 0.6);
-        const double face = b + dockcore::kPi + rng.uniform(-40.0, 40.0) * dockcore::kPi / 180.0;
+        const double face = b + kPiD + rng.uniform(-40.0, 40.0) * kPiD / 180.0;
         const double tx = -std::sin(face), ty = std::cos(face);  // along the board
         // Tape: all over, or 1-3 stripes of 3-15 cm at random places (overlaps merge).
         std::vector<std::pair<double, double>> tape;
@@ -307,7 +306,7 @@ PastedClutter draw_clutter(const ScanView& first, const Pose2& sensor_in_world, 
         for (std::size_t q = before; q < c.world.segments.size(); ++q) c.world.segments[q].retro = true;
       } else {  // chrome legs
         const double side = rng.uniform(0.40, 0.50), radius = rng.uniform(0.01, 0.015);
-        const double yaw = rng.uniform(-dockcore::kPi, dockcore::kPi);
+        const double yaw = rng.uniform(-kPiD, kPiD);
         const std::size_t before = c.world.segments.size();
         for (int q = 0; q < 4; ++q) {
           const double lx = (q & 1 ? 0.5 : -0.5) * side, ly = (q & 2 ? 0.5 : -0.5) * side;
@@ -317,7 +316,7 @@ PastedClutter draw_clutter(const ScanView& first, const Pose2& sensor_in_world, 
         }
         for (std::size_t q = before; q < c.world.segments.size(); ++q) {
           c.world.segments[q].retro = true;
-          c.world.segments[q].retro_cutoff_rad = 12.0 * dockcore::kPi / 180.0;
+          c.world.segments[q].retro_cutoff_rad = 12.0 * kPiD / 180.0;
         }
       }
       ++c.objects;
@@ -448,7 +447,7 @@ bool find_composite_site(const ScanView& scan, const dockcore::DockProfile& prof
     const double amax = amin + static_cast<double>(scan.angle_increment_rad) * static_cast<double>(scan.count - 1);
     for (int a = 0; a < p.attempts; ++a) {
       const double d = rng.uniform(p.free_min_m, p.free_max_m);
-      const double b = full ? rng.uniform(-dockcore::kPi, dockcore::kPi) : rng.uniform(amin, amax);
+      const double b = full ? rng.uniform(-kPiD, kPiD) : rng.uniform(amin, amax);
       const double y = rng.uniform(-p.free_yaw_rad, p.free_yaw_rad);
       const Pose2 pose = dock_pose_from_lidar(d, b, y);
       if (!site_clean(scan, profile, pose, tol, p.margin_beams, p.free_behind_m, s)) continue;
