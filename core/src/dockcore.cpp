@@ -13,6 +13,8 @@ constexpr Real kSceneGateRad = static_cast<Real>(0.0873);  // 5°
 // The scene's reference is renewed at most this often: odometry drifts slowly, and each renewal costs a pass over
 // the scan.
 constexpr std::uint64_t kSceneReferencePeriodUs = 500000;
+// The turns "still" must beat when the implied push rests on one detection: well above a detection's yaw noise.
+constexpr Real kSceneProbeTurnRad = static_cast<Real>(0.1745);  // 10°
 }  // namespace
 
 const char* to_string(DockDetector d) {
@@ -214,25 +216,46 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
       d.expectation_confirmed = true;
       d.expected_in_odom = push_ref_in_odom_;
     }
-    // Off the expectation by more than the scene gate: does the room say push or false detection?
+    // Off the expectation by more than the scene gate: does the room say push or false detection? Against a filter
+    // resting on one detection the room is asked too: there the task tests only how far the robot is from the dock,
+    // and a first detection at a steep, far view may have put the dock decimetres too near.
+    const bool have_expected = d.expectation_confirmed || filter_.initialised();
+    const Pose2 expected_in_odom = d.expectation_confirmed ? d.expected_in_odom : filter_.dock_in_odom();
     const Pose2 detected_in_odom = odom_pose.compose(last_estimate_.pose);
     const bool off_expectation =
-        d.expectation_confirmed &&
-        ((Vec2(detected_in_odom.x_m, detected_in_odom.y_m) - Vec2(d.expected_in_odom.x_m, d.expected_in_odom.y_m))
-                 .norm() > kSceneGateM ||
-         std::fabs(wrap_angle(detected_in_odom.yaw_rad - d.expected_in_odom.yaw_rad)) > kSceneGateRad);
+        have_expected &&
+        ((Vec2(detected_in_odom.x_m, detected_in_odom.y_m) - Vec2(expected_in_odom.x_m, expected_in_odom.y_m)).norm() >
+             kSceneGateM ||
+         std::fabs(wrap_angle(detected_in_odom.yaw_rad - expected_in_odom.yaw_rad)) > kSceneGateRad);
     if (off_expectation && scene_.reference_points() > 0) {
       // The push the detection implies, and its shift alone and its turn alone (about the robot): one detection's
       // yaw at range is noisy enough to blur a pure shove, its position to blur a turn on the spot.
-      const Pose2 full = detected_in_odom.compose(d.expected_in_odom.inverse());
-      const Pose2 shift{detected_in_odom.x_m - d.expected_in_odom.x_m, detected_in_odom.y_m - d.expected_in_odom.y_m,
-                        0};
+      const Pose2 full = detected_in_odom.compose(expected_in_odom.inverse());
+      const Pose2 shift{detected_in_odom.x_m - expected_in_odom.x_m, detected_in_odom.y_m - expected_in_odom.y_m, 0};
       const Pose2 at_robot{odom_pose.x_m, odom_pose.y_m, 0};
-      const Pose2 turn =
-          at_robot.compose(Pose2{0, 0, wrap_angle(detected_in_odom.yaw_rad - d.expected_in_odom.yaw_rad)})
-              .compose(at_robot.inverse());
-      const Pose2 corrections[] = {full, shift, turn};
-      d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, 3, config_.scene);
+      const Pose2 turn = at_robot.compose(Pose2{0, 0, wrap_angle(detected_in_odom.yaw_rad - expected_in_odom.yaw_rad)})
+                             .compose(at_robot.inverse());
+      if (d.expectation_confirmed) {
+        const Pose2 corrections[] = {full, shift, turn};
+        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, 3, config_.scene);
+      } else {
+        // The implied push rests on one detection, which may be the wrong one. "Still" must then also beat a shove
+        // of the push test's size in each direction and a turn either way: a room that could not show such a push
+        // (one long wall along it) gives no verdict, and the distance test stands.
+        const Real a = config_.task.deviation.push_distance_tolerance_m;
+        const Real q = kSceneProbeTurnRad;
+        const auto about_robot = [&](const Pose2& p) { return at_robot.compose(p).compose(at_robot.inverse()); };
+        const Pose2 corrections[] = {full,
+                                     shift,
+                                     turn,
+                                     Pose2{a, 0, 0},
+                                     Pose2{-a, 0, 0},
+                                     Pose2{0, a, 0},
+                                     Pose2{0, -a, 0},
+                                     about_robot(Pose2{0, 0, q}),
+                                     about_robot(Pose2{0, 0, -q})};
+        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, 9, config_.scene);
+      }
     }
     const Pose2 before = filter_.dock_in_odom();
     const std::uint64_t before_us = filter_.last_update_us();
@@ -246,6 +269,12 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
     // A (re)started filter rests on this one detection, which may be clutter: confirmed once a second detection
     // agrees with it (is fused).
     if (u == FilterUpdate::kInitialised || u == FilterUpdate::kReinitialised) filter_confirmed_ = false;
+    // The first look at the dock: the room as odometry puts it, whether or not this detection is right, so that a
+    // disagreement before any detection agrees can be judged too.
+    if (u == FilterUpdate::kInitialised && scene_.reference_points() == 0) {
+      scene_.set_reference(scan, config_.lidar_mount, odom_pose, config_.scene);
+      scene_ref_us_ = stamp_us;
+    }
     if (u == FilterUpdate::kReinitialised && was_confirmed) {  // the estimate a resume may still need
       restart_ref_set_ = true;
       restart_ref_in_odom_ = before;

@@ -176,3 +176,35 @@ TEST(SceneCheck, ReferenceKeepsAnEvenStrideOfTheReturns) {
   CHECK(std::string(to_string(SceneVerdict::kMoved)) == "moved");
   CHECK(std::string(to_string(SceneVerdict::kUnknown)) == "unknown");
 }
+
+TEST(SceneCheck, StandingStillBeatsEveryProbePushOnlyWhereTheRoomCouldShowOne) {
+  // When the implied push rests on one detection, dockcore asks "still" to beat shoves of 0.3 m each way and turns
+  // of 10° about the robot. The robot was not moved. Before the bare dock wall a shove along it explains the wall as
+  // well as standing still does, and the dock's few returns are no margin: no verdict. The box beside the dock and
+  // the room's other walls show every such shove: still.
+  const Pose2 here = pose(1.2, 0.1, kPi);
+  const Pose2 at_robot{here.x_m, here.y_m, 0};
+  const Real a = static_cast<Real>(0.3), q = static_cast<Real>(10.0 * kPi / 180.0);
+  const Pose2 probes[] = {Pose2{a, 0, 0},
+                          Pose2{-a, 0, 0},
+                          Pose2{0, a, 0},
+                          Pose2{0, -a, 0},
+                          at_robot.compose(Pose2{0, 0, q}).compose(at_robot.inverse()),
+                          at_robot.compose(Pose2{0, 0, -q}).compose(at_robot.inverse())};
+  const SceneCheckParams params;
+  for (const bool furnished : {false, true}) {
+    const std::vector<Segment> world = room(furnished, furnished);
+    SceneCheck check;
+    const LaserScan ref = cast(world, kStart);
+    check.set_reference(ref.view(), Pose2{}, kStart, params);
+    const LaserScan now = cast(world, here);
+    SceneVotes v;
+    const SceneVerdict verdict = check.judge(now.view(), Pose2{}, here, probes, 6, params, &v);
+    if (furnished) {
+      CHECK(verdict == SceneVerdict::kStill);
+    } else {
+      CHECK(verdict == SceneVerdict::kUnknown);
+      CHECK(v.still_explained > v.compared / 2);  // standing still explains the scan; it just cannot win
+    }
+  }
+}

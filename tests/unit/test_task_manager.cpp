@@ -415,6 +415,33 @@ TEST(TaskManager, ARepeatedOutlierWhileTheRoomStandsStillIsNotAPush) {
   }
 }
 
+// A first look from afar put the dock 0.5 m too near, and the task started on it. Later detections see it where it
+// is, beyond the start's distance + distance_growth_margin_m: against a filter resting on that one look only the
+// distance is tested, and only the room can tell a push away from a wrong first look. When it stands still, the
+// farther distance becomes the start's, and the approach goes on; when it cannot say, the distance test stands.
+TEST(TaskManager, AWrongFirstLookIsNotAPushAwayWhenTheRoomStandsStill) {
+  for (const bool still : {true, false}) {
+    auto s = std::make_unique<Sim>();
+    s->world = s->odom = Pose2{1.9, 0.05, kPi};
+    s->dock_confirmed = false;
+    s->command(HostCommandType::kDock);
+    CHECK(s->run_until(TaskState::kAlign, 5));
+    s->dock = Pose2{-0.5, 0, 0};  // where the dock really is: 2.4 m out, beyond the start's 1.9 m + 0.3 m
+    s->outlier_scene = still ? SceneVerdict::kStill : SceneVerdict::kUnknown;
+    for (int i = 0; i < 2; ++i) s->outliers.push_back(s->dock);
+    for (int i = 0; i < 40 && s->out.status.state == TaskState::kAlign; ++i) s->step();
+    if (still) {
+      CHECK(s->out.status.state == TaskState::kAlign);
+      // Only the first needed the room: from it on 2.4 m is the start's distance, and the detections there pass.
+      LONGS_EQUAL(1, static_cast<long>(s->tm.pushes_overruled()));
+    } else {
+      CHECK(s->out.status.state == TaskState::kFault);
+      LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+    }
+    LONGS_EQUAL(0, s->zero_violations);
+  }
+}
+
 TEST(TaskManager, TwoDisagreeingOutliersInARowAreNotAFault) {
   auto s = std::make_unique<Sim>();
   s->command(HostCommandType::kDock);
