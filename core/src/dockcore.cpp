@@ -270,8 +270,9 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
     // agrees with it (is fused).
     if (u == FilterUpdate::kInitialised || u == FilterUpdate::kReinitialised) filter_confirmed_ = false;
     // The first look at the dock: the room as odometry puts it, whether or not this detection is right, so that a
-    // disagreement before any detection agrees can be judged too.
-    if (u == FilterUpdate::kInitialised && scene_.reference_points() == 0) {
+    // disagreement before any detection agrees can be judged too. Not when the detection is judged against an older
+    // estimate (a resumed task's): the robot may have been pushed since, and this room would be the pushed one.
+    if (u == FilterUpdate::kInitialised && !d.expectation_confirmed && scene_.reference_points() == 0) {
       scene_.set_reference(scan, config_.lidar_mount, odom_pose, config_.scene);
       scene_ref_us_ = stamp_us;
     }
