@@ -27,6 +27,7 @@ void SceneCheck::set_reference(const ScanView& scan, const Pose2& lidar_mount, c
     const Real r = scan.ranges_m[i];
     if (is_valid_range(r) && r <= params.max_range_m) ++returns;
   }
+  if (returns == 0) return;  // nothing to keep (and no stride to take)
   const std::size_t stride = (returns + kCapacity - 1) / kCapacity;
   std::size_t seen = 0;
   for (std::size_t i = 0; i < scan.count && count_ < kCapacity; ++i) {
@@ -84,7 +85,8 @@ SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, c
       if (still < 0) ++v.still_contradicted;
     }
     for (std::size_t c = 0; c < n; ++c) {
-      std::uint16_t explained = 0, contradicted = 0;
+      std::uint16_t explained = 0;
+      std::uint16_t contradicted = 0;
       for (std::size_t k = 0; k < count_; ++k) {
         bool seen = false;
         const int moved = vote(corrections[c].transform(points_odom_m_[k]), &seen);
