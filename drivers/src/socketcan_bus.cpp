@@ -237,14 +237,24 @@ class SocketCanBusImpl final : public SocketCanBus {
 
  private:
   // The kernel stamps with CLOCK_REALTIME. The frame's age (realtime now - stamp) is subtracted from CLOCK_MONOTONIC
-  // now; an age < 0 or > 10 s (wall clock stepped) falls back to monotonic now.
-  static std::uint64_t to_monotonic(bool have_ts, const timeval& tv) {
-    const std::uint64_t mono = clock_us(CLOCK_MONOTONIC);
-    if (!have_ts) return mono;
-    const std::uint64_t real = clock_us(CLOCK_REALTIME);
-    const std::uint64_t stamp = static_cast<std::uint64_t>(tv.tv_sec) * 1000000u + static_cast<std::uint64_t>(tv.tv_usec);
-    if (stamp > real || real - stamp > 10000000u || real - stamp > mono) return mono;
-    return mono - (real - stamp);
+  // now; an age < 0 or > 10 s (wall clock stepped) falls back to monotonic now. The realtime reading sits between two
+  // monotonic ones, and their midpoint is "now": a thread preempted between two clock reads (a loaded host) would
+  // otherwise age the frame by the preemption. Frames leave one socket in order, so a stamp is never earlier than
+  // the previous frame's.
+  std::uint64_t to_monotonic(bool have_ts, const timeval& tv) {
+    const std::uint64_t mono_before = clock_us(CLOCK_MONOTONIC);
+    std::uint64_t mono = mono_before;
+    if (have_ts) {
+      const std::uint64_t real = clock_us(CLOCK_REALTIME);
+      const std::uint64_t mono_after = clock_us(CLOCK_MONOTONIC);
+      mono = mono_before + (mono_after - mono_before) / 2;
+      const std::uint64_t stamp =
+          static_cast<std::uint64_t>(tv.tv_sec) * 1000000u + static_cast<std::uint64_t>(tv.tv_usec);
+      if (stamp <= real && real - stamp <= 10000000u && real - stamp <= mono) mono -= real - stamp;
+    }
+    if (mono < last_stamp_us_) mono = last_stamp_us_;
+    last_stamp_us_ = mono;
+    return mono;
   }
 
   void lost(int err) {
@@ -266,6 +276,7 @@ class SocketCanBusImpl final : public SocketCanBus {
   hal::CanBusCounters counters_{};
   std::uint32_t last_ovfl_ = 0;
   std::uint32_t enobufs_ = 0;
+  std::uint64_t last_stamp_us_ = 0;  // the previous received frame's stamp (monotonic, µs)
   std::uint64_t next_retry_us_ = 0;
   std::uint64_t backoff_us_ = kBackoffMinUs;
 };
