@@ -233,8 +233,11 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
       const Pose2 full = detected_in_odom.compose(expected_in_odom.inverse());
       const Pose2 shift{detected_in_odom.x_m - expected_in_odom.x_m, detected_in_odom.y_m - expected_in_odom.y_m, 0};
       const Pose2 at_robot{odom_pose.x_m, odom_pose.y_m, 0};
-      const Pose2 turn = at_robot.compose(Pose2{0, 0, wrap_angle(detected_in_odom.yaw_rad - expected_in_odom.yaw_rad)})
-                             .compose(at_robot.inverse());
+      // A turn on the spot: the room turns about the robot, in the odometry frame.
+      const auto turn_about_robot = [&](Real yaw_rad) {
+        return at_robot.compose(Pose2{0, 0, yaw_rad}).compose(at_robot.inverse());
+      };
+      const Pose2 turn = turn_about_robot(wrap_angle(detected_in_odom.yaw_rad - expected_in_odom.yaw_rad));
       if (d.expectation_confirmed) {
         const Pose2 corrections[] = {full, shift, turn};
         d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, 3, config_.scene);
@@ -244,7 +247,6 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
         // (one long wall along it) gives no verdict, and the distance test stands.
         const Real a = config_.task.deviation.push_distance_tolerance_m;
         const Real q = kSceneProbeTurnRad;
-        const auto about_robot = [&](const Pose2& p) { return at_robot.compose(p).compose(at_robot.inverse()); };
         const Pose2 corrections[] = {full,
                                      shift,
                                      turn,
@@ -252,8 +254,8 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
                                      Pose2{-a, 0, 0},
                                      Pose2{0, a, 0},
                                      Pose2{0, -a, 0},
-                                     about_robot(Pose2{0, 0, q}),
-                                     about_robot(Pose2{0, 0, -q})};
+                                     turn_about_robot(q),
+                                     turn_about_robot(-q)};
         d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, 9, config_.scene);
       }
     }
