@@ -4,6 +4,7 @@
 
 #include "dockcore/control/safety.hpp"
 #include "dockcore/perception/dock_profile.hpp"
+#include "real_tolerance.hpp"
 
 #include <CppUTest/TestHarness.h>
 
@@ -222,6 +223,35 @@ TEST(Safety, MotionGate) {
   ObstacleFlags none;  // no scan: fail safe
   CHECK(motion_blocked(Twist2{0.1, 0, 0}, none, g));
   CHECK(!motion_blocked(Twist2{}, none, g));
+}
+
+// Blocked ahead with the way to turn free, a command keeps its turn alone; every other blocked case stops.
+TEST(Safety, ABlockedCommandKeepsOnlyAFreeTurn) {
+  MotionGateParams g;
+  ObstacleFlags f;
+  f.valid = true;
+  f.forward = true;
+  const Twist2 curve{0.2, 0.05, 0.4};
+  const Twist2 kept = permitted_motion(curve, f, g, true);
+  REAL_EQUAL(0.0, kept.vx_mps, 0);
+  REAL_EQUAL(0.0, kept.vy_mps, 0);
+  REAL_EQUAL(0.4, kept.wz_radps, 1e-6);
+  const Twist2 stopped = permitted_motion(curve, f, g, false);  // turn_when_blocked off
+  CHECK(stopped.vx_mps == 0 && stopped.vy_mps == 0 && stopped.wz_radps == 0);
+  // A turn below the rotation threshold is no rotation the gate checks: stopped with the rest.
+  CHECK(permitted_motion(Twist2{0.2, 0, 0.04}, f, g, true).wz_radps == 0);
+  f.rotation = true;  // a corner would hit something when turning
+  CHECK(permitted_motion(curve, f, g, true).wz_radps == 0);
+  f.forward = false;
+  f.rotation = false;
+  f.backward = true;
+  REAL_EQUAL(-0.3, permitted_motion(Twist2{-0.1, 0, -0.3}, f, g, true).wz_radps, 1e-6);
+  // Not blocked: passed unchanged.
+  const Twist2 free = permitted_motion(curve, f, g, true);
+  REAL_EQUAL(0.2, free.vx_mps, 1e-6);
+  REAL_EQUAL(0.4, free.wz_radps, 1e-6);
+  ObstacleFlags none;  // no scan: nothing moves
+  CHECK(permitted_motion(Twist2{0, 0, 0.5}, none, g, true).wz_radps == 0);
 }
 
 TEST(Safety, PoseDeviation) {

@@ -534,6 +534,23 @@ TEST(SimRun, APasserByStepsAroundTheRobotAndTheRobotDocks) {
   CHECK(r.outcome.min_clearance_m < 0.5);  // it did come by
 }
 
+// A start 1 m out, 30° off the axis, facing the box that stands beside the dock: straight ahead is blocked, turning
+// on the spot is not. The robot turns away on its controller's turn and docks; stopping the whole command instead
+// holds it there until fault 180.
+TEST(SimRun, ARobotFacingFurnitureTurnsAwayAndDocks) {
+  docksim::Scenario sc = scenario_file("furniture.toml");
+  const docksim::SimRun r = run_from(sc, "smooth", 5, 0.998, 29.9 * kDeg, -18.4 * kDeg);
+  CHECK(r.outcome.charging_confirmed);
+  CHECK(r.outcome.min_clearance_m > 0.05);
+  bool was_blocked = false;
+  for (const auto& e : r.timeline) was_blocked |= e.kind == docksim::TimelineKind::kHost && e.code == 1;
+  CHECK(was_blocked);
+  sc.task.turn_when_blocked = false;
+  const docksim::SimRun held = run_from(sc, "smooth", 5, 0.998, 29.9 * kDeg, -18.4 * kDeg);
+  CHECK(!held.outcome.charging_confirmed);
+  CHECK(has_fault(held, 180, 0, 20));
+}
+
 // Furniture where the start envelope would put the robot: every start is drawn again until the robot stands clear.
 TEST(SimRun, StartsAreDrawnClearOfFurniture) {
   docksim::Scenario sc = default_scenario();

@@ -184,7 +184,10 @@ struct Sim {
       if (out.status.state == TaskState::kWaitForCharge) ++wait_entries;
     }
     const bool zero = out.cmd.vx_mps == 0 && out.cmd.vy_mps == 0 && out.cmd.wz_radps == 0;
-    if (!zero && (!moving_state(out.status.state) || out.blocked || out.target_lost)) ++zero_violations;
+    // Blocked, the robot may only turn on the spot, and only where turning is free.
+    const bool blocked_moves =
+        out.blocked && (out.cmd.vx_mps != 0 || out.cmd.vy_mps != 0 || !out.obstacles.valid || out.obstacles.rotation);
+    if (!zero && (!moving_state(out.status.state) || blocked_moves || out.target_lost)) ++zero_violations;
     // Integrate the commanded body twist exactly (arc) for truth and odometry alike.
     const double dt = kTickUs * 1e-6;
     const Pose2 delta = arc(out.cmd, dt);

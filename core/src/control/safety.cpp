@@ -183,6 +183,17 @@ bool motion_blocked(const Twist2& cmd, const ObstacleFlags& flags, const MotionG
   return false;
 }
 
+Twist2 permitted_motion(const Twist2& cmd, const ObstacleFlags& flags, const MotionGateParams& gate, bool keep_turn) {
+  if (!motion_blocked(cmd, flags, gate)) return cmd;
+  Twist2 turn{};
+  turn.wz_radps = cmd.wz_radps;
+  // A turn too slow to count as a rotation would pass the gate unchecked: it is stopped with the rest.
+  if (!keep_turn || !(std::fabs(turn.wz_radps) >= gate.rotate_min_wz_radps) || motion_blocked(turn, flags, gate)) {
+    return Twist2{};
+  }
+  return turn;
+}
+
 FaultCode check_pose_deviation(const Pose2& detected_in_odom, const Pose2& expected_in_odom, Real distance_m,
                                Real start_distance_m, const DeviationParams& params) {
   const Real dx = detected_in_odom.x_m - expected_in_odom.x_m;

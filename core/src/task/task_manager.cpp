@@ -546,7 +546,7 @@ void TaskManager::emit(const TaskInput& in, TaskOutput& out) {
       out.obstacles = obstacles_.check(*in.scan, in.lidar_mount, in.dock.valid ? &in.dock.pose : nullptr);
     }
     if (motion_blocked(cmd, out.obstacles, params_.gate)) {
-      cmd = Twist2{};
+      cmd = permitted_motion(cmd, out.obstacles, params_.gate, params_.turn_when_blocked);
       out.blocked = true;
       if (!blocked_) {
         blocked_ = true;

@@ -335,6 +335,9 @@ const ParamSpec kTable[] = {
             "it); a docking that misses them to the end forgets it."),
     DC_REAL("task", "obstacle_timeout_s", "s", 0.1, 600, kBoth, task, obstacle_timeout_s,
             "Blocked this long: fault 180."),
+    DC_BOOL("task", "turn_when_blocked", kBoth, task, turn_when_blocked,
+            "A command whose translation an obstacle blocks keeps its turn when turning in place is free; the "
+            "blocked time runs until a whole command passes again."),
     DC_REAL("task", "charge_current_threshold_a", "A", 0, 200, kBoth, task, charge_current_threshold_a,
             "Charging = contact and current at least this."),
     DC_REAL("task", "charge_confirm_hold_s", "s", 0, 60, kBoth, task, charge_confirm_hold_s,

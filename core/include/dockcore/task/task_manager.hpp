@@ -122,6 +122,11 @@ struct TaskParams {
   DeviationParams deviation{};
   MotionGateParams gate{};
   Real obstacle_timeout_s = static_cast<Real>(10.0);  ///< Blocked this long: fault 180.
+  /// A command whose translation an obstacle blocks keeps its turn when turning in place is free (the robot turns
+  /// away from what stands before it, as the controller wants to turn anyway); false: the whole command stops. The
+  /// blocked time runs until a whole command passes again, so turning on the spot cannot hide an obstacle beyond
+  /// obstacle_timeout_s.
+  bool turn_when_blocked = true;
   // Charging (WAIT_FOR_CHARGE, FINISH_TASKING).
   Real charge_current_threshold_a = static_cast<Real>(0.5);  ///< Charging = contact and current at least this.
   Real charge_confirm_hold_s = static_cast<Real>(0.3);  ///< Contact and current held this long confirm charging.
@@ -249,7 +254,8 @@ struct TaskOutput {
   Twist2 cmd{};                     ///< Body twist to command (before kinematics). Zero unless moving is allowed.
   TaskStatus status{};
   CommandResult command_result = CommandResult::kNone;  ///< For the command given on this tick.
-  bool blocked = false;             ///< The wanted motion was stopped by an obstacle this tick.
+  /// The wanted motion was stopped by an obstacle this tick: cmd is zero, or its turn alone (turn_when_blocked).
+  bool blocked = false;
   bool target_lost = false;         ///< ALIGN is holding because the estimate is stale or the controller lost it.
   ObstacleFlags obstacles{};        ///< Obstacle check of this tick (valid = false when none was needed).
   ControlStatus control = ControlStatus::kRunning;  ///< Controller status this tick (ALIGN only).
