@@ -90,6 +90,8 @@ struct Sim {
   bool dock_confirmed = true;             // DockInput::confirmed
   std::vector<Pose2> outliers;            // next detections report these dock poses (world frame), in order
   SceneVerdict outlier_scene = SceneVerdict::kUnknown;  // what the room says on an outlier's scan (SceneCheck)
+  SceneVerdict scene = SceneVerdict::kUnknown;          // what the room says on the other scans
+  bool expectation_from_filter = false;  // detections carry the filter's expectation, as Dockcore records it
   double start_yaw = kPi;
   bool charger_works = true;
   int charger_fails_first = 0;  // contacts that get no current (attempts)
@@ -155,6 +157,12 @@ struct Sim {
         in.detection_count = 1;
         det.fresh = true;
         det.dock_in_robot = world.inverse().compose(dock);
+        det.scene = scene;
+        if (expectation_from_filter) {
+          det.expectation_set = true;
+          det.expectation_confirmed = dock_confirmed;
+          det.expected_in_odom = dock_in_odom;
+        }
         if (!outliers.empty()) {
           det.dock_in_robot = world.inverse().compose(outliers.front());
           det.scene = outlier_scene;
@@ -475,6 +483,29 @@ TEST(TaskManager, UnconfirmedFilterSkipsThePushTest) {
   for (int i = 0; i < 10 && s->out.status.state == TaskState::kAlign; ++i) s->step();
   CHECK(s->out.status.state == TaskState::kFault);
   LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+}
+
+// Pushed before a second look confirmed the dock: the filter rests on one detection, which alone is no evidence.
+// When the room moved as the detections say, that one detection was right, and the push is reported.
+TEST(TaskManager, APushBeforeTheSecondLookIsSeenWhenTheRoomMovedWithIt) {
+  for (const SceneVerdict room : {SceneVerdict::kMoved, SceneVerdict::kUnknown}) {
+    auto s = std::make_unique<Sim>();
+    s->expectation_from_filter = true;
+    s->command(HostCommandType::kDock);
+    CHECK(s->run_until(TaskState::kAlign, 5));
+    s->run_for(0.5);
+    s->dock_confirmed = false;
+    s->world.y_m += 0.4;
+    s->scene = room;
+    for (int i = 0; i < 25 && s->out.status.state == TaskState::kAlign; ++i) s->step();
+    if (room == SceneVerdict::kMoved) {
+      CHECK(s->out.status.state == TaskState::kFault);
+      LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+    } else {
+      CHECK(s->out.status.state == TaskState::kAlign);
+    }
+    LONGS_EQUAL(0, s->zero_violations);
+  }
 }
 
 TEST(TaskManager, TurnedByHandGives179OnTheSecondDetection) {

@@ -99,6 +99,7 @@ SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, c
         best_moved_net = net;
         v.moved_explained = explained;
         v.moved_contradicted = contradicted;
+        v.moved_best = static_cast<std::uint8_t>(c);
       }
     }
   }

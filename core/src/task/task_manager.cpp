@@ -294,10 +294,11 @@ bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in)
   if (!det.fresh) return false;
   const Pose2 detected = det.odom_at_scan.compose(det.dock_in_robot);
   // An unconfirmed filter rests on one detection: disagreeing with it is no evidence of a push, so only the
-  // distance limit is tested (expected = detected).
+  // distance limit is tested (expected = detected) — unless the room moved as the detection implies: then the one
+  // detection was right and the robot was moved (a push early in ALIGN, before a second look confirmed the dock).
   Pose2 expected = detected;
   if (det.expectation_set) {
-    if (det.expectation_confirmed) expected = det.expected_in_odom;
+    if (det.expectation_confirmed || det.scene == SceneVerdict::kMoved) expected = det.expected_in_odom;
   } else if (in.dock.valid && in.dock.confirmed) {
     expected = in.odom_pose.compose(in.dock.pose);
   } else if (!in.dock.valid) {

@@ -51,6 +51,7 @@ struct SceneVotes {
   std::uint16_t still_contradicted = 0;
   std::uint16_t moved_explained = 0;  ///< Explained under "the room moved by the correction".
   std::uint16_t moved_contradicted = 0;
+  std::uint8_t moved_best = 0;  ///< Index of the best candidate correction (the first of equals).
 };
 
 /// Reference scan and the two-hypothesis test. Fixed capacity: kCapacity points, taken at an even stride.

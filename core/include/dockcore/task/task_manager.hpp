@@ -197,9 +197,13 @@ struct DetectionInput {
   /// TaskInput::dock as it is on the tick.
   bool expectation_set = false;
   bool expectation_confirmed = false;  ///< The expectation rested on two agreeing detections (DockInput::confirmed).
-  Pose2 expected_in_odom{};            ///< Dock in the odometry frame the filter expected (when confirmed).
+  /// Dock in the odometry frame the filter expected: confirmed, or (expectation_confirmed false) the filter resting
+  /// on one detection, which the push test uses only when the room says the robot was moved (scene kMoved).
+  Pose2 expected_in_odom{};
   /// Whether the scan shows the room where odometry puts it (SceneCheck, judged when the detection is off the
-  /// expectation): kStill makes a detection that fails the push test another object taken for the dock, not a push.
+  /// expectation): kStill makes a detection that fails the push test another object taken for the dock, not a push;
+  /// kMoved means the room moved as the detection implies, so even an expectation that rests on one detection
+  /// (expectation_confirmed false) is the push test's reference.
   SceneVerdict scene = SceneVerdict::kUnknown;
 };
 
