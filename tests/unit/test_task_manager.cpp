@@ -699,6 +699,39 @@ TEST(TaskManager, ALossNearTheDockHoldsTheRobot) {
   LONGS_EQUAL(0, s->zero_violations);
 }
 
+// Near the dock but 35° off its axis, a loss keeps the approach going on odometry as far away does: from the side
+// the dock shows one flank, and the way towards its axis is what brings it back. Off: the robot stands at once.
+TEST(TaskManager, FromTheSideALossKeepsTheApproachGoing) {
+  for (const bool carry : {true, false}) {
+    auto s = std::make_unique<Sim>();
+    s->world = s->odom = Pose2{0.75, 0.52, std::atan2(-0.52, -0.75)};  // 0.91 m out, 34.7° off the axis
+    s->params.blind_off_axis_rad = carry ? deg_to_rad(static_cast<Real>(20)) : kPi;
+    s->reconfigure();
+    s->command(HostCommandType::kDock);
+    CHECK(s->run_until(TaskState::kAlign, 5));
+    CHECK(s->centre_to_dock() - kHalfLength < s->params.blind_approach_m);  // not "far"
+    s->occluded = true;
+    const Pose2 from = s->world;
+    const std::uint64_t lost_from_us = s->dock_stamp_us;
+    std::uint64_t held_at_us = 0;
+    for (int i = 0; i < 75; ++i) {  // 1.5 s
+      s->step();
+      if (s->out.target_lost && held_at_us == 0) held_at_us = s->now_us;
+    }
+    CHECK(s->out.status.state == TaskState::kAlign);
+    const double moved_m = std::hypot(s->world.x_m - from.x_m, s->world.y_m - from.y_m);
+    if (carry) {
+      LONGS_EQUAL(0, static_cast<long>(held_at_us));
+      CHECK(moved_m > 0.1);
+    } else {
+      const double held_after_s = static_cast<double>(held_at_us - lost_from_us) * 1e-6;
+      CHECK(held_after_s > 0.45 && held_after_s < 0.6);  // target_lost_after_s
+      CHECK(moved_m < 0.1);
+    }
+    LONGS_EQUAL(0, s->zero_violations);
+  }
+}
+
 TEST(TaskManager, ObstacleStopsAndResumes) {
   auto s = std::make_unique<Sim>();
   s->command(HostCommandType::kDock);

@@ -94,8 +94,12 @@ bool TaskManager::dock_fresh(const TaskInput& in) const {
   }
   // Far away, odometry carries an estimate over a metre with centimetres of error, less than the lidar's own there,
   // and the next detection on the way in corrects it. ALIGN starts on one detection, confirmed or not: holding still
-  // on the view that lost it would not find it again.
-  return age_s <= params_.blind_approach_max_s && distance_m(in.dock.pose) - front_m >= params_.blind_approach_m;
+  // on the view that lost it would not find it again. The same holds for a view from the side.
+  if (age_s > params_.blind_approach_max_s) return false;
+  if (distance_m(in.dock.pose) - front_m >= params_.blind_approach_m) return true;
+  // From the side the dock shows one flank and is refused scan after scan; standing still keeps that view.
+  const Pose2 robot = in.dock.pose.inverse();  // the robot in the dock frame
+  return std::fabs(std::atan2(robot.y_m, robot.x_m)) >= params_.blind_off_axis_rad;
 }
 
 bool TaskManager::in_push_zone(const TaskInput& in) const {

@@ -321,6 +321,9 @@ const ParamSpec kTable[] = {
             "to blind_approach_max_s."),
     DC_REAL("task", "blind_approach_max_s", "s", 0, 60, kBoth, task, blind_approach_max_s,
             "Longest the approach from afar runs on odometry alone; 0: off."),
+    DC_DEG("task", "blind_off_axis_deg", 0, 180, kBoth, task, blind_off_axis_rad,
+           "The robot this far off the dock's axis (bearing from its face): the estimate carried by odometry also "
+           "stays current for up to blind_approach_max_s, however near; 180: off."),
     DC_REAL("task", "push_zone_m", "m", 0.01, 1, kBoth, task, push_zone_m,
             "The final push starts when the robot, lined up with the dock, has its edge this close to the face."),
     DC_REAL("task", "max_push_m", "m", 0.01, 5, kBoth, task, max_push_m,

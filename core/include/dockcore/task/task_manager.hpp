@@ -105,6 +105,11 @@ struct TaskParams {
   /// would keep the view that lost it, while a metre of odometry moves the dock by centimetres, which the next
   /// detection on the way in corrects.
   Real blind_approach_m = static_cast<Real>(1.0);
+  /// The approach from the side: with the robot's centre at least this far off the dock's axis (bearing from the
+  /// dock's face, rad, in [0, pi]), the estimate carried by odometry also stays current for up to
+  /// blind_approach_max_s, however near the dock. Seen that steeply, a dock shows one side (a V one arm, edge-on
+  /// the other) and is refused scan after scan; the way to the axis is what brings it back into view. pi: off.
+  Real blind_off_axis_rad = deg_to_rad(static_cast<Real>(20));
   /// Longest the approach runs on odometry alone, s (0: off). Long enough for a far robot to turn towards the dock
   /// and then cover some of the way: a slow lidar (RPLIDAR at 5.5 Hz) loses a dock 2–2.5 m out from scan to scan.
   Real blind_approach_max_s = static_cast<Real>(8.0);
