@@ -468,6 +468,26 @@ TEST(TaskManager, TwoDisagreeingOutliersInARowAreNotAFault) {
   CHECK(s->outliers.empty());
 }
 
+// A pushed robot far from its dock finds it in few scans, and one of them may be clutter: the outlier between two
+// detections of the pushed dock must not hide the push.
+TEST(TaskManager, AnOutlierBetweenTwoDetectionsOfAPushDoesNotHideIt) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(0.5);
+  s->world.y_m += 0.4;                    // shoved sideways: odometry did not see it
+  for (int i = 0; i < 5; ++i) s->step();  // one scan: the dock where the push put it
+  CHECK(s->tm.push_suspected());
+  s->outliers.push_back(Pose2{0.1, -0.6, 0});  // the next scan: clutter, elsewhere
+  for (int i = 0; i < 5; ++i) s->step();
+  CHECK(s->outliers.empty());
+  CHECK(s->out.status.state == TaskState::kAlign);
+  for (int i = 0; i < 5 && s->out.status.state == TaskState::kAlign; ++i) s->step();  // the dock again
+  CHECK(s->out.status.state == TaskState::kFault);
+  LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
 TEST(TaskManager, UnconfirmedFilterSkipsThePushTest) {
   auto s = std::make_unique<Sim>();
   s->command(HostCommandType::kDock);

@@ -263,7 +263,7 @@ void TaskManager::fail_attempt(FaultCode final_fault, const TaskInput& in, bool 
 void TaskManager::run_reach(const TaskInput& in) {
   if (dock_fresh(in)) {
     start_distance_m_ = distance_m(in.dock.pose);
-    deviation_count_ = 0;
+    suspects_ = 0;
     pushing_ = false;
     push_travel_m_ = 0;
     push_elapsed_s_ = 0;
@@ -312,7 +312,7 @@ bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in)
   const Real dist = distance_m(d);
   const FaultCode f = check_pose_deviation(detected, expected, dist, start_distance_m_, params_.deviation);
   if (f == FaultCode::kNone) {
-    deviation_count_ = 0;
+    suspects_ = 0;
     return false;
   }
   // The room stands where odometry puts it, so the robot was not moved: the detection is something else taken for
@@ -325,13 +325,32 @@ bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in)
     return false;
   }
   // A push moves every later detection to the same new place; an outlier is alone. Count only failing
-  // detections that agree with the previous failing one (same tolerances as the push test itself).
-  const bool repeats = deviation_count_ > 0 &&
-      check_pose_deviation(detected, deviation_pose_, static_cast<Real>(0), start_distance_m_, params_.deviation) ==
-          FaultCode::kNone;
-  deviation_count_ = repeats ? static_cast<std::uint8_t>(deviation_count_ + 1) : static_cast<std::uint8_t>(1);
-  deviation_pose_ = detected;
-  if (deviation_count_ >= params_.deviation.confirm_detections) {
+  // detections that agree with an earlier failing one (same tolerances as the push test itself). Two places are
+  // kept: a lone outlier between two detections of a pushed robot (sparse at range) starts a place of its own
+  // instead of replacing the push's.
+  std::size_t at = suspects_;
+  for (std::size_t i = 0; i < suspects_ && at == suspects_; ++i) {
+    if (check_pose_deviation(detected, suspect_pose_[i], static_cast<Real>(0), start_distance_m_, params_.deviation) ==
+        FaultCode::kNone) {
+      at = i;
+    }
+  }
+  std::uint8_t count = 1;
+  if (at < suspects_) {
+    count = suspect_count_[at] < 255 ? static_cast<std::uint8_t>(suspect_count_[at] + 1) : suspect_count_[at];
+  } else if (suspects_ == kPushSuspects) {
+    at = 0;  // the oldest place gives way
+  } else {
+    ++suspects_;
+  }
+  // The place just seen becomes the newest.
+  for (std::size_t i = at; i + 1 < suspects_; ++i) {
+    suspect_pose_[i] = suspect_pose_[i + 1];
+    suspect_count_[i] = suspect_count_[i + 1];
+  }
+  suspect_pose_[suspects_ - 1] = detected;
+  suspect_count_[suspects_ - 1] = count;
+  if (count >= params_.deviation.confirm_detections) {
     raise(f, in);
     return true;
   }

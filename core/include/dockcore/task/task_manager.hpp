@@ -284,7 +284,7 @@ class TaskManager {
 
   TaskState state() const { return state_; }
   /// A detection failed the push test and the next agreeing one would raise 178/179 (ALIGN). O(1).
-  bool push_suspected() const { return deviation_count_ > 0; }
+  bool push_suspected() const { return suspects_ > 0; }
   /// Detections that failed the push test while their scan showed the room standing where odometry puts it
   /// (DetectionInput::scene kStill): taken for other objects, not counted towards 178/179. Since configure(). O(1).
   std::uint32_t pushes_overruled() const { return pushes_overruled_; }
@@ -367,8 +367,13 @@ class TaskManager {
   std::uint64_t lost_since_us_ = 0;
   Real start_distance_m_ = 0;
   std::uint32_t pushes_overruled_ = 0;
-  std::uint8_t deviation_count_ = 0;  ///< Consecutive detections failing the push test, each agreeing with the last.
-  Pose2 deviation_pose_{};            ///< The last failing detection in the odometry frame.
+  /// Places where detections failed the push test since the last one that passed, newest last: each the latest
+  /// failing detection there (odometry frame) and how many agreeing ones failed there. Two, so that one lone
+  /// outlier between two detections of a pushed robot does not hide the push.
+  static constexpr std::size_t kPushSuspects = 2;
+  Pose2 suspect_pose_[kPushSuspects] = {};
+  std::uint8_t suspect_count_[kPushSuspects] = {};
+  std::uint8_t suspects_ = 0;
   bool pushing_ = false;              ///< In the final push (reset on entering ALIGN).
   std::uint64_t push_since_us_ = 0;
   Pose2 push_prev_odom_{};  ///< Odometry pose of the previous tick in the push.
