@@ -1625,6 +1625,42 @@ TEST(Dockcore, PushRightAfterGatedDetectionsIsStillReported) {
   }
 }
 
+// Far from its dock a robot sees it seldom, and the filter may restart around a push (two looks gated before it,
+// the first after it the third): the last fused look 2.5 s before the push, one look after it, then nothing for
+// 1.2 s. The next look agrees with the restarted filter, but the confirmed estimate from before, carried by
+// odometry, is still the reference (push_check_max_gap_s): 179.
+TEST(Dockcore, APushBetweenSparseLooksIsStillReported) {
+  FacadeSim f;
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  CHECK(f.run_until(TaskState::kAlign, 5));
+  for (int i = 0; i < 25; ++i) f.step();
+  const std::uint32_t reinit0 = f.core->filter().reinitialisations();
+  f.scans_on = false;
+  for (int k = 0; k < 2; ++k) {  // two looks matched to odometry read late: 5 cm off, gated
+    while (f.w.ticks % 5 != 0) f.step();
+    simulate_scan(f.w.world_model(), f.w.world, f.w.model, f.w.rng, &f.w.scan, f.w.now_us);
+    f.core->on_odometry(f.w.odom.compose(Pose2{-0.05, 0, 0}), Twist2{}, f.w.now_us);
+    f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.now_us);
+    f.core->on_odometry(f.w.odom, Twist2{}, f.w.now_us + 1);
+    f.step();
+  }
+  f.scans_on = true;
+  f.lidar_sees_dock = false;
+  for (int i = 0; i < 125; ++i) f.step();                                         // 2.5 s without the dock
+  f.w.world = Pose2{0, 0, deg_to_rad(static_cast<Real>(40))}.compose(f.w.world);  // turned about the dock
+  f.lidar_sees_dock = true;
+  while (f.w.ticks % 5 != 0) f.step();
+  f.step();  // one look: the third gated, the filter restarts on it
+  LONGS_EQUAL(1, static_cast<long>(f.core->filter().reinitialisations() - reinit0));
+  f.lidar_sees_dock = false;
+  for (int i = 0; i < 60; ++i) f.step();  // 1.2 s
+  f.lidar_sees_dock = true;
+  TickOutput o;
+  for (int i = 0; i < 40 && o.status.state != TaskState::kFault; ++i) o = f.step();
+  CHECK(o.status.state == TaskState::kFault);
+  LONGS_EQUAL(179, static_cast<int>(o.status.fault));
+}
+
 // dockd stalls ~0.9 s around a 0.5 m push and then drops the late scans, so the core gets no detection for ~1 s and
 // then only post-push ones. Wheel odometry runs through a lidar gap, so the pre-gap estimate carried by odometry is
 // still the expectation: the push must be reported on the second agreeing post-gap detection (178 sideways, 179

@@ -115,8 +115,11 @@ struct DockcoreConfig {
   /// A resumed dock command (the resume policy's) keeps the dock estimate from before the outage as the push test's
   /// reference when its last detection is at most this old at the resume (s). Wheel odometry runs through a lidar
   /// outage, so the old estimate carried by odometry still says where the dock must be; beyond this, odometry drift
-  /// (and the chance that the robot was carried) make it no evidence of a push, and the task starts afresh.
-  Real push_check_max_gap_s = static_cast<Real>(3.0);
+  /// (and the chance that the robot was carried) make it no evidence of a push, and the task starts afresh. The
+  /// same bound keeps the task's last confirmed estimate the reference while a filter restarted within the task is
+  /// unconfirmed. 8 s: a far robot sees a steep dock seldom, looks seconds apart around a push (blind_approach_max_s
+  /// carries the approach as long), and odometry over that moves the dock by centimetres, not the push test's 0.3 m.
+  Real push_check_max_gap_s = static_cast<Real>(8.0);
   /// The camera, the active dock's tag and the tag noise model (on_tag). dock_tag.id −1 (the default): every tag
   /// detection is refused as kWrongId.
   TagFusionParams tag{};
