@@ -1427,6 +1427,20 @@ struct FacadeSim {
   bool scans_on = true;  // false: a lidar gap (the host drops late scans); ticks and odometry go on
   /// The chassis's odometry at the current time, as a host hands it over (ideal: odometry = w.odom).
   void feed_odom() { core->on_odometry(w.odom, Twist2{}, w.now_us); }
+  /// Steps to the next scan tick and hands that scan over matched to an odometry sample that lags the robot by
+  /// `lag_m` (read late), so its detection lands that far off; then one tick. Scans stay on as they were.
+  void late_odometry_scan(double lag_m) {
+    const bool on = scans_on;
+    scans_on = false;
+    while (w.ticks % 5 != 0) step();
+    simulate_scan(w.world_model(), w.world, w.model, w.rng, &w.scan, w.now_us);
+    // The lagging odometry sample is the one at the scan's stamp; the true pose follows a microsecond later.
+    core->on_odometry(w.odom.compose(Pose2{static_cast<Real>(-lag_m), 0, 0}), Twist2{}, w.now_us);
+    core->on_scan(w.scan.view(), w.now_us, w.now_us);
+    core->on_odometry(w.odom, Twist2{}, w.now_us + 1);
+    step();
+    scans_on = on;
+  }
   bool odom_on = true;  // false: the chassis is silent (no feedback); the robot still moves by the last command
   TickOutput step(HostCommand cmd = HostCommand{}) {
     if (cmd.type != HostCommandType::kNone) {
@@ -1604,16 +1618,7 @@ TEST(Dockcore, PushRightAfterGatedDetectionsIsStillReported) {
     for (int i = 0; i < 25; ++i) f.step();
     const std::uint32_t gated0 = f.core->filter().gated(), reinit0 = f.core->filter().reinitialisations();
     // The odometry matched to these scans lags the robot by 5 cm (read late): the detections land 5 cm off.
-    f.scans_on = false;
-    for (int k = 0; k < gated; ++k) {
-      while (f.w.ticks % 5 != 0) f.step();
-      simulate_scan(f.w.world_model(), f.w.world, f.w.model, f.w.rng, &f.w.scan, f.w.now_us);
-      // The lagging odometry sample is the one at the scan's stamp; the true pose follows a microsecond later.
-      f.core->on_odometry(f.w.odom.compose(Pose2{-0.05, 0, 0}), Twist2{}, f.w.now_us);
-      f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.now_us);
-      f.core->on_odometry(f.w.odom, Twist2{}, f.w.now_us + 1);
-      f.step();
-    }
+    for (int k = 0; k < gated; ++k) f.late_odometry_scan(0.05);
     LONGS_EQUAL_TEXT(gated, static_cast<long>(f.core->filter().gated() - gated0 +
                                               (f.core->filter().reinitialisations() - reinit0)), what.c_str());
     f.scans_on = true;
@@ -1635,16 +1640,7 @@ TEST(Dockcore, APushBetweenSparseLooksIsStillReported) {
   CHECK(f.run_until(TaskState::kAlign, 5));
   for (int i = 0; i < 25; ++i) f.step();
   const std::uint32_t reinit0 = f.core->filter().reinitialisations();
-  f.scans_on = false;
-  for (int k = 0; k < 2; ++k) {  // two looks matched to odometry read late: 5 cm off, gated
-    while (f.w.ticks % 5 != 0) f.step();
-    simulate_scan(f.w.world_model(), f.w.world, f.w.model, f.w.rng, &f.w.scan, f.w.now_us);
-    f.core->on_odometry(f.w.odom.compose(Pose2{-0.05, 0, 0}), Twist2{}, f.w.now_us);
-    f.core->on_scan(f.w.scan.view(), f.w.now_us, f.w.now_us);
-    f.core->on_odometry(f.w.odom, Twist2{}, f.w.now_us + 1);
-    f.step();
-  }
-  f.scans_on = true;
+  for (int k = 0; k < 2; ++k) f.late_odometry_scan(0.05);  // two looks 5 cm off: gated
   f.lidar_sees_dock = false;
   for (int i = 0; i < 125; ++i) f.step();                                         // 2.5 s without the dock
   f.w.world = Pose2{0, 0, deg_to_rad(static_cast<Real>(40))}.compose(f.w.world);  // turned about the dock
