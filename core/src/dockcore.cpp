@@ -220,8 +220,8 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
     // resting on one detection the room is asked too: there the task tests only how far the robot is from the dock,
     // and a first detection at a steep, far view may have put the dock decimetres too near.
     const bool have_expected = d.expectation_confirmed || filter_.initialised();
-    const Pose2 expected_in_odom = d.expectation_confirmed ? d.expected_in_odom : filter_.dock_in_odom();
-    if (!d.expectation_confirmed) d.expected_in_odom = expected_in_odom;
+    if (!d.expectation_confirmed) d.expected_in_odom = filter_.dock_in_odom();
+    const Pose2& expected_in_odom = d.expected_in_odom;
     const Pose2 detected_in_odom = odom_pose.compose(last_estimate_.pose);
     const bool off_expectation =
         have_expected &&
@@ -257,11 +257,8 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
                                      Pose2{0, -a, 0},
                                      turn_about_robot(q),
                                      turn_about_robot(-q)};
-        SceneVotes votes;
-        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, 9, config_.scene, &votes);
-        // Moved, but by a probe rather than by the push the detection implies: the room does not vouch for the
-        // one detection the expectation rests on.
-        if (d.scene == SceneVerdict::kMoved && votes.moved_best >= 3) d.scene = SceneVerdict::kUnknown;
+        // The six probes never make "moved": the room vouches for the one detection only by the push it implies.
+        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, 9, config_.scene, nullptr, 6);
       }
     }
     const Pose2 before = filter_.dock_in_odom();

@@ -41,10 +41,13 @@ void SceneCheck::set_reference(const ScanView& scan, const Pose2& lidar_mount, c
 
 SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose,
                                const Pose2* corrections, std::size_t n, const SceneCheckParams& params,
-                               SceneVotes* votes) const {
+                               SceneVotes* votes, std::size_t probes) const {
   SceneVotes v;
-  int best_moved_net = 0;
+  int best_moved_net = 0;  // over every candidate: what "still" must beat
   bool have_moved = false;
+  int best_push_net = 0;  // over the candidates that are not probes: what a "moved" verdict rests on
+  bool have_push = false;
+  const std::size_t pushes = probes < n ? n - probes : 0;
   if (scan.ranges_m != nullptr && scan.count > 0 && scan.angle_increment_rad > 0) {
     const Pose2 lidar_in_odom = odom_pose.compose(lidar_mount);
     const bool wraps = scan.wraps();
@@ -99,7 +102,10 @@ SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, c
         best_moved_net = net;
         v.moved_explained = explained;
         v.moved_contradicted = contradicted;
-        v.moved_best = static_cast<std::uint8_t>(c);
+      }
+      if (c < pushes && (!have_push || net > best_push_net)) {
+        have_push = true;
+        best_push_net = net;
       }
     }
   }
@@ -110,7 +116,7 @@ SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, c
       static_cast<Real>(v.still_explained) >= params.min_explained_share * static_cast<Real>(v.compared)) {
     return SceneVerdict::kStill;
   }
-  if (have_moved && best_moved_net - still_net >= margin) return SceneVerdict::kMoved;
+  if (have_push && best_push_net - still_net >= margin) return SceneVerdict::kMoved;
   return SceneVerdict::kUnknown;
 }
 

@@ -51,7 +51,6 @@ struct SceneVotes {
   std::uint16_t still_contradicted = 0;
   std::uint16_t moved_explained = 0;  ///< Explained under "the room moved by the correction".
   std::uint16_t moved_contradicted = 0;
-  std::uint8_t moved_best = 0;  ///< Index of the best candidate correction (the first of equals).
 };
 
 /// Reference scan and the two-hypothesis test. Fixed capacity: kCapacity points, taken at an even stride.
@@ -71,10 +70,13 @@ class SceneCheck {
   /// (odometry right), "moved" at correction ∘ point for each of the `n` candidate corrections (a push by an
   /// odometry-frame correction: the one the detection implies, detected ∘ expected⁻¹, and the readings of it that a
   /// noisy detection blurs, e.g. its shift alone or its turn alone), the best of them counting. kStill needs
-  /// min_compared points and a margin over every candidate. `votes`, if given, receives the counts (moved: the best
-  /// candidate's). n ≥ 1. O(n · kCapacity).
+  /// min_compared points and a margin over every candidate. The last `probes` of the n candidates are pushes "still"
+  /// must also beat but that never make a kMoved verdict (shoves the room could show, not the one a detection
+  /// implies). `votes`, if given, receives the counts (moved: the best candidate's, probes included). n ≥ 1,
+  /// probes < n. O(n · kCapacity).
   SceneVerdict judge(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose, const Pose2* corrections,
-                     std::size_t n, const SceneCheckParams& params, SceneVotes* votes = nullptr) const;
+                     std::size_t n, const SceneCheckParams& params, SceneVotes* votes = nullptr,
+                     std::size_t probes = 0) const;
 
  private:
   Vec2 points_odom_m_[kCapacity];
