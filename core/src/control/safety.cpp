@@ -183,8 +183,11 @@ bool motion_blocked(const Twist2& cmd, const ObstacleFlags& flags, const MotionG
   return false;
 }
 
-Twist2 permitted_motion(const Twist2& cmd, const ObstacleFlags& flags, const MotionGateParams& gate, bool keep_turn) {
-  if (!motion_blocked(cmd, flags, gate)) return cmd;
+Twist2 permitted_motion(const Twist2& cmd, const ObstacleFlags& flags, const MotionGateParams& gate, bool keep_turn,
+                        bool* blocked) {
+  const bool stop = motion_blocked(cmd, flags, gate);
+  if (blocked != nullptr) *blocked = stop;
+  if (!stop) return cmd;
   Twist2 turn{};
   turn.wz_radps = cmd.wz_radps;
   // A turn too slow to count as a rotation would pass the gate unchecked: it is stopped with the rest.

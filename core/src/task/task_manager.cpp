@@ -328,20 +328,19 @@ bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in)
   // detections that agree with an earlier failing one (same tolerances as the push test itself). Two places are
   // kept: a lone outlier between two detections of a pushed robot (sparse at range) starts a place of its own
   // instead of replacing the push's.
-  std::size_t at = suspects_;
-  for (std::size_t i = 0; i < suspects_ && at == suspects_; ++i) {
-    if (check_pose_deviation(detected, suspect_pose_[i], static_cast<Real>(0), start_distance_m_, params_.deviation) ==
-        FaultCode::kNone) {
-      at = i;
-    }
-  }
+  const auto agrees = [&](const Pose2& place) {
+    return check_pose_deviation(detected, place, static_cast<Real>(0), start_distance_m_, params_.deviation) ==
+           FaultCode::kNone;
+  };
+  std::size_t at = 0;
+  while (at < suspects_ && !agrees(suspect_pose_[at])) ++at;
   std::uint8_t count = 1;
   if (at < suspects_) {
     count = suspect_count_[at] < 255 ? static_cast<std::uint8_t>(suspect_count_[at] + 1) : suspect_count_[at];
-  } else if (suspects_ == kPushSuspects) {
-    at = 0;  // the oldest place gives way
-  } else {
+  } else if (suspects_ < kPushSuspects) {
     ++suspects_;
+  } else {
+    at = 0;  // the oldest place gives way
   }
   // The place just seen becomes the newest.
   for (std::size_t i = at; i + 1 < suspects_; ++i) {
@@ -569,9 +568,8 @@ void TaskManager::emit(const TaskInput& in, TaskOutput& out) {
     if (in.scan != nullptr) {
       out.obstacles = obstacles_.check(*in.scan, in.lidar_mount, in.dock.valid ? &in.dock.pose : nullptr);
     }
-    if (motion_blocked(cmd, out.obstacles, params_.gate)) {
-      cmd = permitted_motion(cmd, out.obstacles, params_.gate, params_.turn_when_blocked);
-      out.blocked = true;
+    cmd = permitted_motion(cmd, out.obstacles, params_.gate, params_.turn_when_blocked, &out.blocked);
+    if (out.blocked) {
       if (!blocked_) {
         blocked_ = true;
         blocked_since_us_ = in.now_us;

@@ -147,8 +147,10 @@ bool motion_blocked(const Twist2& cmd, const ObstacleFlags& flags, const MotionG
 
 /// The part of `cmd` that `flags` let through: `cmd` when motion_blocked() is false; otherwise, when `keep_turn` is
 /// set, its turn alone (vx = vy = 0) if that is an in-place rotation of at least gate.rotate_min_wz_radps that the
-/// rotation check allows; otherwise zero. Invalid flags give zero for any motion. O(1).
-Twist2 permitted_motion(const Twist2& cmd, const ObstacleFlags& flags, const MotionGateParams& gate, bool keep_turn);
+/// rotation check allows; otherwise zero. Invalid flags give zero for any motion. `blocked`, if given, receives
+/// motion_blocked(cmd, flags, gate). O(1).
+Twist2 permitted_motion(const Twist2& cmd, const ObstacleFlags& flags, const MotionGateParams& gate, bool keep_turn,
+                        bool* blocked = nullptr);
 
 /// Pose-deviation thresholds (seed 004 Table 3 plus the push test).
 struct DeviationParams {
