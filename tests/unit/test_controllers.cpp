@@ -220,6 +220,63 @@ TEST(Controllers, SmoothSaturatedTurnKeepsTheMinimumTurnSpeed) {
   DOUBLES_EQUAL(p.min_turn_speed_mps, o.cmd.vx_mps, 0.0);
 }
 
+TEST(Controllers, SmoothTightCurveTowardsAConfirmedDockKeepsTheMinimumTurnRate) {
+  // Pads 0.8 m from the plane, 0.1 m off the axis and turned 0.3 rad: the graceful law's curve is tight (6 1/m),
+  // and its speed law alone would crawl round it at the creep speed. Towards a confirmed estimate the speed along
+  // the same curve is raised so the turn runs at min_turn_rate_radps; towards one detection, or with the floor
+  // off, the law's own speed stands.
+  SmoothParams p;
+  ControlInput in;
+  in.dt_s = static_cast<Real>(kCtlDt);
+  in.dock_valid = true;
+  Pose2 robot;
+  robot.x_m = static_cast<Real>(kPadReach + 0.8);
+  robot.y_m = static_cast<Real>(0.1);
+  robot.yaw_rad = static_cast<Real>(wrapd(kPiD - 0.3));
+  in.dock_in_robot = robot.inverse();
+  SmoothController fast(p);
+  const ControlOutput o = fast.step(in);
+  CHECK(o.status == ControlStatus::kRunning);
+  DOUBLES_EQUAL(p.min_turn_rate_radps, std::fabs(o.cmd.wz_radps), 1e-9);
+  CHECK(o.cmd.vx_mps > p.common.creep_speed_mps && o.cmd.vx_mps <= p.v_max_mps);
+  in.dock_confirmed = false;
+  SmoothController cautious(p);
+  const ControlOutput u = cautious.step(in);
+  CHECK(std::fabs(u.cmd.wz_radps) < p.min_turn_rate_radps);
+  // The same curve: only the speed along it differs.
+  DOUBLES_EQUAL(o.cmd.wz_radps / o.cmd.vx_mps, u.cmd.wz_radps / u.cmd.vx_mps, 1e-9);
+  in.dock_confirmed = true;
+  p.min_turn_rate_radps = 0;
+  SmoothController off(p);
+  const ControlOutput f = off.step(in);
+  DOUBLES_EQUAL(u.cmd.vx_mps, f.cmd.vx_mps, 0.0);
+  DOUBLES_EQUAL(u.cmd.wz_radps, f.cmd.wz_radps, 0.0);
+}
+
+TEST(Controllers, SmoothTurnRateFloorStaysOutOfTheLineupZone) {
+  // Pads 0.3 m from the plane (inside lineup_distance_m + lineup_hysteresis_m), 0.1 m off the axis (the graceful
+  // law still steers) and turned 0.3 rad, a curve of 8 1/m: the floor does not apply there, where the heading
+  // settles before the contacts judge it.
+  SmoothParams p;
+  ControlInput in;
+  in.dt_s = static_cast<Real>(kCtlDt);
+  in.dock_valid = true;
+  Pose2 robot;
+  robot.x_m = static_cast<Real>(kPadReach + 0.3);
+  robot.y_m = static_cast<Real>(0.1);
+  robot.yaw_rad = static_cast<Real>(wrapd(kPiD + 0.3));
+  in.dock_in_robot = robot.inverse();
+  SmoothController with(p);
+  const ControlOutput a = with.step(in);
+  const Real floor_radps = p.min_turn_rate_radps;
+  p.min_turn_rate_radps = 0;
+  SmoothController without(p);
+  const ControlOutput b = without.step(in);
+  DOUBLES_EQUAL(b.cmd.vx_mps, a.cmd.vx_mps, 0.0);
+  DOUBLES_EQUAL(b.cmd.wz_radps, a.cmd.wz_radps, 0.0);
+  CHECK(std::fabs(a.cmd.wz_radps) < floor_radps);  // it would have applied
+}
+
 TEST(Controllers, ContactMeansArrivedAndZero) {
   SmoothController d;
   ControlInput in;

@@ -221,11 +221,11 @@ TEST(DockdDaemon, TheLoopRecordReplaysEveryTickBitForBit) {
   CHECK_TRUE(ok.ok);
   CHECK_FALSE(ok.truncated);
   CHECK_EQUAL(ticks, ok.ticks);
-  CHECK(ok.scans > 100);
   std::printf("\nloop record: %llu records, %llu ticks, %llu scans, %llu commands replayed bit for bit\n",
               static_cast<unsigned long long>(ok.records), static_cast<unsigned long long>(ok.ticks),
               static_cast<unsigned long long>(ok.scans), static_cast<unsigned long long>(ok.commands));
   CHECK(ok.commands >= 1);
+  CHECK(ok.scans > 50);  // a whole docking: some 10 s of LD06 turns
   // The replay can fail: a record whose core got other inputs diverges, and says where.
   std::FILE* f = std::fopen(rec.c_str(), "r+b");
   CHECK(f != nullptr);

@@ -476,6 +476,12 @@ ControlOutput SmoothController::step(const ControlInput& in) {
     kappa = graceful_curvature(r, phi, delta, p_.k_phi, p_.k_delta);
   }
   Real v = p_.v_max_mps / (kOne + p_.beta * std::pow(std::fabs(kappa), p_.lambda));
+  const Real lineup_zone_m = (p_.lineup_distance_m > 0 ? p_.lineup_distance_m : kZero) + p_.lineup_hysteresis_m;
+  if (p_.min_turn_rate_radps > 0 && in.dock_confirmed && d > lineup_zone_m && std::fabs(kappa) > 0) {
+    Real v_turn = p_.min_turn_rate_radps / std::fabs(kappa);
+    if (v_turn > p_.v_max_mps) v_turn = p_.v_max_mps;
+    if (v_turn > v) v = v_turn;
+  }
   SmoothPhase ph = SmoothPhase::kApproach;
   if (p_.slowdown_radius_m > 0) {
     const Real vs = p_.v_max_mps * d / p_.slowdown_radius_m;

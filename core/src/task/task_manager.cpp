@@ -381,6 +381,7 @@ void TaskManager::run_align(const TaskInput& in, TaskOutput& out) {
   ci.now_us = in.now_us;
   ci.dt_s = dt_s_;
   ci.dock_valid = in.dock.valid;
+  ci.dock_confirmed = in.dock.confirmed;
   ci.dock_in_robot = in.dock.pose;
   ci.aim_lateral_m = attempt_aim_m();
   ci.dock_covariance = in.dock.covariance;

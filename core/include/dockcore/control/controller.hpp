@@ -39,6 +39,9 @@ struct ControlInput {
   std::uint64_t now_us = 0;  ///< Monotonic time of this tick.
   Real dt_s = 0;             ///< Time since the previous tick (> 0).
   bool dock_valid = false;   ///< A current (filtered) dock estimate exists.
+  /// The estimate rests on at least two agreeing detections (DockInput::confirmed). One detection alone may be
+  /// clutter: a controller may approach it more cautiously.
+  bool dock_confirmed = true;
   Pose2 dock_in_robot{};     ///< Dock frame (origin at the contacts, x out of the face) in the robot frame.
   Mat3 dock_covariance = Mat3::Zero();
   std::uint64_t dock_stamp_us = 0;  ///< Time of the scan behind the estimate.

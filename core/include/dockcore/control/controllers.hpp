@@ -219,7 +219,8 @@ class Seed003Controller final : public DockingController {
 /// robot centre onto a goal projected `goal_projection_m` behind the docked pose along the docking axis, so the law's
 /// 1/r stays regular at the contacts. With r, φ, δ the egocentric polar coordinates (Nav2's convention):
 ///   κ = −(1/r)·[k_δ(δ − atan(−k_φ φ)) + (1 + k_φ/(1 + (k_φ φ)²))·sin δ],
-///   v = v_max/(1 + β|κ|^λ), v ≤ v_max·d/slowdown_radius, v ≤ √(2·a_dec·d) (d = pad distance to the contact plane),
+///   v = v_max/(1 + β|κ|^λ), raised to min_turn_rate/|κ| (≤ v_max) outside the line-up zone towards a confirmed
+///   estimate, then v ≤ v_max·d/slowdown_radius, v ≤ √(2·a_dec·d) (d = pad distance to the contact plane),
 ///   v ≥ creep_speed (the deadband floor), ω = κ·v ≤ ω_max with v recomputed to keep κ.
 /// Never commands v ≤ 0 while running: one forward motion, no reversals, no in-place rotation (v is floored at
 /// min_turn_speed_mps when ω saturates). vy is always 0: the same law serves mecanum drives (a vy assist on the pads'
@@ -241,6 +242,13 @@ struct SmoothParams {
   Real goal_projection_m = static_cast<Real>(0.10);
   /// Smallest forward speed when ω saturates, m/s (keeps the turn an arc: radius ≥ this/ω_max).
   Real min_turn_speed_mps = static_cast<Real>(0.03);
+  /// Slowest turn along a tight curve of the graceful law, rad/s (0: off). The law's speed falls as 1/|κ|^λ, so a
+  /// robot turning towards the axis would crawl round it at the creep speed, at |κ|·creep rad/s; instead the speed
+  /// along the curve is at least this/|κ| (never above v_max_mps), the curve itself unchanged. Only outside the
+  /// line-up zone (pads beyond lineup_distance_m + lineup_hysteresis_m from the contact plane), where the heading is
+  /// settled before the contacts judge it, and only towards a confirmed estimate (ControlInput::dock_confirmed): one
+  /// detection may be clutter, and a slow approach gives the next scans time to say so.
+  Real min_turn_rate_radps = static_cast<Real>(0.3);
   /// Line-up: once the pads are this close to the contact plane (m), the graceful law hands over to an axis tracker
   /// (the graceful goal sits only goal_projection_m behind the pads, so its 1/r turns the estimate's lateral noise
   /// into heading noise right where the contacts judge the heading). ≤ 0 disables the line-up.
