@@ -58,6 +58,7 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
   tasks_.configure(config.task, config.footprint, profile);
   pending_count_ = 0;
   pending_dropped_ = 0;
+  detections_unplaced_ = 0;
   scene_.clear();
   for (std::uint32_t& c : tag_counts_) c = 0;
   have_tag_ = false;
@@ -190,6 +191,13 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
   }
   last_estimate_ = detector_ == DockDetector::kBreakpoint ? breakpoint_estimate(scan)
                                                           : estimator_.estimate(scan, config_.lidar_mount, hint_ptr);
+  // A scan taken during a gap in the odometry (a host that read no feedback for a while, a chassis outage) cannot
+  // be placed: the pose before the gap may be a driven half-second off, and the detection would land that far from
+  // the dock, which the push test reads as a push. Its estimate is reported; the filter and the push test skip it.
+  if (last_estimate_.found && odometry_.valid() && !odometry_.placed_at(stamp_us)) {
+    ++detections_unplaced_;
+    return last_estimate_;
+  }
   if (last_estimate_.found) {
     // The push test's reference is the filter before this detection: once fused (or adopted by a restart) it
     // would agree with the detection whatever happened to the robot.

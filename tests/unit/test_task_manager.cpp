@@ -1826,6 +1826,32 @@ TEST(Dockcore, StaleChassisHoldsTheDriveThenFaultsAndTheRampRestartsFromRest) {
   CHECK_EQUAL(2u, f.core->inputs().chassis_trips());
 }
 
+// A scan stamped in a gap of the odometry (no feedback for longer than Odometry::kMaxGapUs) is placed at the pose
+// before the gap, however far the robot drove meanwhile: its detection is counted and neither fused nor tested for
+// a push. Once feedback returns, detections are fused again and the docking goes on.
+TEST(Dockcore, ADetectionInAnOdometryGapIsNeitherFusedNorTestedForAPush) {
+  FacadeSim f;
+  f.step(HostCommand{HostCommandType::kDock, 0});
+  CHECK(f.run_until(TaskState::kAlign, 5));
+  for (int i = 0; i < 25; ++i) f.step();
+  CHECK(f.core->filter().initialised());
+  LONGS_EQUAL(0, static_cast<long>(f.core->detections_unplaced()));
+  const std::uint64_t fused_before_us = f.core->filter().last_update_us();
+  // The chassis falls silent for 0.3 s (held after chassis_stale_ms, no fault yet); scans go on.
+  f.odom_on = false;
+  for (int i = 0; i < 15; ++i) f.step();
+  CHECK(f.core->detections_unplaced() >= 1);
+  const std::uint64_t fused_in_gap_us = f.core->filter().last_update_us();
+  // Scans of the first 0.2 s are still placed by the last feedback; none after it.
+  CHECK(fused_in_gap_us - fused_before_us <= Odometry::kMaxGapUs + 2 * Sim::kTickUs);
+  f.odom_on = true;
+  TickOutput o;
+  for (int i = 0; i < 20; ++i) o = f.step();
+  CHECK(f.core->filter().last_update_us() > fused_in_gap_us);
+  CHECK(o.status.fault == FaultCode::kNone);
+  CHECK(o.status.state == TaskState::kAlign);
+}
+
 TEST(Dockcore, AChassisOutageFaultIsResumedAtMostMaxResumesTimes) {
   FacadeSim f;
   const WatchdogParams wd = f.core->config().watchdog;

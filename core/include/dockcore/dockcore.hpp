@@ -257,6 +257,9 @@ class DockcoreBase {
   const WheelDeadband& deadband() const { return deadband_; }
   /// Detections that did not fit into one tick's list (more than kMaxDetectionsPerTick scans between two ticks).
   std::uint32_t detections_dropped() const { return pending_dropped_; }
+  /// Detections of scans stamped in a gap of the odometry (Odometry::placed_at false): reported in the estimate, not
+  /// fused and not tested for a push. O(1).
+  std::uint32_t detections_unplaced() const { return detections_unplaced_; }
 
  protected:
   /// `controller` must outlive this object; `estimator` and the two scan arrays (`scan_capacity` elements each)
@@ -311,6 +314,7 @@ class DockcoreBase {
   DockDetector detector_ = DockDetector::kEstimator;  ///< The configured one (kEstimator after a refusal).
   ConfigureStatus configure_status_ = ConfigureStatus::kOk;
   std::uint32_t pending_dropped_ = 0;  ///< Detections beyond kMaxDetectionsPerTick between two ticks (not tested).
+  std::uint32_t detections_unplaced_ = 0;  ///< Detections of scans the odometry could not place (not fused).
   std::uint32_t tag_counts_[kTagStatusCount] = {};
   bool have_tag_ = false;
   TaskState prev_state_ = TaskState::kNotTasking;  // beside the flag: the two share one padded word

@@ -47,4 +47,11 @@ Pose2 Odometry::pose_at(std::uint64_t stamp_us) const {
   return best != nullptr ? best->pose : pose_;
 }
 
+bool Odometry::placed_at(std::uint64_t stamp_us) const {
+  for (const Sample& s : history_) {
+    if (s.stamp_us != 0 && s.stamp_us <= stamp_us && stamp_us - s.stamp_us <= kMaxGapUs) return true;
+  }
+  return false;
+}
+
 }  // namespace dockcore

@@ -48,6 +48,11 @@ class Odometry {
   /// The pose of the newest sample not after `stamp_us`; the current pose when no kept sample is that old (the
   /// history covers kHistory feedbacks) or before any feedback. O(kHistory).
   Pose2 pose_at(std::uint64_t stamp_us) const;
+  /// A kept sample lies at most kMaxGapUs before `stamp_us`, so pose_at() places something stamped then where the
+  /// robot was to within a feedback interval. False across a gap in the feedback (a host that read none for a while,
+  /// a chassis outage): pose_at() then gives the pose before the gap, however far the robot moved during it.
+  /// O(kHistory).
+  bool placed_at(std::uint64_t stamp_us) const;
 
  private:
   struct Sample {
