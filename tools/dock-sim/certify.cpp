@@ -377,6 +377,11 @@ int run_certify(const CertifyOptions& o) {
   const std::string unseen_profile = !ec && std::filesystem::is_regular_file(unseen_path, ec)
                                          ? unseen_path.lexically_normal().string()
                                          : std::string();
+  if (unseen_profile.empty()) {
+    std::cerr << "dock-sim certify: no " << unseen_path.string()
+              << ": the family's unseen dock shape (dock.unseen_profile) is left out; its trials keep the scenario's "
+                 "dock\n";
+  }
   auto load = [&](std::size_t t, std::vector<double>* values) {
     const toml::table w = draw_world(base, base_sc.dock_pose, unseen_profile, seed, t, values);
     return docksim::parse_scenario_toml(toml_text(w), o.scenario + " (trial " + std::to_string(t) + ")");
