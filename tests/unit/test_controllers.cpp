@@ -220,20 +220,29 @@ TEST(Controllers, SmoothSaturatedTurnKeepsTheMinimumTurnSpeed) {
   DOUBLES_EQUAL(p.min_turn_speed_mps, o.cmd.vx_mps, 0.0);
 }
 
+namespace {
+// A running smooth controller's input: the pads `pads_m` from the contact plane, the centre `lateral_m` off the axis
+// and turned `turn_rad` from the docked heading.
+ControlInput smooth_input_at(double pads_m, double lateral_m, double turn_rad) {
+  ControlInput in;
+  in.dt_s = static_cast<Real>(kCtlDt);
+  in.dock_valid = true;
+  Pose2 robot;
+  robot.x_m = static_cast<Real>(kPadReach + pads_m);
+  robot.y_m = static_cast<Real>(lateral_m);
+  robot.yaw_rad = static_cast<Real>(wrapd(kPiD + turn_rad));
+  in.dock_in_robot = robot.inverse();
+  return in;
+}
+}  // namespace
+
 TEST(Controllers, SmoothTightCurveTowardsAConfirmedDockKeepsTheMinimumTurnRate) {
   // Pads 0.8 m from the plane, 0.1 m off the axis and turned 0.3 rad: the graceful law's curve is tight (6 1/m),
   // and its speed law alone would crawl round it at the creep speed. Towards a confirmed estimate the speed along
   // the same curve is raised so the turn runs at min_turn_rate_radps; towards one detection, or with the floor
   // off, the law's own speed stands.
   SmoothParams p;
-  ControlInput in;
-  in.dt_s = static_cast<Real>(kCtlDt);
-  in.dock_valid = true;
-  Pose2 robot;
-  robot.x_m = static_cast<Real>(kPadReach + 0.8);
-  robot.y_m = static_cast<Real>(0.1);
-  robot.yaw_rad = static_cast<Real>(wrapd(kPiD - 0.3));
-  in.dock_in_robot = robot.inverse();
+  ControlInput in = smooth_input_at(0.8, 0.1, -0.3);
   SmoothController fast(p);
   const ControlOutput o = fast.step(in);
   CHECK(o.status == ControlStatus::kRunning);
@@ -258,14 +267,7 @@ TEST(Controllers, SmoothTurnRateFloorStaysOutOfTheLineupZone) {
   // law still steers) and turned 0.3 rad, a curve of 8 1/m: the floor does not apply there, where the heading
   // settles before the contacts judge it.
   SmoothParams p;
-  ControlInput in;
-  in.dt_s = static_cast<Real>(kCtlDt);
-  in.dock_valid = true;
-  Pose2 robot;
-  robot.x_m = static_cast<Real>(kPadReach + 0.3);
-  robot.y_m = static_cast<Real>(0.1);
-  robot.yaw_rad = static_cast<Real>(wrapd(kPiD + 0.3));
-  in.dock_in_robot = robot.inverse();
+  const ControlInput in = smooth_input_at(0.3, 0.1, 0.3);
   SmoothController with(p);
   const ControlOutput a = with.step(in);
   const Real floor_radps = p.min_turn_rate_radps;
