@@ -324,7 +324,8 @@ TagStatus DockcoreBase::on_tag(const TagObservation& obs) {
     const Real lag_s = have_scan_ && last_scan_us_ > obs.stamp_us
                            ? static_cast<Real>(last_scan_us_ - obs.stamp_us) * static_cast<Real>(1e-6)
                            : static_cast<Real>(0);
-    if (!(lag_s <= p.max_lag_s)) {
+    // A frame taken in a gap of the odometry cannot be placed, as a scan cannot (estimate_scan()).
+    if (!(lag_s <= p.max_lag_s) || (odometry_.valid() && !odometry_.placed_at(obs.stamp_us))) {
       st = TagStatus::kStale;
     } else {
       st = tag_to_dock_measurement(obs, p, &m);

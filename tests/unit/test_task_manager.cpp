@@ -2062,6 +2062,12 @@ TEST(Dockcore, WrongIdStaleAndOutOfOrderTagsAreCountedAndChangeNothing) {
   nan.rotation(0, 0) = std::nan("");
   check_refused(nan, TagStatus::kInvalid);
   CHECK(f.core->on_tag(tag_at(scan_us + 3)) == TagStatus::kFused);
+  // A frame taken in a gap of the odometry (no feedback for 0.3 s) cannot be placed: stale too.
+  f.odom_on = false;
+  for (int i = 0; i < 15; ++i) f.step();
+  check_refused(tag_at(f.core->last_scan().stamp_us), TagStatus::kStale);
+  f.odom_on = true;
+  f.step();
   // A dock without a tag (id −1) takes none.
   TagFusionParams none = p;
   none.dock_tag.id = -1;

@@ -88,7 +88,7 @@ enum class TagStatus : std::uint8_t {
   kBehind = 3,      ///< The tag is not in front of the camera (z ≤ 0), or seen from its back.
   kFar = 4,         ///< Farther than max_range_m.
   kWeak = 5,        ///< Decision margin below min_decision_margin.
-  kStale = 6,       ///< Older than the newest scan by more than max_lag_s.
+  kStale = 6,       ///< Older than the newest scan by more than max_lag_s, or in a gap of the odometry.
   kOutOfOrder = 7,  ///< Not newer than the previous tag frame given.
   kGated = 8,       ///< Rejected by the filter's Mahalanobis gate.
 };
