@@ -505,7 +505,7 @@ const ParamSpec kTable[] = {
             "Goal behind the docked pose."),
     DC_REAL("controller.smooth", "min_turn_speed_mps", "m/s", 0, 1e4, kScenario, smooth, min_turn_speed_mps,
             "Smallest forward speed when ω saturates."),
-    DC_REAL("controller.smooth", "min_turn_rate_radps", "rad/s", 0, 5, kScenario, smooth, min_turn_rate_radps,
+    DC_REAL("controller.smooth", "min_turn_rate_radps", "rad/s", 0, 5, kBoth, smooth, min_turn_rate_radps,
             "Slowest turn along a tight curve, towards a confirmed estimate outside the line-up zone (0: off)."),
     DC_REAL("controller.smooth", "lineup_distance_m", "m", 0, 2, kBoth, smooth, lineup_distance_m,
             "Axis tracker range (0 disables)."),
