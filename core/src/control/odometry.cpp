@@ -1,6 +1,8 @@
 #include "dockcore/control/odometry.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 
 namespace dockcore {
 
@@ -48,10 +50,9 @@ Pose2 Odometry::pose_at(std::uint64_t stamp_us) const {
 }
 
 bool Odometry::placed_at(std::uint64_t stamp_us) const {
-  for (const Sample& s : history_) {
-    if (s.stamp_us != 0 && s.stamp_us <= stamp_us && stamp_us - s.stamp_us <= kMaxGapUs) return true;
-  }
-  return false;
+  return std::any_of(std::begin(history_), std::end(history_), [stamp_us](const Sample& s) {
+    return s.stamp_us != 0 && s.stamp_us <= stamp_us && stamp_us - s.stamp_us <= kMaxGapUs;
+  });
 }
 
 }  // namespace dockcore
