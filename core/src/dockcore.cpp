@@ -167,7 +167,8 @@ const DockEstimate& DockcoreBase::rescan() {
 }
 
 const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint64_t stamp_us) {
-  const Pose2 odom_pose = odometry_.pose_at(stamp_us);
+  bool odometry_gap = false;
+  const Pose2 odom_pose = odometry_.pose_at(stamp_us, &odometry_gap);
   const std::size_t n = scan.count < scan_capacity_ ? scan.count : scan_capacity_;
   // The tick's copy of the scan: the one copy a scan gets on its way from the parser (the estimator reads the
   // caller's). A scan fed back from that copy (last_scan()) is already there.
@@ -194,7 +195,7 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
   // A scan taken during a gap in the odometry (a host that read no feedback for a while, a chassis outage) cannot
   // be placed: the pose before the gap may be a driven half-second off, and the detection would land that far from
   // the dock, which the push test reads as a push. Its estimate is reported; the filter and the push test skip it.
-  if (last_estimate_.found && odometry_.valid() && !odometry_.placed_at(stamp_us)) {
+  if (last_estimate_.found && odometry_gap) {
     ++detections_unplaced_;
     return last_estimate_;
   }
@@ -314,6 +315,7 @@ TagStatus DockcoreBase::on_tag(const TagObservation& obs) {
   const TagFusionParams& p = config_.tag;
   TagStatus st = TagStatus::kFused;
   TagMeasurement m;
+  Pose2 odom_at_frame{};  // where the robot was at the frame's stamp, by odometry
   if (p.dock_tag.id < 0 || obs.id != p.dock_tag.id) {
     st = TagStatus::kWrongId;
   } else if (have_tag_ && obs.stamp_us <= last_tag_us_) {
@@ -324,16 +326,17 @@ TagStatus DockcoreBase::on_tag(const TagObservation& obs) {
     const Real lag_s = have_scan_ && last_scan_us_ > obs.stamp_us
                            ? static_cast<Real>(last_scan_us_ - obs.stamp_us) * static_cast<Real>(1e-6)
                            : static_cast<Real>(0);
+    bool odometry_gap = false;
+    odom_at_frame = odometry_.pose_at(obs.stamp_us, &odometry_gap);
     // A frame taken in a gap of the odometry cannot be placed, as a scan cannot (estimate_scan()).
-    if (!(lag_s <= p.max_lag_s) || (odometry_.valid() && !odometry_.placed_at(obs.stamp_us))) {
+    if (!(lag_s <= p.max_lag_s) || odometry_gap) {
       st = TagStatus::kStale;
     } else {
       st = tag_to_dock_measurement(obs, p, &m);
     }
   }
   if (st == TagStatus::kFused) {
-    const FilterUpdate u =
-        filter_.update_tag(m.dock_in_robot, m.covariance, odometry_.pose_at(obs.stamp_us), obs.stamp_us);
+    const FilterUpdate u = filter_.update_tag(m.dock_in_robot, m.covariance, odom_at_frame, obs.stamp_us);
     if (u == FilterUpdate::kGated) st = TagStatus::kGated;
     if (u == FilterUpdate::kInvalid) st = TagStatus::kInvalid;
     // A filter (re)started by a tag rests on it alone: the push test waits for a second lidar detection.

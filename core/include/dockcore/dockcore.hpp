@@ -257,7 +257,7 @@ class DockcoreBase {
   const WheelDeadband& deadband() const { return deadband_; }
   /// Detections that did not fit into one tick's list (more than kMaxDetectionsPerTick scans between two ticks).
   std::uint32_t detections_dropped() const { return pending_dropped_; }
-  /// Detections of scans stamped in a gap of the odometry (Odometry::placed_at false): reported in the estimate, not
+  /// Detections of scans stamped in a gap of the odometry (Odometry::pose_at's in_gap): reported in the estimate, not
   /// fused and not tested for a push. O(1).
   std::uint32_t detections_unplaced() const { return detections_unplaced_; }
 

@@ -1,8 +1,6 @@
 #include "dockcore/control/odometry.hpp"
 
-#include <algorithm>
 #include <cmath>
-#include <iterator>
 
 namespace dockcore {
 
@@ -40,19 +38,14 @@ void Odometry::record(std::uint64_t stamp_us) {
   next_ = (next_ + 1) % kHistory;
 }
 
-Pose2 Odometry::pose_at(std::uint64_t stamp_us) const {
+Pose2 Odometry::pose_at(std::uint64_t stamp_us, bool* in_gap) const {
   const Sample* best = nullptr;
   for (const Sample& s : history_) {
     if (s.stamp_us == 0 || s.stamp_us > stamp_us) continue;
     if (best == nullptr || s.stamp_us > best->stamp_us) best = &s;
   }
+  if (in_gap != nullptr) *in_gap = valid_ && (best == nullptr || stamp_us - best->stamp_us > kMaxGapUs);
   return best != nullptr ? best->pose : pose_;
-}
-
-bool Odometry::placed_at(std::uint64_t stamp_us) const {
-  return std::any_of(std::begin(history_), std::end(history_), [stamp_us](const Sample& s) {
-    return s.stamp_us != 0 && s.stamp_us <= stamp_us && stamp_us - s.stamp_us <= kMaxGapUs;
-  });
 }
 
 }  // namespace dockcore

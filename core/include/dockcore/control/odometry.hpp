@@ -46,13 +46,11 @@ class Odometry {
   /// Stamp of the newest feedback, µs (0 before any). O(1).
   std::uint64_t stamp_us() const { return stamp_us_; }
   /// The pose of the newest sample not after `stamp_us`; the current pose when no kept sample is that old (the
-  /// history covers kHistory feedbacks) or before any feedback. O(kHistory).
-  Pose2 pose_at(std::uint64_t stamp_us) const;
-  /// A kept sample lies at most kMaxGapUs before `stamp_us`, so pose_at() places something stamped then where the
-  /// robot was to within a feedback interval. False across a gap in the feedback (a host that read none for a while,
-  /// a chassis outage): pose_at() then gives the pose before the gap, however far the robot moved during it.
-  /// O(kHistory).
-  bool placed_at(std::uint64_t stamp_us) const;
+  /// history covers kHistory feedbacks) or before any feedback. `in_gap`, if given, receives whether feedback has
+  /// arrived but that sample is missing or more than kMaxGapUs before `stamp_us`: something stamped then falls in a
+  /// gap of the feedback (a host that read none for a while, a chassis outage), and the pose given is the one before
+  /// the gap, however far the robot moved during it. O(kHistory).
+  Pose2 pose_at(std::uint64_t stamp_us, bool* in_gap = nullptr) const;
 
  private:
   struct Sample {
