@@ -471,6 +471,16 @@ TEST(RealData, CompositesInRealScansKeepTheirTruth) {
   LONGS_EQUAL(a.scans_tried, a.placed + a.no_site);
   CHECK_TRUE(a.placed <= 10);
   LONGS_EQUAL(a.detected, a.pos_err_m.size());
+  // Every composite falls in one view bin, and a bin's detections are among its placements.
+  std::size_t placed_in_bins = 0;
+  std::size_t detected_in_bins = 0;
+  for (int v = 0; v < kCompositeViewBins; ++v) {
+    CHECK_TRUE(a.detected_by_view[v] <= a.placed_by_view[v]);
+    placed_in_bins += a.placed_by_view[v];
+    detected_in_bins += a.detected_by_view[v];
+  }
+  LONGS_EQUAL(a.placed, placed_in_bins);
+  LONGS_EQUAL(a.detected, detected_in_bins);
   LONGS_EQUAL(a.placed, b.placed);
   LONGS_EQUAL(a.detected, b.detected);
   LONGS_EQUAL(a.wrong, b.wrong);

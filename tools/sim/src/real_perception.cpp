@@ -566,6 +566,13 @@ CompositeResult measure_real_composites(const LoadedRecording& rec, const dockco
     paste_dock(background->view(), installed, site.dock_in_sensor, noise, rng, composite.get());
     ++out.placed;
     const dockcore::DockEstimate e = est->estimate(composite->view(), real_lidar_mount());
+    // The face's turn from facing the lidar: its x axis against the direction from the dock to the lidar.
+    const Pose2& truth = site.dock_in_sensor;
+    const double to_lidar = std::atan2(-static_cast<double>(truth.y_m), -static_cast<double>(truth.x_m));
+    const double view_deg = std::fabs(wrap(static_cast<double>(truth.yaw_rad) - to_lidar)) / kDegD;
+    int view_bin = 0;
+    while (view_bin + 1 < kCompositeViewBins && view_deg > kCompositeViewBinDeg[view_bin]) ++view_bin;
+    ++out.placed_by_view[view_bin];
     if (!e.found) {
       ++out.missed;
       continue;
@@ -575,6 +582,7 @@ CompositeResult measure_real_composites(const LoadedRecording& rec, const dockco
     const double yaw = std::fabs(wrap(static_cast<double>(e.pose.yaw_rad - site.dock_in_sensor.yaw_rad)));
     if (pos <= o.match_m && yaw <= o.match_rad) {
       ++out.detected;
+      ++out.detected_by_view[view_bin];
       out.pos_err_m.push_back(pos);
       out.yaw_err_rad.push_back(yaw);
     } else {

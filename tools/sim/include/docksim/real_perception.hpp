@@ -183,6 +183,11 @@ struct CompositeOptions {
 };
 
 /// Composite results of one (recording, profile, kind).
+/// Upper edges (degrees) of the view-angle bins of CompositeResult: 0-30° (the detection targets' envelope), 30-45°,
+/// 45-60° (the wall sites' max_incidence_rad).
+constexpr int kCompositeViewBins = 3;
+constexpr double kCompositeViewBinDeg[kCompositeViewBins] = {30.0, 45.0, 60.0};
+
 struct CompositeResult {
   std::size_t scans_tried = 0;             ///< Scans looked at for a site.
   std::size_t no_site = 0;                 ///< Of which had no clean site.
@@ -190,6 +195,10 @@ struct CompositeResult {
   std::size_t detected = 0;                ///< Found within match_m / match_rad of the truth.
   std::size_t wrong = 0;                   ///< Found elsewhere.
   std::size_t missed = 0;                  ///< Not found.
+  /// By how far the dock's face is turned from facing the lidar (kCompositeViewBinDeg): composites placed and
+  /// detected. A dock seen further off its axis shows less of itself (a 90° notch beyond 45° shows one arm).
+  std::size_t placed_by_view[kCompositeViewBins] = {};
+  std::size_t detected_by_view[kCompositeViewBins] = {};
   std::vector<double> pos_err_m;           ///< Of the detected ones.
   std::vector<double> yaw_err_rad;         ///< Of the detected ones.
   std::vector<double> wrong_pos_err_m;     ///< Of the wrong ones: how far from the truth (near miss or elsewhere).
