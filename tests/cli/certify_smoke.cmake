@@ -8,7 +8,7 @@ set(known_failures "18;40")
 # Inputs: -DDOCKSIM=<dock-sim> -DSCENARIO=<default.toml> -DWORK=<scratch dir>.
 file(MAKE_DIRECTORY ${WORK})
 
-execute_process(COMMAND ${DOCKSIM} certify ${SCENARIO} --trials 60 --seed 1 --jobs 2 --json
+execute_process(COMMAND ${DOCKSIM} certify ${SCENARIO} --trials 60 --seed 1 --jobs 2 --json --csv ${WORK}/trials.csv
   RESULT_VARIABLE rc OUTPUT_VARIABLE two ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "certify: exit ${rc}\n${err}")
@@ -32,6 +32,25 @@ list(LENGTH known_failures nknown)
 math(EXPR want "60 - ${nknown}")
 if(NOT ok EQUAL want)
   message(FATAL_ERROR "certify: ${ok} of 60 right, want ${want}")
+endif()
+# The per-trial CSV: a header and 60 rows; a wrong outcome names its cause, a docking its errors at the contacts.
+file(STRINGS ${WORK}/trials.csv rows)
+list(LENGTH rows nrows)
+list(GET rows 0 header)
+if(NOT nrows EQUAL 61 OR NOT header MATCHES "^trial,right,charging_confirmed,cause,lateral_mm,.*,robot\\.kinematics,")
+  message(FATAL_ERROR "certify --csv: ${nrows} lines, header '${header}'")
+endif()
+set(csv_failed "")
+foreach(row IN LISTS rows)
+  if(row MATCHES "^([0-9]+),0,0,([^,]+),,,,")
+    list(APPEND csv_failed ${CMAKE_MATCH_1})
+  elseif(row MATCHES "^[0-9]+,1,1,,-?[0-9.]+,-?[0-9.]+,-?[0-9.]+,[0-9.]+,")
+  elseif(NOT row STREQUAL header AND NOT row MATCHES "^[0-9]+,1,0,,,,,")  # a push seen: right, not charging
+    message(FATAL_ERROR "certify --csv: unexpected row '${row}'")
+  endif()
+endforeach()
+if(NOT csv_failed STREQUAL known_failures)
+  message(FATAL_ERROR "certify --csv: failed trials '${csv_failed}', the JSON's '${failed}'")
 endif()
 string(JSON lower GET "${two}" lower_bound_95)
 string(JSON rate GET "${two}" success_rate)
@@ -67,4 +86,5 @@ execute_process(COMMAND ${DOCKSIM} certify ${SCENARIO} --write ${WORK}/x.toml
 if(NOT rc EQUAL 2 OR NOT err MATCHES "--write needs --trial")
   message(FATAL_ERROR "certify --write without --trial: exit ${rc}, want 2 with a message\n${err}")
 endif()
-message(STATUS "certify: ${ok} / 60 right, the failures the known ones, independent of --jobs; a trial replays alone")
+message(STATUS "certify: ${ok} / 60 right, the failures the known ones (in the JSON and the CSV), independent of "
+               "--jobs; a trial replays alone")

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -19,6 +20,7 @@
 #include <toml++/toml.h>
 #include <nlohmann/json.hpp>
 
+#include "angles.hpp"
 #include "commands.hpp"
 #include "dockcore/task/faults.hpp"
 #include "dockcore/task/task_manager.hpp"
@@ -110,6 +112,33 @@ constexpr double kPasserReachM = 1.5;
 constexpr std::size_t kFactorCount = sizeof(kFactors) / sizeof(kFactors[0]);
 constexpr std::uint64_t kFamilySalt = 0x63657274696679ull;  // the family's own stream, apart from the run's noise
 
+/// Writes one CSV row per trial: its index, whether the outcome was right, charging confirmed, the cause when not
+/// right, the pads' signed errors at the contacts (mm, mm, deg; empty when charging was not confirmed), time to
+/// charging, reversals and retries, then every factor's drawn value (empty when the trial did not draw it). What a
+/// user needs to see which factors drive the contact errors, not only the failures. False when the file cannot be
+/// written.
+bool write_trials_csv(const std::string& path, const std::vector<docksim::SimRun>& runs,
+                      const std::vector<std::vector<double>>& values, const std::vector<bool>& ok,
+                      const std::function<std::string(std::size_t)>& cause) {
+  std::ofstream out(path, std::ios::binary);
+  out << "trial,right,charging_confirmed,cause,lateral_mm,longitudinal_mm,yaw_deg,time_to_charging_s,reversals,retries";
+  for (const Factor& f : kFactors) out << "," << f.table << "." << f.key;
+  out << "\n";
+  auto num = [](double v, const char* format) { return std::isfinite(v) ? fmt(format, v) : std::string(); };
+  for (std::size_t t = 0; t < runs.size(); ++t) {
+    const docksim::SimOutcome& oc = runs[t].outcome;
+    const bool docked = oc.charging_confirmed;
+    out << t << "," << (ok[t] ? 1 : 0) << "," << (docked ? 1 : 0) << "," << (ok[t] ? std::string() : cause(t)) << ","
+        << (docked ? fmt("%.2f", oc.lateral_m * 1e3) : "") << ","
+        << (docked ? fmt("%.2f", oc.longitudinal_m * 1e3) : "") << ","
+        << (docked ? fmt("%.3f", oc.yaw_rad * kRadToDeg) : "") << "," << num(oc.time_to_charging_s, "%.2f") << ","
+        << oc.reversals << "," << oc.retries;
+    for (std::size_t i = 0; i < kFactorCount; ++i) out << "," << num(values[t][i], "%.6g");
+    out << "\n";
+  }
+  return static_cast<bool>(out);
+}
+
 struct CertifyOptions {
   std::string scenario;
   std::string controller;
@@ -119,6 +148,7 @@ struct CertifyOptions {
   int jobs = 1;
   bool json = false;
   std::string svg;
+  std::string csv;    // --csv: one row per trial
   int trial = -1;     // --trial: draw only this trial
   std::string write;  // --write: the drawn trial's scenario file
 };
@@ -446,9 +476,11 @@ int run_certify(const CertifyOptions& o) {
   const double rate = static_cast<double>(successes) / static_cast<double>(n);
   const double lower = clopper_pearson_lower(o.trials, successes, 0.05);
 
-  // Success by quartile of each continuous factor (discrete: by choice).
+  // Success by quartile of each continuous factor (discrete: by choice), and the errors at the contacts of the
+  // robots that docked there.
   struct Bin {
     int n = 0, ok = 0;
+    std::vector<double> lat_mm, yaw_deg;
   };
   std::vector<std::vector<Bin>> bins(kFactorCount, std::vector<Bin>(4));
   for (std::size_t i = 0; i < kFactorCount; ++i) {
@@ -461,6 +493,11 @@ int run_certify(const CertifyOptions& o) {
                                 : std::min<std::size_t>(3, static_cast<std::size_t>(4 * (v - f.lo) / (f.hi - f.lo)));
       ++bins[i][q].n;
       bins[i][q].ok += ok[t] ? 1 : 0;
+      const docksim::SimOutcome& oc = runs[t].outcome;
+      if (oc.charging_confirmed) {
+        bins[i][q].lat_mm.push_back(std::fabs(oc.lateral_m) * 1e3);
+        bins[i][q].yaw_deg.push_back(std::fabs(oc.yaw_rad) * kRadToDeg);
+      }
     }
   }
   auto cause = [&](std::size_t t) {
@@ -508,7 +545,13 @@ int run_certify(const CertifyOptions& o) {
     nlohmann::ordered_json fac = nlohmann::ordered_json::array();
     for (std::size_t i = 0; i < kFactorCount; ++i) {
       nlohmann::ordered_json b = nlohmann::ordered_json::array();
-      for (const Bin& x : bins[i]) b.push_back({{"trials", x.n}, {"successes", x.ok}});
+      for (const Bin& x : bins[i]) {
+        auto p95 = [](const std::vector<double>& v) {
+          return v.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(pct(v, 95));
+        };
+        b.push_back(
+            {{"trials", x.n}, {"successes", x.ok}, {"lateral_mm_p95", p95(x.lat_mm)}, {"yaw_deg_p95", p95(x.yaw_deg)}});
+      }
       fac.push_back({{"factor", std::string(kFactors[i].table) + "." + kFactors[i].key}, {"bins", b}});
     }
     j["factors"] = fac;
@@ -559,6 +602,25 @@ int run_certify(const CertifyOptions& o) {
         std::printf("   %g to %g %s\n", f.lo, f.hi, f.unit);
       }
     }
+    std::printf(
+        "\nerrors at the contacts by quartile of each factor (discrete: by choice), p95 lateral mm / yaw deg of "
+        "the robots that docked\n");
+    for (std::size_t i = 0; i < kFactorCount; ++i) {
+      const Factor& f = kFactors[i];
+      std::printf("  %-26s", (std::string(f.table) + "." + f.key).c_str());
+      const std::size_t nb = f.first != nullptr ? 2 : 4;
+      for (std::size_t q = 0; q < nb; ++q) {
+        const Bin& x = bins[i][q];
+        std::printf("  %12s", x.lat_mm.empty()
+                                  ? "-"
+                                  : (fmt("%.1f", pct(x.lat_mm, 95)) + " / " + fmt("%.2f", pct(x.yaw_deg, 95))).c_str());
+      }
+      std::printf("\n");
+    }
+  }
+  if (!o.csv.empty() && !write_trials_csv(o.csv, runs, values, ok, cause)) {
+    std::cerr << "dock-sim certify: cannot write " << o.csv << "\n";
+    return 2;
   }
   if (!o.svg.empty()) {
     draw_envelope(
@@ -586,6 +648,9 @@ void register_certify(CLI::App& app) {
   sub->add_option("--jobs", o->jobs, "Worker threads (results do not depend on it)")->capture_default_str();
   sub->add_flag("--json", o->json, "Print JSON instead of the report");
   sub->add_option("--svg", o->svg, "Draw success and failure over each factor's range");
+  sub->add_option("--csv", o->csv,
+                  "Write one row per trial: outcome, cause, errors at the contacts, time, reversals, retries and every "
+                  "drawn factor");
   sub->add_option("--trial", o->trial, "Draw only this trial's robot: print its scenario (or --write it)");
   sub->add_option("--write", o->write, "With --trial: write the trial's scenario file here");
   sub->callback([o, seed]() {
