@@ -212,6 +212,35 @@ TEST(DockPoseEstimator, ConvergesFromPoorHint) {
   check_close(t.dock_in_lidar, e, 0.015, deg_to_rad(3.0));
 }
 
+TEST(DockPoseEstimator, WhereTheSurfacesEndFixesADockAlongAFaceOfParallelSurfaces) {
+  // A raised face on a wider plate, seen straight on: every surface the lidar sees is parallel to the face (the steps'
+  // sides face away), so the point-to-surface fit cannot tell where along the face the dock stands, and without the
+  // ends of its surfaces the dock is refused for weak geometry. A hint 20 mm off along the face, and the fit must find
+  // the dock from where its range steps fall (a beam is 14 mm wide there), with a covariance that says so.
+  const Vec2 v[] = {Vec2(-0.05, -0.2), Vec2(-0.05, -0.1), Vec2(0, -0.1),
+                    Vec2(0, 0.1),      Vec2(-0.05, 0.1),  Vec2(-0.05, 0.2)};
+  DockProfile prof;
+  CHECK_EQUAL(static_cast<int>(ProfileError::kOk), static_cast<int>(make_profile(v, 6, 0, "raised-face", prof)));
+  g_est.configure(prof, EstimatorParams{});
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const Truth t = simulate(prof, 1.0, 0.0, 0.0, ld06(0.002), 40 + seed);
+    const Pose2& d = t.dock_in_lidar;
+    const Vec2 along(-std::sin(d.yaw_rad), std::cos(d.yaw_rad));  // the dock's y axis in the lidar frame
+    const Pose2 hint = dockcore_test::pose(d.x_m + 0.02 * along.x(), d.y_m + 0.02 * along.y(), d.yaw_rad);
+    const DockEstimate e = g_est.estimate(g_scan.view(), Pose2{}, &hint);
+    char msg[128];
+    std::snprintf(msg, sizeof msg, "seed %llu: %s", static_cast<unsigned long long>(seed), to_string(e.status));
+    CHECK_TEXT(e.found, msg);
+    const double off_along = (e.pose.x_m - d.x_m) * along.x() + (e.pose.y_m - d.y_m) * along.y();
+    const double var_along = along.dot(e.covariance.block<2, 2>(0, 0) * along);
+    std::snprintf(msg, sizeof msg, "seed %llu: %.4f m off along the face, sigma %.4f m",
+                  static_cast<unsigned long long>(seed), off_along, std::sqrt(var_along));
+    // Each end is placed to within its two beams; a mixed pixel read as the surface moves one end by a beam.
+    CHECK_TEXT(std::fabs(off_along) <= 0.008, msg);
+    CHECK_TEXT(var_along > 0 && std::sqrt(var_along) < 0.01, msg);
+  }
+}
+
 TEST(DockPoseEstimator, DeterministicBitForBit) {
   const DockProfile prof = profile("v-marker");
   g_est.configure(prof, EstimatorParams{});

@@ -42,6 +42,19 @@ constexpr std::uint8_t kNoSegment = 0xFF;
 
 // Gauss-Newton iterations that use Huber weights before switching to Tukey's biweight.
 constexpr std::uint8_t kHuberIterations = 3;
+// Beams either side of where the pose puts a surface's end that edge_terms() looks at for the step: the fit is within a
+// beam or two of the truth along a face once it has converged on the surfaces.
+constexpr long kEdgeSearchBeams = 3;
+// A surface's end is no measurement when an interior point 1 mm from it is hidden by another part of the dock.
+constexpr Real kEdgeProbeM = static_cast<Real>(0.001);
+// The surfaces' ends enter the fit only when its weakest direction carries less than this share of its information
+// (the trace, yaw as arc length at the dock's radius): the profile check's ambiguity bound. Applied to every fit,
+// their quantisation moved poses the surfaces fix and let more false docks through on the real dock-less scans.
+constexpr Real kEdgeWeakShare = static_cast<Real>(0.01);
+// At most this many steps with the ends (each may move the pose by a beam and change which beams bracket an end),
+// stopping once a step moves the pose less than kEdgeStopM.
+constexpr std::uint8_t kEdgeSteps = 3;
+constexpr Real kEdgeStopM = static_cast<Real>(0.001);
 
 // A return on the line of a long profile segment, this far past its end, means that surface carries on where the
 // dock ends: a wall or a box face, not the dock. Closer than the minimum is ambiguous: a 45° wing is only 4 cm
@@ -560,6 +573,33 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
       }
     }
   }
+  if (out.iterations > 0) {
+    // Where the surfaces leave a direction of the pose almost unfixed (every visible surface parallel, or nearly),
+    // their ends fix it: a few steps with them, and their information in the fit's. Elsewhere the ends add little and
+    // their quantisation would only move a pose the surfaces fix.
+    Mat3 scale = Mat3::Identity();
+    scale(2, 2) = profile_radius_m_ > 0 ? 1 / profile_radius_m_ : R(1);
+    const Mat3 hs = scale * out.h * scale;
+    if (min_eigen_sym3(hs) < kEdgeWeakShare * hs.trace()) {
+      const Mat3 h_surfaces = out.h;
+      for (std::uint8_t step = 0; step < kEdgeSteps; ++step) {
+        placed_.place(profile_, pose);
+        Mat3 h_edge = Mat3::Zero();
+        Vec3 g_edge = Vec3::Zero();
+        if (edge_terms(pose, &h_edge, &g_edge) == 0) break;
+        const Mat3 h = h_surfaces + h_edge;
+        Mat3 hinv;
+        if (!invert_sym3(h + h.trace() * R(1e-9) * Mat3::Identity(), &hinv)) break;
+        const Vec3 delta = -(hinv * g_edge);
+        if (!delta.allFinite()) break;
+        pose.x_m += delta.x();
+        pose.y_m += delta.y();
+        pose.yaw_rad = wrap_angle(pose.yaw_rad + delta.z());
+        out.h = h;
+        if (std::fabs(delta.x()) + std::fabs(delta.y()) + profile_radius_m_ * std::fabs(delta.z()) < kEdgeStopM) break;
+      }
+    }
+  }
   out.pose = pose;
   out.ok = out.iterations > 0;
   return out;
@@ -1041,6 +1081,85 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   }
   if (r.reject != RejectReason::kNone) return;
   r.ok = true;
+}
+
+std::size_t DockPoseEstimatorBase::edge_terms(const Pose2& pose, Mat3* h, Vec3* g) const {
+  const std::size_t segments = placed_.segments;
+  if (segments == 0 || beams_ == 0) return 0;
+  const Vec2 t(pose.x_m, pose.y_m);
+  const Real gate = params_.inlier_gate_m;
+  // In the surfaces' units: range_sigma_m is what one beam's residual is worth, and what the covariance scales by.
+  const Real sigma_sq = params_.range_sigma_m * params_.range_sigma_m;
+  std::size_t used = 0;
+  for (std::size_t j = 0; j <= segments; ++j) {
+    const bool vis_before = j > 0 && placed_.visible[j - 1];
+    const bool vis_after = j < segments && placed_.visible[j];
+    // Both visible: a corner, the rays either side meet one surface or the other at about the same range.
+    if (vis_before == vis_after) continue;
+    const std::size_t s_on = vis_before ? j - 1 : j;
+    const Vec2& v = placed_.v_m[j];
+    const Real rho = v.norm();
+    if (!(rho > params_.min_range_m)) continue;
+    // A point of the surface just inside its end must be what the ray meets: no other part of the dock hides it.
+    const Vec2 inside = v + placed_.u[s_on] * (vis_before ? -kEdgeProbeM : kEdgeProbeM);
+    const Real inside_m = inside.norm();
+    Real hit_m = 0;
+    std::size_t hit_seg = 0;
+    if (!placed_.raycast(inside / inside_m, &hit_m, &hit_seg) || hit_seg != s_on) continue;
+    const Vec2 v_dir = v / rho;
+    // Which way (counter-clockwise +1) the surface lies from its end, as seen from the lidar.
+    const Real on_side = v_dir.x() * inside.y() - v_dir.y() * inside.x() > 0 ? R(1) : R(-1);
+    const Vec2& n = placed_.n[s_on];
+    const Real c = placed_.c_m[s_on];
+    const long centre = first_beam(std::atan2(v.y(), v.x()));
+    // Walking from the side away from the surface towards it: the last beam past the surface's line before a beam on
+    // it. Offsets are sines of the angle from the vertex, signed towards the surface.
+    bool have_off = false;
+    Real off_s = 0;
+    std::size_t since_off = 0;
+    bool found = false;
+    Real best_mid = 0;
+    Real best_width = 0;
+    for (long q = -kEdgeSearchBeams; q <= kEdgeSearchBeams; ++q) {
+      const long step = on_side > 0 ? q : -q;
+      std::size_t i = 0;
+      if (!beam_at(centre + step, 0, &i)) continue;
+      const Vec2& d = dir_[i];
+      const Real s = on_side * (v_dir.x() * d.y() - v_dir.y() * d.x());
+      const Real m = range_at(i);
+      const Real nd = n.dot(d);
+      // Along this beam, the range at which it meets the surface's line (extended past its end).
+      const Real line_m = nd < 0 ? c / nd : R(0);
+      ++since_off;
+      if (m == 0 || !(line_m > 0)) continue;
+      if (m > line_m + gate) {
+        have_off = true;
+        off_s = s;
+        since_off = 0;
+      } else if (std::fabs(m - line_m) <= gate && have_off && since_off <= 2) {
+        const Real mid = R(0.5) * (off_s + s);
+        if (!found || std::fabs(mid) < std::fabs(best_mid)) {
+          found = true;
+          best_mid = mid;
+          best_width = s - off_s;
+        }
+        have_off = false;
+      }
+    }
+    if (!found || !(best_width > 0)) continue;
+    // The vertex's bearing lies uniformly between the two beams: residual of the pose's bearing in metres across the
+    // ray, standard deviation width/√12 in the same units.
+    const Real e = -on_side * best_mid * rho;
+    const Real var = rho * rho * best_width * best_width / 12;
+    const Real w = sigma_sq / var;
+    const Vec2 u_perp(-v_dir.y(), v_dir.x());
+    const Vec2 rel = v - t;
+    const Vec3 jac(u_perp.x(), u_perp.y(), u_perp.x() * -rel.y() + u_perp.y() * rel.x());
+    *h += w * jac * jac.transpose();
+    *g += w * e * jac;
+    ++used;
+  }
+  return used;
 }
 
 void DockPoseEstimatorBase::decide(Refined& r, const Pose2* hint) {

@@ -310,6 +310,16 @@ class DockPoseEstimatorBase {
   std::size_t span_beams(Real dist_m, const Vec2& t, const Vec2& nd, Real gate_m);
   /// Scores a refined candidate (its evidence and counts) and decides. `hint` is the hint in the lidar frame or null.
   void verify(Refined& r, const Pose2* hint);
+  /// Where the scan shows the ends of the placed dock's visible surfaces. A silhouette vertex is the end of a visible
+  /// surface whose neighbour along the profile is hidden or absent: rays past it miss that surface. When the last
+  /// beam on the surface and the first beam beyond its line lie within kEdgeSearchBeams of where the pose puts the
+  /// vertex, with at most one beam between them, the vertex's bearing lies between those two beams: a measurement
+  /// whose error is uniform over that interval (standard deviation width/√12). Adds its Gauss-Newton terms, in the
+  /// range units of refine() (weighted by range_sigma_m² over that variance), to `h` and `g`. refine() takes them
+  /// when its fit leaves a direction almost unfixed (kEdgeWeakShare): a dock along a face that every visible surface
+  /// is parallel to, which the point-to-surface residuals cannot place. Returns the edges used. Requires placed_ at
+  /// `pose` and a loaded scan. O(V·S): a raycast per silhouette vertex, and 2·kEdgeSearchBeams + 1 beams each.
+  std::size_t edge_terms(const Pose2& pose, Mat3* h, Vec3* g) const;
   /// verify(), then the hint radius: the whole accept decision for one candidate, no counters touched.
   void decide(Refined& r, const Pose2* hint);
   /// Signed index of the beam nearest angle_rad (may lie outside [0, beams) for a partial scan).
