@@ -580,7 +580,14 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
     Mat3 scale = Mat3::Identity();
     scale(2, 2) = profile_radius_m_ > 0 ? 1 / profile_radius_m_ : R(1);
     const Mat3 hs = scale * out.h * scale;
-    if (min_eigen_sym3(hs) < kEdgeWeakShare * hs.trace()) {
+    const Real trace = hs.trace();
+    // λmin ≥ det / (λmid·λmax) ≥ 4·det / trace² (λmid + λmax ≤ trace): when that bound clears the share, as it does
+    // for any dock seen from two sides, the closed-form eigenvalue is not needed.
+    const Real det = hs(0, 0) * (hs(1, 1) * hs(2, 2) - hs(1, 2) * hs(1, 2)) -
+                     hs(0, 1) * (hs(0, 1) * hs(2, 2) - hs(1, 2) * hs(0, 2)) +
+                     hs(0, 2) * (hs(0, 1) * hs(1, 2) - hs(1, 1) * hs(0, 2));
+    const bool surely_fixed = trace > 0 && 4 * det >= kEdgeWeakShare * trace * trace * trace;
+    if (!surely_fixed && min_eigen_sym3(hs) < kEdgeWeakShare * trace) {
       const Mat3 h_surfaces = out.h;
       for (std::uint8_t step = 0; step < kEdgeSteps; ++step) {
         placed_.place(profile_, pose);
