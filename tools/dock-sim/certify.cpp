@@ -587,36 +587,43 @@ int run_certify(const CertifyOptions& o) {
       ++shown;
     }
     if (shown == 0) std::printf("  none\n");
-    std::printf("\nsuccess by quartile of each factor (discrete: by choice), %% (trials)\n");
-    for (std::size_t i = 0; i < kFactorCount; ++i) {
-      const Factor& f = kFactors[i];
-      std::printf("  %-26s", (std::string(f.table) + "." + f.key).c_str());
-      const std::size_t nb = f.first != nullptr ? 2 : 4;
-      for (std::size_t q = 0; q < nb; ++q) {
-        const Bin& x = bins[i][q];
-        std::printf("  %6s (%3d)", x.n > 0 ? fmt("%.1f", 100.0 * x.ok / x.n).c_str() : "-", x.n);
+    // One row per factor, a cell per bin (its two choices, or the quartiles of its range).
+    auto by_factor = [&](const char* title, const std::function<std::string(const Bin&)>& cell, bool ranges) {
+      std::printf("%s", title);
+      for (std::size_t i = 0; i < kFactorCount; ++i) {
+        const Factor& f = kFactors[i];
+        std::printf("  %-26s", (std::string(f.table) + "." + f.key).c_str());
+        const std::size_t nb = f.first != nullptr ? 2 : 4;
+        for (std::size_t q = 0; q < nb; ++q) std::printf("  %s", cell(bins[i][q]).c_str());
+        if (!ranges) {
+          std::printf("\n");
+        } else if (f.first != nullptr) {
+          std::printf("   %s | %s\n", f.first, f.second);
+        } else {
+          std::printf("   %g to %g %s\n", f.lo, f.hi, f.unit);
+        }
       }
-      if (f.first != nullptr) {
-        std::printf("   %s | %s\n", f.first, f.second);
-      } else {
-        std::printf("   %g to %g %s\n", f.lo, f.hi, f.unit);
-      }
-    }
-    std::printf(
-        "\nerrors at the contacts by quartile of each factor (discrete: by choice), p95 lateral mm / yaw deg of "
-        "the robots that docked\n");
-    for (std::size_t i = 0; i < kFactorCount; ++i) {
-      const Factor& f = kFactors[i];
-      std::printf("  %-26s", (std::string(f.table) + "." + f.key).c_str());
-      const std::size_t nb = f.first != nullptr ? 2 : 4;
-      for (std::size_t q = 0; q < nb; ++q) {
-        const Bin& x = bins[i][q];
-        std::printf("  %12s", x.lat_mm.empty()
-                                  ? "-"
-                                  : (fmt("%.1f", pct(x.lat_mm, 95)) + " / " + fmt("%.2f", pct(x.yaw_deg, 95))).c_str());
-      }
-      std::printf("\n");
-    }
+    };
+    by_factor(
+        "\nsuccess by quartile of each factor (discrete: by choice), % (trials)\n",
+        [](const Bin& x) {
+          char c[32];
+          std::snprintf(c, sizeof c, "%6s (%3d)", x.n > 0 ? fmt("%.1f", 100.0 * x.ok / x.n).c_str() : "-", x.n);
+          return std::string(c);
+        },
+        true);
+    by_factor(
+        "\nerrors at the contacts by quartile of each factor (discrete: by choice), p95 lateral mm / yaw deg of the "
+        "robots that docked\n",
+        [](const Bin& x) {
+          char c[32];
+          std::snprintf(c, sizeof c, "%12s",
+                        x.lat_mm.empty()
+                            ? "-"
+                            : (fmt("%.1f", pct(x.lat_mm, 95)) + " / " + fmt("%.2f", pct(x.yaw_deg, 95))).c_str());
+          return std::string(c);
+        },
+        false);
   }
   if (!o.csv.empty() && !write_trials_csv(o.csv, runs, values, ok, cause)) {
     std::cerr << "dock-sim certify: cannot write " << o.csv << "\n";
