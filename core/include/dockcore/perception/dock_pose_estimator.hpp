@@ -302,6 +302,8 @@ class DockPoseEstimatorBase {
   /// global-search hypothesis), so large steps fit a sample of a dense span; a hint refines on every beam from the
   /// start. O(I · W · S) for I iterations over the W beams of the dock's span and S profile segments. A fit that
   /// comes close to one of the `n_verified` poses in `verified` after a few iterations is abandoned (duplicate set).
+  /// When the fit leaves a direction almost unfixed, up to kEdgeSteps more steps with edge_terms() (O(kEdgeSteps · V ·
+  /// S)).
   Refined refine(const Pose2& initial, bool rough, const Pose2* verified = nullptr, std::size_t n_verified = 0);
   /// Fills the association list (assoc_beam_, no segment yet) with the returns in placed_'s angular span plus the
   /// margin that `gate_m` (the iteration's association gate) subtends at the dock, leaving out wall points beside a
