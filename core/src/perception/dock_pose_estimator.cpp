@@ -40,6 +40,12 @@ constexpr Real kConvergedDuplicateRad = static_cast<Real>(0.01);
 // Association with no segment yet (assoc_seg_).
 constexpr std::uint8_t kNoSegment = 0xFF;
 
+// Damping of the normal equations, as a share of their trace: a whisper that keeps a nearly degenerate view (one
+// flat face) solvable without biasing a good fit. In float it must stand above the rounding of the Jacobian (a face
+// seen head-on has n_y of order epsilon, not 0), or a step along the unfixed direction runs away.
+constexpr Real kDampingShare = std::numeric_limits<Real>::epsilon() * 8 > static_cast<Real>(1e-9)
+                                   ? std::numeric_limits<Real>::epsilon() * 8
+                                   : static_cast<Real>(1e-9);
 // Gauss-Newton iterations that use Huber weights before switching to Tukey's biweight.
 constexpr std::uint8_t kHuberIterations = 3;
 // Beams either side of where the pose puts a surface's end that edge_terms() looks at for the step: the fit is within a
@@ -542,8 +548,7 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
     h << h00, h01, h02, h01, h11, h12, h02, h12, h22;
     const Vec3 g(g0, g1, g2);
     if (used < 3) return out;
-    // A whisper of damping keeps a nearly degenerate view (one flat face) solvable; it does not bias a good fit.
-    const Real damping = h.trace() * R(1e-9);
+    const Real damping = h.trace() * kDampingShare;
     const Mat3 hd = h + damping * Mat3::Identity();
     Mat3 hinv;
     if (!invert_sym3(hd, &hinv)) return out;
@@ -596,7 +601,7 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
         if (edge_terms(pose, &h_edge, &g_edge) == 0) break;
         const Mat3 h = h_surfaces + h_edge;
         Mat3 hinv;
-        if (!invert_sym3(h + h.trace() * R(1e-9) * Mat3::Identity(), &hinv)) break;
+        if (!invert_sym3(h + h.trace() * kDampingShare * Mat3::Identity(), &hinv)) break;
         const Vec3 delta = -(hinv * g_edge);
         if (!delta.allFinite()) break;
         pose.x_m += delta.x();
