@@ -582,17 +582,8 @@ DockPoseEstimatorBase::Refined DockPoseEstimatorBase::refine(const Pose2& initia
     // Where the surfaces leave a direction of the pose almost unfixed (every visible surface parallel, or nearly),
     // their ends fix it: a few steps with them, and their information in the fit's. Elsewhere the ends add little and
     // their quantisation would only move a pose the surfaces fix.
-    Mat3 scale = Mat3::Identity();
-    scale(2, 2) = profile_radius_m_ > 0 ? 1 / profile_radius_m_ : R(1);
-    const Mat3 hs = scale * out.h * scale;
-    const Real trace = hs.trace();
-    // λmin ≥ det / (λmid·λmax) ≥ 4·det / trace² (λmid + λmax ≤ trace): when that bound clears the share, as it does
-    // for any dock seen from two sides, the closed-form eigenvalue is not needed.
-    const Real det = hs(0, 0) * (hs(1, 1) * hs(2, 2) - hs(1, 2) * hs(1, 2)) -
-                     hs(0, 1) * (hs(0, 1) * hs(2, 2) - hs(1, 2) * hs(0, 2)) +
-                     hs(0, 2) * (hs(0, 1) * hs(1, 2) - hs(1, 1) * hs(0, 2));
-    const bool surely_fixed = trace > 0 && 4 * det >= kEdgeWeakShare * trace * trace * trace;
-    if (!surely_fixed && min_eigen_sym3(hs) < kEdgeWeakShare * trace) {
+    const Mat3 hs = arc_scaled(out.h);
+    if (min_eigen_sym3(hs) < kEdgeWeakShare * hs.trace()) {
       const Mat3 h_surfaces = out.h;
       for (std::uint8_t step = 0; step < kEdgeSteps; ++step) {
         placed_.place(profile_, pose);
@@ -1035,12 +1026,7 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
     f.wall_seen = w_dock * static_cast<Real>(r.wall_seen);
     f.wall_missed = w_dock * static_cast<Real>(r.wall_looked - r.wall_seen);
   }
-  {
-    // The fit's information with yaw expressed as arc length at the dock's radius, so all three are in beams.
-    Mat3 scale = Mat3::Identity();
-    scale(2, 2) = profile_radius_m_ > 0 ? 1 / profile_radius_m_ : R(1);
-    f.constraint = w_dock * min_eigen_sym3(scale * r.h * scale);
-  }
+  f.constraint = w_dock * min_eigen_sym3(arc_scaled(r.h));
   Real* cue = r.evidence.cue_nats;
   // A wider gate (a noisier lidar) catches chance surfaces more often: a hit is worth less by the gate's growth.
   const Real gate_growth = gate > kReferenceGateM ? kGateGrowthShare * std::log(gate / kReferenceGateM) : R(0);
@@ -1093,6 +1079,14 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   }
   if (r.reject != RejectReason::kNone) return;
   r.ok = true;
+}
+
+Mat3 DockPoseEstimatorBase::arc_scaled(const Mat3& h) const {
+  const Real s = profile_radius_m_ > 0 ? 1 / profile_radius_m_ : R(1);
+  Mat3 out = h;
+  out.row(2) *= s;
+  out.col(2) *= s;
+  return out;
 }
 
 std::size_t DockPoseEstimatorBase::edge_terms(const Pose2& pose, Mat3* h, Vec3* g) const {

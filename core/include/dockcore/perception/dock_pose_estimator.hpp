@@ -322,6 +322,10 @@ class DockPoseEstimatorBase {
   /// is parallel to, which the point-to-surface residuals cannot place. Returns the edges used. Requires placed_ at
   /// `pose` and a loaded scan. O(V·S): a raycast per silhouette vertex, and 2·kEdgeSearchBeams + 1 beams each.
   std::size_t edge_terms(const Pose2& pose, Mat3* h, Vec3* g) const;
+  /// A fit's information (refine()'s normal matrix) with yaw expressed as arc length at the dock's radius, so that all
+  /// three components are in metres: what the `geometry` cue and refine()'s test for an almost unfixed direction read.
+  /// O(1).
+  Mat3 arc_scaled(const Mat3& h) const;
   /// verify(), then the hint radius: the whole accept decision for one candidate, no counters touched.
   void decide(Refined& r, const Pose2* hint);
   /// Signed index of the beam nearest angle_rad (may lie outside [0, beams) for a partial scan).
