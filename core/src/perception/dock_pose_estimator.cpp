@@ -1212,20 +1212,24 @@ Real DockPoseEstimatorBase::prescore(const Pose2& pose, Real floor) {
   return score;
 }
 
-void DockPoseEstimatorBase::push_hypothesis(const Vec2& n_scan, const Vec2& anchor_scan, const Vec2& anchor_dock,
-                                        std::size_t profile_segment, std::size_t* n) {
+Pose2 DockPoseEstimatorBase::hypothesis_pose(const Vec2& n_scan, const Vec2& anchor_scan, const Vec2& anchor_dock,
+                                             std::size_t profile_segment) const {
   // The rotation taking the profile's unit normal onto the scan's: cosine and sine straight from the dot and cross
   // products (both normals are unit), so only the reported yaw needs an arctangent.
   const Vec2 n_j = profile_.normal(profile_segment);
   const Real c = n_j.dot(n_scan);
   const Real s = n_j.x() * n_scan.y() - n_j.y() * n_scan.x();
-  const Real yaw = std::atan2(s, c);
   const Vec2 t = anchor_scan - Vec2(c * anchor_dock.x() - s * anchor_dock.y(), s * anchor_dock.x() + c * anchor_dock.y());
+  return Pose2{t.x(), t.y(), std::atan2(s, c)};
+}
+
+void DockPoseEstimatorBase::push_hypothesis(const Vec2& n_scan, const Vec2& anchor_scan, const Vec2& anchor_dock,
+                                            std::size_t profile_segment, std::size_t* n) {
   if (*n >= kMaxHypotheses) {
     ++counters_.truncated_candidates;
     return;
   }
-  hyps_[*n].pose = Pose2{t.x(), t.y(), yaw};
+  hyps_[*n].pose = hypothesis_pose(n_scan, anchor_scan, anchor_dock, profile_segment);
   // Only the best max_candidates are refined: a hypothesis that cannot reach the current last of them needs no
   // exact score (it stays below that one, which only rises).
   const std::size_t keep = params_.max_candidates;
@@ -1445,7 +1449,72 @@ std::size_t DockPoseEstimatorBase::generate_candidates() {
     }
   }
   if (n > keep) counters_.truncated_candidates += static_cast<std::uint32_t>(n - keep);
-  return keep;
+  const bool stripes = profile_.reflector_count > 0 && intensity_usable_ && intensities_ != nullptr;
+  return keep + (stripes ? add_stripe_hypotheses(keep) : 0);
+}
+
+std::size_t DockPoseEstimatorBase::add_stripe_hypotheses(std::size_t at) {
+  const std::size_t np = points_.size();
+  const Real gate = params_.inlier_gate_m;
+  auto bright = [this](std::size_t k) { return intensities_[points_[k].index] >= params_.reflector_min_intensity; };
+  std::size_t added = 0;
+  std::size_t k = 0;
+  while (k < np && added < kMaxStripeHypotheses && at + added < kMaxHypotheses) {
+    if (!bright(k)) {
+      ++k;
+      continue;
+    }
+    // The run: consecutive bright returns without a depth gap (the gap test of the window hypotheses).
+    std::size_t last = k;
+    while (last + 1 < np && bright(last + 1)) {
+      const Real step_m = 5 * points_[last].range_m * angle_inc_rad_;
+      const Real allowed = step_m > R(0.05) ? step_m : R(0.05);
+      if ((points_[last + 1].p_m - points_[last].p_m).squaredNorm() > allowed * allowed) break;
+      ++last;
+    }
+    const Vec2 centre = (points_[k].p_m + points_[last].p_m) * R(0.5);
+    // What the run lights: its span and a beam's spacing either side (the tape's ends lie between beams).
+    const Real lit_m = (points_[last].p_m - points_[k].p_m).norm() + 2 * centre.norm() * angle_inc_rad_;
+    const std::size_t run_n = last + 1 - k;
+    k = last + 1;
+    if (run_n < 2) continue;
+    const LineSegment* line = nullptr;
+    for (const LineSegment& seg : segs_) {
+      if (std::fabs(seg.signed_distance_m(centre)) > gate) continue;
+      const Real along_m = seg.direction().dot(centre - seg.start_m);
+      if (along_m < -gate || along_m > seg.length_m() + gate) continue;
+      line = &seg;
+      break;
+    }
+    if (line == nullptr) continue;
+    const Vec2 on_line = centre - line->normal * line->signed_distance_m(centre);
+    // Groups of touching stripes (adjacent taped regions read as one run).
+    std::size_t q = 0;
+    while (q < profile_.reflector_count && added < kMaxStripeHypotheses && at + added < kMaxHypotheses) {
+      const ReflectorStripe& first = profile_.reflectors[q];
+      Real to_m = first.to_m;
+      std::size_t end = q + 1;
+      while (end < profile_.reflector_count && profile_.reflectors[end].segment == first.segment &&
+             profile_.reflectors[end].from_m <= to_m + kStripeEdgeMarginM) {
+        to_m = profile_.reflectors[end].to_m;
+        ++end;
+      }
+      const Real group_m = to_m - first.from_m;
+      // A run much longer than the group lies on something else (another code's wider stripe, a taped sign).
+      if (lit_m - 2 * gate <= group_m + 2 * kStripeEdgeMarginM) {
+        const std::size_t seg = first.segment;
+        const Vec2& a = profile_.vertices_m[seg];
+        const Vec2 d = profile_.vertices_m[seg + 1] - a;
+        const Real len_m = d.norm();
+        const Vec2 mid = a + d * ((first.from_m + to_m) * R(0.5) / len_m);
+        hyps_[at + added].pose = hypothesis_pose(line->normal, on_line, mid, seg);
+        hyps_[at + added].prescore = 0;
+        ++added;
+      }
+      q = end;
+    }
+  }
+  return added;
 }
 
 void DockPoseEstimatorBase::report(const Refined& r, DockEstimate* est) {

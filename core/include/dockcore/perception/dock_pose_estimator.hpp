@@ -6,8 +6,11 @@
 ///  1. Candidates. With a pose hint (the tracker's prediction, or a configured dock pose) the hint is tried first.
 ///     Otherwise (or when the hint fails) line segments of the scan are matched to the profile's long segments: each
 ///     pairing of a scan segment with a profile segment of similar length, facing the lidar, gives up to three pose
-///     hypotheses (centres aligned, or either end aligned for a partly hidden segment).
-///  2. Registration. Point-to-segment Gauss-Newton on (x, y, yaw) with Huber then Tukey weights, over the beams inside the dock's
+///     hypotheses (centres aligned, or either end aligned for a partly hidden segment). A dock with reflector stripes,
+///     on a lidar whose intensity is usable, also gets hypotheses from the scan's bright runs, refined whatever their
+///     prescore (at most kMaxStripeHypotheses).
+///  2. Registration. Point-to-segment Gauss-Newton on (x, y, yaw) with Huber then Tukey weights, over the beams inside
+///  the dock's
 ///     angular span (plus a margin), associating each point with the nearest visible profile segment.
 ///  3. Decision. The expected scan of the profile at the refined pose is compared beam by beam with the measured one,
 ///     and each candidate gets a log-likelihood ratio (nats): how much better "this dock at this pose" explains the
@@ -23,8 +26,9 @@
 /// Cost: tracking (a hint that holds) reads only the beams in the dock's span: O(I · W · S) with I <= max_iterations,
 /// W beams in the span, S visible profile segments (most beams keep their segment between iterations). A global
 /// search adds O(B) for the B beams (points, segmentation, hypotheses) and refines at most max_candidates
-/// candidates. The beam directions cost O(B) only when the scan geometry changes. No heap: the working buffers are
-/// DockPoseEstimatorN's, sized by its beam capacity (docs/architecture.md gives the sizes).
+/// candidates (and at most kMaxStripeHypotheses more for a dock with stripes). The beam directions cost O(B) only when
+/// the scan geometry changes. No heap: the working buffers are DockPoseEstimatorN's, sized by its beam capacity
+/// (docs/architecture.md gives the sizes).
 
 #include <cstddef>
 #include <cstdint>
@@ -349,12 +353,22 @@ class DockPoseEstimatorBase {
     return true;
   }
   /// Fills hyps_ with ranked pose hypotheses from scan line segments and sliding-window line fits (points_ already
-  /// built); returns how many to refine.
+  /// built), the best max_candidates first, then the stripe hypotheses; returns how many to refine in all.
   std::size_t generate_candidates();
   /// Appends the hypothesis that puts profile segment `profile_segment` (normal facing the lidar along n_scan) with
   /// its point anchor_dock (dock frame) onto anchor_scan (lidar frame). Counts truncation at kMaxHypotheses.
   void push_hypothesis(const Vec2& n_scan, const Vec2& anchor_scan, const Vec2& anchor_dock, std::size_t profile_segment,
                        std::size_t* n);
+  /// The pose that puts profile segment `profile_segment` (normal facing the lidar along n_scan) with its point
+  /// anchor_dock (dock frame) onto anchor_scan (lidar frame). O(1), one arctangent.
+  Pose2 hypothesis_pose(const Vec2& n_scan, const Vec2& anchor_scan, const Vec2& anchor_dock,
+                        std::size_t profile_segment) const;
+  /// Reflector docks with usable intensity: hypotheses from the scan's bright runs, written to hyps_ from index `at`
+  /// (past the ranked ones, so they are refined whatever their prescore). A run on a scan line segment puts the
+  /// centre of each group of touching stripes no shorter than the run at the run's centre, the line giving the
+  /// face's direction: the stripes pin a flat face along itself where its outline does not. At most
+  /// kMaxStripeHypotheses; returns how many. O(points + runs · (line segments + stripes)).
+  std::size_t add_stripe_hypotheses(std::size_t at);
   /// Hypotheses from windows of each long profile segment's length slid along contiguous runs of points: a window
   /// that is flat to the noise level, spans the segment's length and ends (a bend or a gap) on one side at least.
   /// Robust where split-and-merge merges a short wing into the face. O(points · long profile segments).
@@ -375,6 +389,8 @@ class DockPoseEstimatorBase {
 
   /// Hypotheses collected per scan before ranking; beyond this they are counted as truncated.
   static constexpr std::size_t kMaxHypotheses = 128;
+  /// Stripe hypotheses (add_stripe_hypotheses) refined per scan at most, besides the ranked ones.
+  static constexpr std::size_t kMaxStripeHypotheses = 6;
   /// Most prescores ranked_ holds: with more candidates than this, every prescore is exact.
   static constexpr std::size_t kMaxRanked = 16;
   struct Hypothesis {
