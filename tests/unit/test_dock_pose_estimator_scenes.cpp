@@ -680,11 +680,11 @@ TEST(DockPoseEstimator, ReflectorStripesTellDocksOfOneShapeApart) {
   DOUBLES_EQUAL(0.0, cue(q, EvidenceCue::kIntensity), 0.0);
 }
 
-// A reflector dock's bright runs give hypotheses of their own, refined whatever their prescore: the run's line fixes
-// the face's direction and its centre the stripes' place along it. Here a nearer untaped dock of the same shape
-// takes the one ranked slot (max_candidates 1) and is refused for its missing stripes; the coded dock farther away
-// is still found, from its stripes, at its pose. Without usable intensity no stripe is seen and the same search
-// takes the nearer dock, as the outline cannot tell them apart.
+// With stripe_hypotheses, a reflector dock's bright runs give hypotheses of their own, refined whatever their
+// prescore: the run's line fixes the face's direction and its centre the stripes' place along it. Here a nearer
+// untaped dock of the same shape takes the one ranked slot (max_candidates 1) and is refused for its missing
+// stripes; the coded dock farther away is still found, from its stripes, at its pose, and only so. Without usable
+// intensity no stripe is seen and the same search takes the nearer dock, as the outline cannot tell them apart.
 TEST(DockPoseEstimator, StripesGiveTheirOwnHypotheses) {
   const DockProfile code = coded_plate({{0.0, 0.10}, {0.20, 0.30}});
   const DockProfile plain = profile("plate-v");
@@ -693,11 +693,16 @@ TEST(DockPoseEstimator, StripesGiveTheirOwnHypotheses) {
   twin.add_dock(plain, twin_pose);
   EstimatorParams one;
   one.max_candidates = 1;
-  int found = 0, n = 0;
+  EstimatorParams off = one;
+  one.stripe_hypotheses = true;
+  int found = 0, found_off = 0, n = 0;
   for (std::uint64_t seed = 1; seed <= 4; ++seed) {
     for (double bearing_deg : {5.0, 20.0}) {
       const Truth t = simulate(code, 1.4, deg_to_rad(bearing_deg), deg_to_rad(-10.0), ld06(0.005), seed, 0, &twin);
       ++n;
+      g_est.configure(code, off);
+      g_est.set_intensity_usable(true);
+      found_off += g_est.estimate(g_scan.view(), Pose2{}).found ? 1 : 0;
       g_est.configure(code, one);
       g_est.set_intensity_usable(true);
       const DockEstimate e = g_est.estimate(g_scan.view(), Pose2{});
@@ -712,4 +717,5 @@ TEST(DockPoseEstimator, StripesGiveTheirOwnHypotheses) {
     }
   }
   CHECK_EQUAL(n, found);
+  CHECK_EQUAL(0, found_off);
 }

@@ -73,17 +73,19 @@ docksim::WorldGenParams reflector_params(int profiles) {
   return p;
 }
 
-dockcore::EstimatorParams params_for(const docksim::GenScene& s) {
-  return dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0)));
+dockcore::EstimatorParams params_for(const docksim::GenScene& s, bool stripe_hypotheses = false) {
+  dockcore::EstimatorParams p = dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0)));
+  p.stripe_hypotheses = stripe_hypotheses;
+  return p;
 }
 
 /// Estimator c (c < cases) told the scene's profile with its stripes and its mounting; intensity usable for case 0.
-void configure(Worker& w, const docksim::GenScene& s, int cases) {
+void configure(Worker& w, const docksim::GenScene& s, int cases, bool stripe_hypotheses) {
   dockcore::DockProfile p = s.profile;
   p.mounting = s.told_mounting;
   for (int c = 0; c < cases; ++c) {
     dockcore::DockPoseEstimator& e = *w.est[static_cast<std::size_t>(c)];
-    e.configure(p, params_for(s));
+    e.configure(p, params_for(s, stripe_hypotheses));
     e.set_intensity_usable(c == 0);
   }
 }
@@ -159,7 +161,8 @@ std::string object_at(const docksim::GenScene& s, const Pose2& dock_in_world) {
   return "walls or nothing";
 }
 
-DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w, int cases, std::uint64_t stream) {
+DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w, int cases, std::uint64_t stream,
+                    bool stripe_hypotheses) {
   const docksim::GenScene s = g.draw(i, true, docksim::ScenePath::kSingle);
   DockRecord r;
   r.range_bin = edge_bin(s.distance_m, kRangeEdges, kRangeBins);
@@ -175,7 +178,7 @@ DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
   if (!r.excluded.empty()) return r;
   docksim::Rng rng(scan_seed(g.seed(), stream, i));
   w.simulate(s, 0, rng, 0);
-  configure(w, s, cases);
+  configure(w, s, cases, stripe_hypotheses);
   const Pose2 truth_sensor = s.dock_in_sensor(0), mount_inv = s.lidar_mount.inverse();
   for (int c = 0; c < cases; ++c) {
     const dockcore::DockEstimate e = w.est[static_cast<std::size_t>(c)]->estimate(w.scan->view(), s.lidar_mount);
@@ -185,7 +188,7 @@ DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
   return r;
 }
 
-FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w) {
+FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w, bool stripe_hypotheses) {
   const docksim::GenScene s = g.draw(i, false, docksim::ScenePath::kConfirm);
   FreeRecord r;
   r.index = i;
@@ -193,7 +196,7 @@ FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
   for (const docksim::ReflectiveClass k : s.reflective) r.reflective |= 1u << static_cast<unsigned>(k);
   r.excluded = excluded_why(s, 0);
   if (!r.excluded.empty()) return r;
-  configure(w, s, kCases);
+  configure(w, s, kCases, stripe_hypotheses);
   docksim::Rng rng(scan_seed(g.seed(), kFreeStream, i));
   const Pose2 mount_inv = s.lidar_mount.inverse();
   Confirmation conf[kCases];
@@ -289,8 +292,9 @@ json run_read_range(const ReflectorOptions& o) {
       std::vector<DockRecord> docks(static_cast<std::size_t>(o.read_range_scenes));
       char label[64];
       std::snprintf(label, sizeof label, "read range %s %.1f cm", lidar, 100 * region_m);
-      run_scenes(docks.size(), o.jobs, 1, label,
-                 [&](std::size_t i, Worker& w) { docks[i] = run_dock(gen, i, w, 1, kReadStream); });
+      run_scenes(docks.size(), o.jobs, 1, label, [&](std::size_t i, Worker& w) {
+        docks[i] = run_dock(gen, i, w, 1, kReadStream, o.stripe_hypotheses);
+      });
       json bins = json::array();
       json farthest = nullptr;
       for (int b = 0; b < kRangeBins; ++b) {
@@ -326,9 +330,9 @@ json run_reflectors(const ReflectorOptions& o) {
   std::vector<FreeRecord> frees(n_free);
   run_scenes(n_dock + n_free, o.jobs, kCases, "reflector worlds", [&](std::size_t i, Worker& w) {
     if (i < n_dock) {
-      docks[i] = run_dock(gen, i, w, kCases, kDockStream);
+      docks[i] = run_dock(gen, i, w, kCases, kDockStream, o.stripe_hypotheses);
     } else {
-      frees[i - n_dock] = run_free(gen, i - n_dock, w);
+      frees[i - n_dock] = run_free(gen, i - n_dock, w, o.stripe_hypotheses);
     }
   });
 
@@ -340,6 +344,7 @@ json run_reflectors(const ReflectorOptions& o) {
                    {"random_profiles", o.profiles},
                    {"lidar", "ld06"},
                    {"mounting", "told"},
+                   {"stripe_hypotheses", o.stripe_hypotheses},
                    {"envelope", {{"distance_m", kEnvDistanceM}, {"bearing_deg", 45}, {"dock_yaw_deg", 30}}},
                    {"correct_within", {{"pos_m", kCorrectPosM}, {"yaw_deg", 10}}},
                    {"confirm_within", {{"pos_m", kAgreePosM}, {"yaw_deg", 5}}}};
@@ -528,6 +533,7 @@ void print_reflectors(const json& j) {
       "\n== Reflector docks (seed %llu): %d docking scenes, %d dock-less scenes x %d scans, %d random profiles, LD06\n",
       static_cast<unsigned long long>(cfg["seed"].get<std::uint64_t>()), cfg["docking_scenes"].get<int>(),
       cfg["dockless_scenes"].get<int>(), cfg["dockless_scans_per_scene"].get<int>(), cfg["random_profiles"].get<int>());
+  if (cfg.value("stripe_hypotheses", false)) std::printf("[estimator] stripe_hypotheses = true\n");
   std::printf(
       "intensity = stripes read (set_intensity_usable(true)); geometry = the same scans, intensity not usable. The\n"
       "profile's mounting is told. det = found within 0.10 m / 10° of the truth (sensor frame) in the envelope\n"

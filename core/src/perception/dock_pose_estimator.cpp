@@ -1449,7 +1449,8 @@ std::size_t DockPoseEstimatorBase::generate_candidates() {
     }
   }
   if (n > keep) counters_.truncated_candidates += static_cast<std::uint32_t>(n - keep);
-  const bool stripes = profile_.reflector_count > 0 && intensity_usable_ && intensities_ != nullptr;
+  const bool stripes =
+      params_.stripe_hypotheses && profile_.reflector_count > 0 && intensity_usable_ && intensities_ != nullptr;
   return keep + (stripes ? add_stripe_hypotheses(keep) : 0);
 }
 

@@ -199,6 +199,10 @@ const ParamSpec kTable[] = {
     DC_REAL("estimator", "reflector_min_intensity", "sensor units", 0, 65535, kBoth, estimator, reflector_min_intensity,
             "A return at least this bright counts as reflector tape (intensity cue; docks with `[[reflectors]]` on a "
             "lidar whose intensity is usable). LD06: 0–255."),
+    DC_BOOL("estimator", "stripe_hypotheses", kBoth, estimator, stripe_hypotheses,
+            "Docks with `[[reflectors]]` on a lidar whose intensity is usable: the search also tries the scan's bright "
+            "runs as the dock's stripes. Finds more coded docks, and takes more taped things for them "
+            "([performance.md](performance.md#reflector-docks))."),
     DC_REAL("estimator", "wall_tolerance_m", "m", 0, 0.2, kBoth, estimator, wall_tolerance_m,
             "How far outside the mounting's gap range a wall still counts as the dock's wall."),
     DC_REAL("estimator", "max_sigma_m", "m", 0.001, 1, kBoth, estimator, max_sigma_m,

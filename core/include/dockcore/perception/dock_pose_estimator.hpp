@@ -7,8 +7,8 @@
 ///     Otherwise (or when the hint fails) line segments of the scan are matched to the profile's long segments: each
 ///     pairing of a scan segment with a profile segment of similar length, facing the lidar, gives up to three pose
 ///     hypotheses (centres aligned, or either end aligned for a partly hidden segment). A dock with reflector stripes,
-///     on a lidar whose intensity is usable, also gets hypotheses from the scan's bright runs, refined whatever their
-///     prescore (at most kMaxStripeHypotheses).
+///     on a lidar whose intensity is usable, can also get hypotheses from the scan's bright runs, refined whatever
+///     their prescore (stripe_hypotheses; at most kMaxStripeHypotheses).
 ///  2. Registration. Point-to-segment Gauss-Newton on (x, y, yaw) with Huber then Tukey weights, over the beams inside
 ///  the dock's
 ///     angular span (plus a margin), associating each point with the nearest visible profile segment.
@@ -187,6 +187,11 @@ struct EstimatorParams {
   /// A return at least this bright (the lidar's own units: LD06 0–255) counts as retro-reflective tape for the
   /// intensity cue. Only used for profiles with reflectors.
   Real reflector_min_intensity = static_cast<Real>(235);
+  /// A dock with reflector stripes, on a lidar whose intensity is usable: the global search also tries the scan's
+  /// bright runs as the stripes (add_stripe_hypotheses), whatever their outline's rank. Finds more coded docks (their
+  /// outline outranked by a nearer look-alike or a flat wall) and tries more taped things for them: more false
+  /// docks and wrong ids (docs/performance.md, "Reflector docks").
+  bool stripe_hypotheses = false;
 };
 
 /// Parameters for a lidar whose 1-σ range noise is `range_sigma_m`: the noise-dependent gates (inlier gate 3σ,
