@@ -1294,6 +1294,12 @@ struct RunningMoments {
 
 }  // namespace
 
+bool DockPoseEstimatorBase::depth_gap(const ScanPoint& a, const ScanPoint& b) const {
+  const Real step_m = 5 * a.range_m * angle_inc_rad_;
+  const Real allowed = step_m > R(0.05) ? step_m : R(0.05);
+  return (b.p_m - a.p_m).squaredNorm() > allowed * allowed;
+}
+
 void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
   // Split the points into contiguous runs (no range gap), in circular order on a full-turn scan.
   const std::size_t np = points_.size();
@@ -1304,8 +1310,7 @@ void DockPoseEstimatorBase::add_window_hypotheses(std::size_t* n) {
   for (std::size_t k = 0; k < np; ++k) {
     const ScanPoint& a = points_[k];
     const ScanPoint& b = points_[(k + 1) % np];
-    const Real allowed = 5 * a.range_m * angle_inc_rad_ > R(0.05) ? 5 * a.range_m * angle_inc_rad_ : R(0.05);
-    gap[k] = (b.p_m - a.p_m).squaredNorm() > allowed * allowed ? 1 : 0;
+    gap[k] = depth_gap(a, b) ? 1 : 0;
   }
   auto gap_after = [gap](std::size_t k) { return gap[k] != 0; };
   // Start just after a gap so no run is cut by the array's end (only matters when the scan wraps).
@@ -1465,14 +1470,9 @@ std::size_t DockPoseEstimatorBase::add_stripe_hypotheses(std::size_t at) {
       ++k;
       continue;
     }
-    // The run: consecutive bright returns without a depth gap (the gap test of the window hypotheses).
+    // The run: consecutive bright returns without a depth gap.
     std::size_t last = k;
-    while (last + 1 < np && bright(last + 1)) {
-      const Real step_m = 5 * points_[last].range_m * angle_inc_rad_;
-      const Real allowed = step_m > R(0.05) ? step_m : R(0.05);
-      if ((points_[last + 1].p_m - points_[last].p_m).squaredNorm() > allowed * allowed) break;
-      ++last;
-    }
+    while (last + 1 < np && bright(last + 1) && !depth_gap(points_[last], points_[last + 1])) ++last;
     const Vec2 centre = (points_[k].p_m + points_[last].p_m) * R(0.5);
     // What the run lights: its span and a beam's spacing either side (the tape's ends lie between beams).
     const Real lit_m = (points_[last].p_m - points_[k].p_m).norm() + 2 * centre.norm() * angle_inc_rad_;

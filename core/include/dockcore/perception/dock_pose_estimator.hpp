@@ -374,6 +374,9 @@ class DockPoseEstimatorBase {
   /// face's direction: the stripes pin a flat face along itself where its outline does not. At most
   /// kMaxStripeHypotheses; returns how many. O(points + runs · (line segments + stripes)).
   std::size_t add_stripe_hypotheses(std::size_t at);
+  /// Whether consecutive points a, b lie apart by more than five beam spacings at a's range (at least 5 cm): one
+  /// surface does not continue across that. O(1).
+  bool depth_gap(const ScanPoint& a, const ScanPoint& b) const;
   /// Hypotheses from windows of each long profile segment's length slid along contiguous runs of points: a window
   /// that is flat to the noise level, spans the segment's length and ends (a bend or a gap) on one side at least.
   /// Robust where split-and-merge merges a short wing into the face. O(points · long profile segments).
