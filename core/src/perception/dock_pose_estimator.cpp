@@ -744,19 +744,17 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
   // Closes the open run; `dark_end`: at a dark beam `dark_end_m` along the segment. O(stripes).
   auto close_run = [&](bool dark_end, Real dark_end_m) {
     if (long_run_open && seg_taped_[long_run_seg]) {
-      // Stripes meeting end to end are one piece.
       Real longest_m = 0;
       Real under_m = 0;
-      Real piece_from_m = 0;
-      Real piece_to_m = -1;
-      for (std::size_t q = 0; q < profile_.reflector_count; ++q) {
+      for (std::size_t q = 0; q < profile_.reflector_count;) {
+        Real to_m = 0;
+        const std::size_t next = tape_piece(q, &to_m);
         const ReflectorStripe& st = profile_.reflectors[q];
+        q = next;
         if (st.segment != long_run_seg) continue;
-        if (st.from_m > piece_to_m + kStripeEdgeMarginM) piece_from_m = st.from_m;
-        piece_to_m = st.to_m;
-        const Real piece_m = piece_to_m - piece_from_m;
+        const Real piece_m = to_m - st.from_m;
         longest_m = piece_m > longest_m ? piece_m : longest_m;
-        if (long_run_mid >= piece_from_m && long_run_mid <= piece_to_m) under_m = piece_m;
+        if (long_run_mid >= st.from_m && long_run_mid <= to_m) under_m = piece_m;
       }
       if (long_run_hi - long_run_lo > longest_m) run_misfit = true;
       if (run_bounded && dark_end && std::fabs(dark_end_m - run_dark_m) + 2 * kStripeEdgeMarginM < under_m) {
@@ -871,13 +869,10 @@ void DockPoseEstimatorBase::verify(Refined& r, const Pose2* hint) {
           // A dark beam well inside a piece of this code's tape is left to the stripe's own tally (which forgives a
           // quarter of its beams): it neither ends nor bounds a run.
           bool dark_inside = false;
-          for (std::size_t q = 0; q < profile_.reflector_count && !bright && !dark_inside; ++q) {
+          for (std::size_t q = 0; q < profile_.reflector_count && !bright && !dark_inside;) {
             const ReflectorStripe& st = profile_.reflectors[q];
-            Real to_m = st.to_m;
-            while (q + 1 < profile_.reflector_count && profile_.reflectors[q + 1].segment == st.segment &&
-                   profile_.reflectors[q + 1].from_m <= to_m + kStripeEdgeMarginM) {
-              to_m = profile_.reflectors[++q].to_m;
-            }
+            Real to_m = 0;
+            q = tape_piece(q, &to_m);
             dark_inside = st.segment == seg && s >= st.from_m + edge_m && s <= to_m - edge_m;
           }
           if (seg != long_run_seg) {
@@ -1294,6 +1289,18 @@ struct RunningMoments {
 
 }  // namespace
 
+std::size_t DockPoseEstimatorBase::tape_piece(std::size_t q, Real* to_m) const {
+  const ReflectorStripe& first = profile_.reflectors[q];
+  Real end_m = first.to_m;
+  std::size_t next = q + 1;
+  while (next < profile_.reflector_count && profile_.reflectors[next].segment == first.segment &&
+         profile_.reflectors[next].from_m <= end_m + kStripeEdgeMarginM) {
+    end_m = profile_.reflectors[next++].to_m;
+  }
+  *to_m = end_m;
+  return next;
+}
+
 bool DockPoseEstimatorBase::depth_gap(const ScanPoint& a, const ScanPoint& b) const {
   const Real step_m = 5 * a.range_m * angle_inc_rad_;
   const Real allowed = step_m > R(0.05) ? step_m : R(0.05);
@@ -1489,20 +1496,15 @@ std::size_t DockPoseEstimatorBase::add_stripe_hypotheses(std::size_t at) {
     }
     if (line == nullptr) continue;
     const Vec2 on_line = centre - line->normal * line->signed_distance_m(centre);
-    // Groups of touching stripes (adjacent taped regions read as one run).
+    // Each piece of tape (touching stripes read as one run).
     std::size_t q = 0;
     while (q < profile_.reflector_count && added < kMaxStripeHypotheses && at + added < kMaxHypotheses) {
       const ReflectorStripe& first = profile_.reflectors[q];
-      Real to_m = first.to_m;
-      std::size_t end = q + 1;
-      while (end < profile_.reflector_count && profile_.reflectors[end].segment == first.segment &&
-             profile_.reflectors[end].from_m <= to_m + kStripeEdgeMarginM) {
-        to_m = profile_.reflectors[end].to_m;
-        ++end;
-      }
-      const Real group_m = to_m - first.from_m;
-      // A run much longer than the group lies on something else (another code's wider stripe, a taped sign).
-      if (lit_m - 2 * gate <= group_m + 2 * kStripeEdgeMarginM) {
+      Real to_m = 0;
+      const std::size_t end = tape_piece(q, &to_m);
+      const Real piece_m = to_m - first.from_m;
+      // A run much longer than the piece lies on something else (another code's wider stripe, a taped sign).
+      if (lit_m - 2 * gate <= piece_m + 2 * kStripeEdgeMarginM) {
         const std::size_t seg = first.segment;
         const Vec2& a = profile_.vertices_m[seg];
         const Vec2 d = profile_.vertices_m[seg + 1] - a;

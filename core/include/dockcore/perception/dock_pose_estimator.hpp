@@ -9,9 +9,9 @@
 ///     hypotheses (centres aligned, or either end aligned for a partly hidden segment). A dock with reflector stripes,
 ///     on a lidar whose intensity is usable, can also get hypotheses from the scan's bright runs, refined whatever
 ///     their prescore (stripe_hypotheses; at most kMaxStripeHypotheses).
-///  2. Registration. Point-to-segment Gauss-Newton on (x, y, yaw) with Huber then Tukey weights, over the beams inside
-///  the dock's
-///     angular span (plus a margin), associating each point with the nearest visible profile segment.
+///  2. Registration. Point-to-segment Gauss-Newton on (x, y, yaw) with Huber then Tukey weights, over the beams
+///     inside the dock's angular span (plus a margin), associating each point with the nearest visible profile
+///     segment.
 ///  3. Decision. The expected scan of the profile at the refined pose is compared beam by beam with the measured one,
 ///     and each candidate gets a log-likelihood ratio (nats): how much better "this dock at this pose" explains the
 ///     beams than "no dock here". It is a sum of cues (EvidenceCue), each reported: the fit of the beams that land on
@@ -370,10 +370,14 @@ class DockPoseEstimatorBase {
                         std::size_t profile_segment) const;
   /// Reflector docks with usable intensity: hypotheses from the scan's bright runs, written to hyps_ from index `at`
   /// (past the ranked ones, so they are refined whatever their prescore). A run on a scan line segment puts the
-  /// centre of each group of touching stripes no shorter than the run at the run's centre, the line giving the
+  /// centre of each piece of tape (tape_piece) no shorter than the run at the run's centre, the line giving the
   /// face's direction: the stripes pin a flat face along itself where its outline does not. At most
   /// kMaxStripeHypotheses; returns how many. O(points + runs · (line segments + stripes)).
   std::size_t add_stripe_hypotheses(std::size_t at);
+  /// The piece of tape that starts at stripe q (q < reflector_count): the stripes meeting it end to end (within
+  /// kStripeEdgeMarginM) on its segment. Writes the piece's end along the segment to *to_m; returns the index past its
+  /// last stripe. O(stripes in the piece).
+  std::size_t tape_piece(std::size_t q, Real* to_m) const;
   /// Whether consecutive points a, b lie apart by more than five beam spacings at a's range (at least 5 cm): one
   /// surface does not continue across that. O(1).
   bool depth_gap(const ScanPoint& a, const ScanPoint& b) const;
