@@ -114,10 +114,9 @@ TEST(DockPoseEstimator, CovarianceAboveTheLimitIsRefusedAsUncertain) {
 
 TEST(DockPoseEstimator, ADocksOwnFloorOnInliersReplacesTheParameters) {
   // The same plate-v scan (noise-free, 1 m ahead): found with the parameters' floor; a profile stating a floor one
-  // above the inliers it gets is refused for too few inliers, whatever the parameters say. The small built-ins
-  // bring 6.
+  // above the inliers it gets is refused for too few inliers, whatever the parameters say. The built-ins bring 6.
   DockProfile prof = profile("plate-v");
-  CHECK_EQUAL(0, prof.min_inliers);
+  CHECK_EQUAL(6, prof.min_inliers);
   CHECK_EQUAL(6, profile("v-marker").min_inliers);
   CHECK_EQUAL(6, profile("breakpoint").min_inliers);
   cast_dock(prof, dockcore_test::pose(1.0, 0.05, kPi - 0.1), 450, -kPi);

@@ -481,17 +481,20 @@ json run_reflectors(const ReflectorOptions& o) {
       // Intensity case: the dock-less scenes with a scan accepted at the look-alike, to re-generate them (geometry
       // alone takes most; for it the list stays empty).
       json scenes = json::array();
+      json confirmed = json::array();  // of which confirmed over three scans at the look-alike
       for (const auto& r : frees) {
         if (!r.excluded.empty()) continue;
         const auto la = static_cast<docksim::LookAlike>(r.look_alike);
         if (la != docksim::LookAlike::kOtherCode && la != docksim::LookAlike::kUntaped) continue;
         cell.add(r, c);
         if (c == 0 && r.at_look[c] > 0) scenes.push_back(r.index);
+        if (c == 0 && r.confirmed_at_look[c]) confirmed.push_back(r.index);
       }
       const json j = cell.to_json();
       cw[kCaseNames[c]] = {{"per_scan", j["at_look_alike_per_scan"]},
                            {"per_confirmation", j["at_look_alike_per_confirmation"]},
-                           {"scene_indices", scenes}};
+                           {"scene_indices", scenes},
+                           {"confirmed_scene_indices", confirmed}};
     }
     out["confident_wrong_id"] = cw;
   }
@@ -593,11 +596,14 @@ void print_reflectors(const json& j) {
     std::printf("%-9s per scan %s (ub95 %s), per confirmation %s (ub95 %s)\n", kCaseNames[c],
                 hits_of(x["per_scan"]).c_str(), upper_of(x["per_scan"]).c_str(), hits_of(x["per_confirmation"]).c_str(),
                 upper_of(x["per_confirmation"]).c_str());
-    if (!x["scene_indices"].empty()) {
+    auto print_indices = [&x](const char* key, const char* what) {
+      if (x[key].empty()) return;
       std::string idx;
-      for (const json& i : x["scene_indices"]) idx += (idx.empty() ? "" : " ") + std::to_string(i.get<std::uint64_t>());
-      std::printf("%-9s dock-less scenes (index): %s\n", "", idx.c_str());
-    }
+      for (const json& i : x[key]) idx += (idx.empty() ? "" : " ") + std::to_string(i.get<std::uint64_t>());
+      std::printf("%-9s %s: %s\n", "", what, idx.c_str());
+    };
+    print_indices("scene_indices", "dock-less scenes (index)");
+    print_indices("confirmed_scene_indices", "of which confirmed");
   }
 
   const std::vector<Column> fc = {{"", 12, false},

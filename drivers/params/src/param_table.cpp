@@ -187,7 +187,7 @@ const ParamSpec kTable[] = {
             "Returns this close in front of the expected surface count against the dock (free-space cue: the space "
             "before a dock is empty), not as occlusion."),
     DC_INT("estimator", "min_inliers", "–", 1, 1000, kBoth, estimator, min_inliers,
-           "Inliers, at least; the built-in v-marker and breakpoint docks bring their own floor of 6."),
+           "Inliers, at least; the built-in docks (plate-v, v-marker, breakpoint) bring their own floor of 6."),
     DC_REAL("estimator", "min_visible_fraction", "–", 0, 1, kBoth, estimator, min_visible_fraction,
             "Inliers / all beams expected on the dock, at least (how much may be hidden)."),
     DC_REAL("estimator", "extension_band_m", "m", 0.001, 0.5, kBoth, estimator, extension_band_m,

@@ -84,7 +84,7 @@ enum class EvidenceCue : std::uint8_t {
   kSeeThrough,  ///< Beams that pass where the dock should stop them, or return nothing there.
   kFreeSpace,   ///< Surfaces just in front of the dock (free_space_m), where an approaching robot would be.
   kSupport,     ///< Long dock surfaces with too few of their beams (a surface of the dock that is not there).
-  kEdges,       ///< Beams just past the dock's ends: a surface carrying on in line (against) or stopping (for).
+  kEdges,       ///< Returns just past the dock's ends: a surface carrying on in line, or something right beside it.
   kWall,        ///< Beams past the ends meeting the wall where the mounting puts it (for), or not (against).
   kGeometry,    ///< How well the visible part of the dock fixes all three pose components (a flat face alone cannot).
   kPrior,       ///< Closeness to the pose hint when hint_radius_m is set (dock database, staging pose).
@@ -111,7 +111,7 @@ struct DecisionFeatures {
   Real front = 0;        ///< Weighted dock beams returning within free_space_m in front of it.
   Real missing = 0;      ///< Long dock surfaces (>= 3 expected beams) with fewer than half their beams on them.
   Real continues = 0;    ///< Weighted returns 4-12 cm past a long surface's end, on its line.
-  Real stops = 0;        ///< Weighted returns there off its line (not scored: free-standing clutter stops too).
+  Real stops = 0;        ///< Weighted returns there off its line but within 12 cm of it (beside the dock's end).
   Real wall_seen = 0;    ///< Weighted beams past the dock's ends meeting the mounting's wall.
   Real wall_missed = 0;  ///< Weighted beams past the ends that could have, and did not.
   /// Smallest eigenvalue of the fit's information matrix (yaw scaled by the dock's radius), weighted: the number of
@@ -173,7 +173,7 @@ struct EstimatorParams {
   Real extension_band_m = static_cast<Real>(0.02);
   /// Accept a candidate when its evidence (sum of the cues' log-likelihood ratios) reaches this, nats. Higher: fewer
   /// false detections, more misses of partly seen docks. docs/performance.md gives the rates per setting.
-  Real min_evidence_nats = static_cast<Real>(3.8);
+  Real min_evidence_nats = static_cast<Real>(3.4);
   Real max_sigma_m = static_cast<Real>(0.05);     ///< Reject when the position 1-σ (covariance) exceeds this.
   Real max_view_angle_rad = static_cast<Real>(1.2);     ///< Dock face seen more obliquely than this is rejected.
   Real hint_gate_m = static_cast<Real>(0.3);      ///< A verified pose farther than this from the hint ignores it.
@@ -395,7 +395,7 @@ class DockPoseEstimatorBase {
   void wall_behind(const Pose2& pose, long first, std::size_t k_first_hit, std::size_t k_last_hit,
                    std::uint16_t* seen, std::uint16_t* looked) const;
   /// For a return p: 0 when it is not 4-12 cm past the end of a long visible segment of placed_ (or lies on the
-  /// dock), 1 when it is but off that segment's line, 2 when it continues the segment's line. [box_lo, box_hi]:
+  /// dock), 1 when it is off that segment's line by at most 12 cm, 2 when it continues the line. [box_lo, box_hi]:
   /// placed_'s bounding box grown by the inlier gate (p outside it is off the dock).
   int continues_past_end(const Vec2& p, const Vec2& box_lo, const Vec2& box_hi) const;
 
