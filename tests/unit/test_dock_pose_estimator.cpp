@@ -142,6 +142,51 @@ TEST(DockPoseEstimator, ADocksOwnFloorOnInliersReplacesTheParameters) {
   CHECK_TRUE(g_est.estimate(g_scan.view(), Pose2{}).found);
 }
 
+namespace {
+
+// Puts a return at the dock-frame point (x_m, y_m) of `dock` on the beam of g_scan nearest its bearing (0.8° beams
+// from -π, as cast_dock lays them). Returns the beam's index.
+std::size_t put_return(const Pose2& dock, Real x_m, Real y_m) {
+  const Vec2 p = dock.transform(Vec2(x_m, y_m));
+  const Real a = std::atan2(p.y(), p.x());
+  const auto i = static_cast<std::size_t>(std::lround((a + kPi) / deg_to_rad(0.8)));
+  g_scan.ranges_m[i] = p.norm();
+  return i;
+}
+
+}  // namespace
+
+TEST(DockPoseEstimator, AReturnRightBesideTheDocksEndCountsAgainstIt) {
+  // A noise-free plate-v 1 m ahead, tracked from its own pose: nothing past its ends, no edges cue. Something right
+  // beside the end of its face (5 cm in front of the face's line, 7-9 cm past its end) counts against the dock
+  // (`stops`, the edges cue); the same thing 30 cm in front of the line is the room, and counts for nothing.
+  const DockProfile prof = profile("plate-v");
+  const Pose2 dock = dockcore_test::pose(1.0, 0.0, kPi);
+  g_est.configure(prof, EstimatorParams{});
+  cast_dock(prof, dock, 450, -kPi);
+  const DockEstimate clean = g_est.estimate(g_scan.view(), Pose2{}, &dock);
+  check_found_at(clean, dock);
+  DOUBLES_EQUAL(0.0, clean.evidence.features.stops, 1e-9);
+  const std::size_t edges = static_cast<std::size_t>(EvidenceCue::kEdges);
+  DOUBLES_EQUAL(0.0, clean.evidence.cue_nats[edges], 1e-9);
+
+  // Two beams' worth: at 1 m a beam covers 1.4 cm, so it stands for under a third of the 5 cm correlation length.
+  CHECK_TRUE(put_return(dock, static_cast<Real>(0.05), static_cast<Real>(0.215)) !=
+             put_return(dock, static_cast<Real>(0.05), static_cast<Real>(0.235)));
+  const DockEstimate beside = g_est.estimate(g_scan.view(), Pose2{}, &dock);
+  CHECK_TRUE(beside.evidence.features.stops > 0);
+  CHECK_TRUE(beside.evidence.cue_nats[edges] < -1);
+  CHECK_TRUE(beside.evidence.total_nats < clean.evidence.total_nats - 1);
+
+  cast_dock(prof, dock, 450, -kPi);
+  put_return(dock, static_cast<Real>(0.30), static_cast<Real>(0.215));
+  put_return(dock, static_cast<Real>(0.30), static_cast<Real>(0.235));
+  const DockEstimate room = g_est.estimate(g_scan.view(), Pose2{}, &dock);
+  check_found_at(room, dock);
+  DOUBLES_EQUAL(0.0, room.evidence.features.stops, 1e-9);
+  DOUBLES_EQUAL(clean.evidence.total_nats, room.evidence.total_nats, 1e-9);
+}
+
 TEST(DockPoseEstimator, GlobalSearchFindsADockAcrossTheWrapOfAFullTurn) {
   // Behind the lidar: the dock's beams are the scan's last and first, and registration's span runs across the wrap.
   const DockProfile prof = profile("plate-v");
