@@ -414,11 +414,11 @@ int DockPoseEstimatorBase::continues_past_end(const Vec2& p, const Vec2& box_lo,
     const Real u = (p - placed_.v_m[j]).dot(placed_.u[j]);
     const Real overhang = u < 0 ? -u : u - len;
     if (overhang < kExtensionMinM || overhang > kExtensionMaxM) continue;
-    const Real off_m = placed_.n[j].dot(p) - placed_.c_m[j];
-    if (std::fabs(off_m) <= params_.extension_band_m) return 2;
+    const Real off_m = std::fabs(placed_.n[j].dot(p) - placed_.c_m[j]);
+    if (off_m <= params_.extension_band_m) return 2;
     // Something right beside the dock's end, off its line (a look-alike's own next surface turning away, or clutter
     // at its side). Farther off the line it is a room behind or in front, which a free-standing dock has as well.
-    if (std::fabs(off_m) <= kExtensionMaxM) result = 1;
+    if (off_m <= kExtensionMaxM) result = 1;
   }
   return result;
 }

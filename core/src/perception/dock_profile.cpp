@@ -6,7 +6,7 @@ namespace dockcore {
 namespace {
 
 // The built-in docks' floor on inliers: with it their false docks on the real dock-less scans stay within 1 %
-// (plate-v 0.85 %, v-marker 0.24 %, breakpoint 0.65 %), and a coarse lidar still finds them from 2.5 m.
+// (plate-v 0.86 %, v-marker 0.24 %, breakpoint 0.65 %), and a coarse lidar still finds them from 2.5 m.
 constexpr std::uint16_t kBuiltinMinInliers = 6;
 
 bool same_name(const char* a, const char* b) {
@@ -140,7 +140,10 @@ ProfileError add_reflector(DockProfile& profile, const ReflectorStripe& stripe) 
 
 const char* const kBuiltinProfileNames[] = {"breakpoint", "v-marker", "plate-v", nullptr};
 
-ProfileError builtin_profile(const char* name, DockProfile& out) {
+namespace {
+
+// The outline of built-in `name` into `out` (make_profile's result), or kUnknownName.
+ProfileError builtin_outline(const char* name, DockProfile& out) {
   if (name == nullptr) return ProfileError::kUnknownName;
   if (same_name(name, "breakpoint")) {
     // Seed 000's feature dock: raised face (x = 0) with two 0.06 m deep, 0.03 m wide slots; 0.02 m end blocks.
@@ -158,27 +161,29 @@ ProfileError builtin_profile(const char* name, DockProfile& out) {
                       Vec2(0, to_real(0.13)),
                       Vec2(0, to_real(0.15)),
                       Vec2(to_real(-0.10), to_real(0.15))};
-    const ProfileError e = make_profile(v, sizeof(v) / sizeof(v[0]), 0, "breakpoint", out);
-    if (e == ProfileError::kOk) out.min_inliers = kBuiltinMinInliers;
-    return e;
+    return make_profile(v, sizeof(v) / sizeof(v[0]), 0, "breakpoint", out);
   }
   if (same_name(name, "v-marker")) {
     // Seed 004's triangle label: a 0.30 m wide mouth with a 90° notch, apex 0.15 m behind the mouth line.
     const Vec2 v[] = {Vec2(0, to_real(-0.15)), Vec2(to_real(-0.15), 0), Vec2(0, to_real(0.15))};
-    const ProfileError e = make_profile(v, 3, 0, "v-marker", out);
-    if (e == ProfileError::kOk) out.min_inliers = kBuiltinMinInliers;
-    return e;
+    return make_profile(v, 3, 0, "v-marker", out);
   }
   if (same_name(name, "plate-v")) {
     // 0.30 m flat face, 0.10 m wings swept back at 45° (the common open-source lidar dock).
     const Real w = to_real(0.10 * 0.70710678118654752);
     const Vec2 v[] = {Vec2(-w, to_real(-0.15) - w), Vec2(0, to_real(-0.15)), Vec2(0, to_real(0.15)),
                       Vec2(-w, to_real(0.15) + w)};
-    const ProfileError e = make_profile(v, 4, 0, "plate-v", out);
-    if (e == ProfileError::kOk) out.min_inliers = kBuiltinMinInliers;
-    return e;
+    return make_profile(v, 4, 0, "plate-v", out);
   }
   return ProfileError::kUnknownName;
+}
+
+}  // namespace
+
+ProfileError builtin_profile(const char* name, DockProfile& out) {
+  const ProfileError e = builtin_outline(name, out);
+  if (e == ProfileError::kOk) out.min_inliers = kBuiltinMinInliers;
+  return e;
 }
 
 }  // namespace dockcore
