@@ -238,36 +238,25 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
              kSceneGateM ||
          std::fabs(wrap_angle(detected_in_odom.yaw_rad - expected_in_odom.yaw_rad)) > kSceneGateRad);
     if (off_expectation && scene_.reference_points() > 0) {
-      // The push the detection implies, and its shift alone and its turn alone (about the robot): one detection's
-      // yaw at range is noisy enough to blur a pure shove, its position to blur a turn on the spot.
-      const Pose2 full = detected_in_odom.compose(expected_in_odom.inverse());
-      const Pose2 shift{detected_in_odom.x_m - expected_in_odom.x_m, detected_in_odom.y_m - expected_in_odom.y_m, 0};
-      const Pose2 at_robot{odom_pose.x_m, odom_pose.y_m, 0};
-      // A turn on the spot: the room turns about the robot, in the odometry frame.
-      const auto turn_about_robot = [&](Real yaw_rad) {
-        return at_robot.compose(Pose2{0, 0, yaw_rad}).compose(at_robot.inverse());
-      };
-      const Pose2 turn = turn_about_robot(wrap_angle(detected_in_odom.yaw_rad - expected_in_odom.yaw_rad));
+      // The push the detection implies, and the partial readings of it that a noisy detection allows.
+      Pose2 corrections[9];
+      std::size_t readings = push_readings(expected_in_odom, detected_in_odom, odom_pose, config_.scene, corrections);
       if (d.expectation_confirmed) {
-        const Pose2 corrections[] = {full, shift, turn};
-        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, 3, config_.scene);
+        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, readings, config_.scene);
       } else {
         // The implied push rests on one detection, which may be the wrong one. "Still" must then also beat a shove
         // of the push test's size in each direction and a turn either way: a room that could not show such a push
         // (one long wall along it) gives no verdict, and the distance test stands.
         const Real a = config_.task.deviation.push_distance_tolerance_m;
-        const Real q = kSceneProbeTurnRad;
-        const Pose2 corrections[] = {full,
-                                     shift,
-                                     turn,
-                                     Pose2{a, 0, 0},
-                                     Pose2{-a, 0, 0},
-                                     Pose2{0, a, 0},
-                                     Pose2{0, -a, 0},
-                                     turn_about_robot(q),
-                                     turn_about_robot(-q)};
-        // The six probes never make "moved": the room vouches for the one detection only by the push it implies.
-        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, 9, config_.scene, nullptr, 6);
+        const std::size_t pushes = readings;
+        for (const Pose2& probe :
+             {Pose2{a, 0, 0}, Pose2{-a, 0, 0}, Pose2{0, a, 0}, Pose2{0, -a, 0},
+              turn_about(odom_pose, kSceneProbeTurnRad), turn_about(odom_pose, -kSceneProbeTurnRad)}) {
+          corrections[readings++] = probe;
+        }
+        // The probes never make "moved": the room vouches for the one detection only by the push it implies.
+        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, readings, config_.scene, nullptr,
+                               readings - pushes);
       }
     }
     const Pose2 before = filter_.dock_in_odom();

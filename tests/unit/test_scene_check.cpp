@@ -208,3 +208,40 @@ TEST(SceneCheck, StandingStillBeatsEveryProbePushOnlyWhereTheRoomCouldShowOne) {
     }
   }
 }
+
+TEST(SceneCheck, AReadingCountsOnlyWhereTheDetectionAllowsIt) {
+  const SceneCheckParams params;
+  const Pose2 here = pose(1.2, 0.1, kPi);
+  Pose2 out[3];
+  // The box taken for the dock, 0.95 m along the wall, its yaw 1° off: a shove along the wall (with the turn as
+  // noise), never a turn of 1° on the spot, which would leave the box where it was.
+  const Pose2 box = pose(0, 0.95, 1.0 * kPi / 180.0);
+  LONGS_EQUAL(2, static_cast<long>(push_readings(Pose2{}, box, here, params, out)));
+  REAL_EQUAL(0.95, static_cast<double>(out[1].y_m), 1e-6);
+  CHECK(out[1].yaw_rad == 0);
+  // Turned 35° on the spot, the dock seen 10 cm from where the turn puts it (a far fit's position): the turn alone
+  // counts, the shift alone does not (the detection turned by far more than a fit's noise).
+  const Real turn = static_cast<Real>(35.0 * kPi / 180.0);
+  const Pose2 turned = turn_about(here, -turn).compose(Pose2{}).compose(pose(0, 0.1, 0));
+  LONGS_EQUAL(2, static_cast<long>(push_readings(Pose2{}, turned, here, params, out)));
+  REAL_EQUAL(-static_cast<double>(turn), static_cast<double>(out[1].yaw_rad), 1e-6);
+  // A shove with the yaw blurred by 8°: all three (the turn alone lands 0.17 m off at 1.2 m, within the blur).
+  LONGS_EQUAL(3, static_cast<long>(push_readings(Pose2{}, pose(0, -0.4, 8.0 * kPi / 180.0), here, params, out)));
+}
+
+TEST(SceneCheck, TheBoxAlongTheWallIsStillOnlyWithoutATurnItDoesNotAllow) {
+  // The robot was not moved and took the box for the dock. Judged with the readings the detection allows, the room
+  // stands still. A turn of 1° on the spot explains the room about as well as standing still does; offered as a
+  // reading, it ties with "still" and the verdict is lost.
+  const Pose2 here = pose(1.2, 0.1, kPi);
+  const SceneCheckParams params;
+  SceneCheck check;
+  check.set_reference(cast(room(true), kStart).view(), Pose2{}, kStart, params);
+  const LaserScan now = cast(room(true), here);
+  const Pose2 box = pose(0, 0.95, 1.0 * kPi / 180.0);
+  Pose2 readings[4];
+  const std::size_t n = push_readings(Pose2{}, box, here, params, readings);
+  CHECK(check.judge(now.view(), Pose2{}, here, readings, n, params) == SceneVerdict::kStill);
+  readings[n] = turn_about(here, box.yaw_rad);
+  CHECK(check.judge(now.view(), Pose2{}, here, readings, n + 1, params) != SceneVerdict::kStill);
+}

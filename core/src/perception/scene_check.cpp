@@ -4,6 +4,11 @@
 
 namespace dockcore {
 
+namespace {
+// push_readings(): a turn alone must land the expectation this near the detection, plus the range times the blur.
+constexpr Real kReadingGateM = static_cast<Real>(0.05);
+}  // namespace
+
 const char* to_string(SceneVerdict v) {
   switch (v) {
     case SceneVerdict::kStill:
@@ -14,6 +19,29 @@ const char* to_string(SceneVerdict v) {
       break;
   }
   return "unknown";
+}
+
+Pose2 turn_about(const Pose2& robot_in_odom, Real yaw_rad) {
+  const Pose2 at_robot{robot_in_odom.x_m, robot_in_odom.y_m, 0};
+  return at_robot.compose(Pose2{0, 0, yaw_rad}).compose(at_robot.inverse());
+}
+
+std::size_t push_readings(const Pose2& expected_in_odom, const Pose2& detected_in_odom, const Pose2& robot_in_odom,
+                          const SceneCheckParams& params, Pose2 out[3]) {
+  const Vec2 expected_m(expected_in_odom.x_m, expected_in_odom.y_m);
+  const Vec2 detected_m(detected_in_odom.x_m, detected_in_odom.y_m);
+  const Real turn_rad = wrap_angle(detected_in_odom.yaw_rad - expected_in_odom.yaw_rad);
+  std::size_t n = 0;
+  out[n++] = detected_in_odom.compose(expected_in_odom.inverse());
+  if (std::fabs(turn_rad) <= params.reading_blur_rad) {
+    out[n++] = Pose2{detected_m.x() - expected_m.x(), detected_m.y() - expected_m.y(), 0};
+  }
+  const Pose2 turn = turn_about(robot_in_odom, turn_rad);
+  const Real range_m = (expected_m - Vec2(robot_in_odom.x_m, robot_in_odom.y_m)).norm();
+  if ((turn.transform(expected_m) - detected_m).norm() <= kReadingGateM + range_m * params.reading_blur_rad) {
+    out[n++] = turn;
+  }
+  return n;
 }
 
 void SceneCheck::set_reference(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose,

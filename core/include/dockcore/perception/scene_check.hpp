@@ -42,6 +42,9 @@ struct SceneCheckParams {
   Real min_explained_share =
       static_cast<Real>(0.5);       ///< kStill also needs this share of the compared points explained.
   std::uint16_t min_compared = 20;  ///< kStill needs at least this many reference points seen in the scan.
+  /// How far a far detection's yaw may be off, rad: the blur push_readings() allows each partial reading of a
+  /// detection.
+  Real reading_blur_rad = static_cast<Real>(0.1745);
 };
 
 /// Points each hypothesis explains and contradicts (judge()'s detail, for reports and tests).
@@ -52,6 +55,21 @@ struct SceneVotes {
   std::uint16_t moved_explained = 0;  ///< Explained under "the room moved by the correction".
   std::uint16_t moved_contradicted = 0;
 };
+
+/// A turn on the spot by `yaw_rad` of the robot at `robot_in_odom`, as the odometry-frame correction it makes: the room
+/// turns about the robot. O(1).
+Pose2 turn_about(const Pose2& robot_in_odom, Real yaw_rad);
+
+/// The pushes a detection off its expectation may mean, as odometry-frame corrections for SceneCheck::judge(), written
+/// to `out`; returns how many (1 to 3). Always the full correction, detected ∘ expected⁻¹. One detection's yaw at range
+/// is noisy enough to blur a pure shove and its position a turn on the spot, so also each partial reading the
+/// detection allows: the shift alone when the detection's turn is within params.reading_blur_rad (the turn may then
+/// be noise), and the turn alone, about the robot at `robot_in_odom`, when it lands the expectation within
+/// 5 cm + range × reading_blur_rad of the detection. A reading the detection does not allow would be judged anyway
+/// and could only blur the verdict: a turn of a degree explains no detection a metre along the wall, yet it ties
+/// with "still" however clearly the room stood still. O(1).
+std::size_t push_readings(const Pose2& expected_in_odom, const Pose2& detected_in_odom, const Pose2& robot_in_odom,
+                          const SceneCheckParams& params, Pose2 out[3]);
 
 /// Reference scan and the two-hypothesis test. Fixed capacity: kCapacity points, taken at an even stride.
 class SceneCheck {
