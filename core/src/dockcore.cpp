@@ -239,10 +239,13 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
          std::fabs(wrap_angle(detected_in_odom.yaw_rad - expected_in_odom.yaw_rad)) > kSceneGateRad);
     if (off_expectation && scene_.reference_points() > 0) {
       // The push the detection implies, and the partial readings of it that a noisy detection allows.
+      const ExpectedDock dock{Vec2(expected_in_odom.x_m, expected_in_odom.y_m),
+                              estimator_.profile_radius_m() + config_.scene.range_tolerance_m};
       Pose2 corrections[9];
       std::size_t readings = push_readings(expected_in_odom, detected_in_odom, odom_pose, config_.scene, corrections);
       if (d.expectation_confirmed) {
-        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, readings, config_.scene);
+        d.scene =
+            scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, readings, config_.scene, nullptr, 0, &dock);
       } else {
         // The implied push rests on one detection, which may be the wrong one. "Still" must then also beat a shove
         // of the push test's size in each direction and a turn either way: a room that could not show such a push
@@ -256,7 +259,7 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
         }
         // The probes never make "moved": the room vouches for the one detection only by the push it implies.
         d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, readings, config_.scene, nullptr,
-                               readings - pushes);
+                               readings - pushes, &dock);
       }
     }
     const Pose2 before = filter_.dock_in_odom();

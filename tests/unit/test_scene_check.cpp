@@ -27,8 +27,9 @@ struct Segment {
 };
 
 /// A 5 x 4 m room whose wall at x = 0 holds a 0.3 m dock (a 6 cm deep box on the wall at y = 0) and, 0.6 m to its
-/// left, a 0.4 m box; `with_room` false leaves only the dock's wall, 4 m long.
-std::vector<Segment> room(bool with_room, bool with_box = true) {
+/// left, a 0.4 m box; `with_room` false leaves only the dock's wall, 4 m long; `with_dock` false takes the dock out
+/// (hidden from the lidar) of a glass stretch of its wall.
+std::vector<Segment> room(bool with_room, bool with_box = true, bool with_dock = true) {
   std::vector<Segment> s;
   auto box = [&](double x0, double y0, double x1, double y1) {
     s.push_back({v(x0, y0), v(x1, y0)});
@@ -36,8 +37,13 @@ std::vector<Segment> room(bool with_room, bool with_box = true) {
     s.push_back({v(x1, y1), v(x0, y1)});
     s.push_back({v(x0, y1), v(x0, y0)});
   };
-  s.push_back({v(0, -2), v(0, 2)});
-  box(0, -0.15, 0.06, 0.15);
+  if (with_dock) {
+    s.push_back({v(0, -2), v(0, 2)});
+    box(0, -0.15, 0.06, 0.15);
+  } else {  // the wall behind it is glass: the beams that met the dock now leave the room
+    s.push_back({v(0, -2), v(0, -0.15)});
+    s.push_back({v(0, 0.15), v(0, 2)});
+  }
   if (with_box) box(0, 0.75, 0.4, 1.15);
   if (with_room) {
     s.push_back({v(0, 2), v(5, 2)});
@@ -244,4 +250,49 @@ TEST(SceneCheck, TheBoxAlongTheWallIsStillOnlyWithoutATurnItDoesNotAllow) {
   CHECK(check.judge(now.view(), Pose2{}, here, readings, n, params) == SceneVerdict::kStill);
   readings[n] = turn_about(here, box.yaw_rad);
   CHECK(check.judge(now.view(), Pose2{}, here, readings, n + 1, params) != SceneVerdict::kStill);
+}
+
+TEST(SceneCheck, TheDocksOwnAbsenceDoesNotCountAgainstStandingStill) {
+  // The dock is hidden (the beams that met it pass through the glass behind it) and the box taken for it; the robot
+  // was not moved. The dock's reference points read beyond under "still": counted against it, they cost its margin
+  // (in a room with less beside the dock than this box, the verdict); with the expected dock given they count for
+  // neither.
+  const Pose2 here = pose(1.2, 0.1, kPi);
+  const SceneCheckParams params;
+  for (const bool furnished : {false, true}) {
+    SceneCheck check;
+    check.set_reference(cast(room(furnished), kStart).view(), Pose2{}, kStart, params);
+    const LaserScan now = cast(room(furnished, true, false), here);
+    const Pose2 box = pose(0, 0.95, 0);
+    Pose2 readings[3];
+    const std::size_t n = push_readings(Pose2{}, box, here, params, readings);
+    const ExpectedDock dock{Vec2(0, 0), static_cast<Real>(0.25)};
+    SceneVotes with, without;
+    CHECK(check.judge(now.view(), Pose2{}, here, readings, n, params, &with, 0, &dock) == SceneVerdict::kStill);
+    const SceneVerdict verdict = check.judge(now.view(), Pose2{}, here, readings, n, params, &without);
+    CHECK(without.still_contradicted > with.still_contradicted);
+    CHECK(verdict == SceneVerdict::kStill);  // this room's box decides either way
+    LONGS_EQUAL(0, static_cast<long>(with.still_contradicted));
+    CHECK(without.still_contradicted >= 5);  // the dock's points, read through the glass
+    LONGS_EQUAL(static_cast<long>(without.still_explained), static_cast<long>(with.still_explained));
+  }
+}
+
+TEST(SceneCheck, PointsHiddenNearTheLidarDoNotDiluteStandingStill) {
+  // After the reference, something stands right behind the robot and hides most of the room: those points read
+  // nearer (occluded) and vote for neither. The rest of the room is explained as before: still.
+  const Pose2 here = pose(1.2, 0.1, kPi);
+  const SceneCheckParams params;
+  SceneCheck check;
+  check.set_reference(cast(room(true), kStart).view(), Pose2{}, kStart, params);
+  std::vector<Segment> world = room(true);
+  world.push_back({v(1.3, -1.9), v(1.3, 1.9)});
+  const LaserScan now = cast(world, here);
+  const Pose2 box = pose(0, 0.95, 0);
+  Pose2 readings[3];
+  const std::size_t n = push_readings(Pose2{}, box, here, params, readings);
+  SceneVotes votes;
+  CHECK(check.judge(now.view(), Pose2{}, here, readings, n, params, &votes) == SceneVerdict::kStill);
+  // Fewer than half the compared points are explained: the occluded ones are most of them.
+  CHECK(2 * votes.still_explained < votes.compared);
 }

@@ -69,7 +69,7 @@ void SceneCheck::set_reference(const ScanView& scan, const Pose2& lidar_mount, c
 
 SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose,
                                const Pose2* corrections, std::size_t n, const SceneCheckParams& params,
-                               SceneVotes* votes, std::size_t probes) const {
+                               SceneVotes* votes, std::size_t probes, const ExpectedDock* dock) const {
   SceneVotes v;
   int best_moved_net = 0;  // over every candidate: what "still" must beat
   bool have_moved = false;
@@ -110,7 +110,8 @@ SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, c
     };
     for (std::size_t k = 0; k < count_; ++k) {
       bool seen = false;
-      const int still = vote(points_odom_m_[k], &seen);
+      int still = vote(points_odom_m_[k], &seen);
+      if (still < 0 && dock != nullptr && (points_odom_m_[k] - dock->centre_odom_m).norm() <= dock->radius_m) still = 0;
       if (seen) ++v.compared;
       if (still > 0) ++v.still_explained;
       if (still < 0) ++v.still_contradicted;
@@ -141,7 +142,8 @@ SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, c
   const int still_net = static_cast<int>(v.still_explained) - static_cast<int>(v.still_contradicted);
   const int margin = static_cast<int>(params.min_margin_points);
   if (v.compared >= params.min_compared && still_net - best_moved_net >= margin &&
-      static_cast<Real>(v.still_explained) >= params.min_explained_share * static_cast<Real>(v.compared)) {
+      static_cast<Real>(v.still_explained) >=
+          params.min_explained_share * static_cast<Real>(v.still_explained + v.still_contradicted)) {
     return SceneVerdict::kStill;
   }
   if (have_push && best_push_net - still_net >= margin) return SceneVerdict::kMoved;

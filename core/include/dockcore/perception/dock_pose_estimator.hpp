@@ -262,6 +262,8 @@ class DockPoseEstimatorBase {
   const EstimatorCounters& counters() const { return counters_; }
   const EstimatorParams& params() const { return params_; }
   const DockProfile& profile() const { return profile_; }
+  /// The configured profile's largest vertex distance from the dock origin, m (0 before configure()). O(1).
+  Real profile_radius_m() const { return profile_radius_m_; }
   /// Most beams a scan may have (larger scans are refused as kBadScan).
   std::size_t capacity() const { return capacity_; }
 

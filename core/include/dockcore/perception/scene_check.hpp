@@ -39,8 +39,9 @@ struct SceneCheckParams {
   Real range_tolerance_frac = static_cast<Real>(0.02);  ///< ... plus this share of its range.
   Real max_range_m = static_cast<Real>(6.0);            ///< Reference returns beyond this are not kept, m.
   std::uint16_t min_margin_points = 10;  ///< A verdict needs this many more net points than the other hypothesis.
-  Real min_explained_share =
-      static_cast<Real>(0.5);       ///< kStill also needs this share of the compared points explained.
+  /// kStill also needs this share explained of the points that vote on it (explained or contradicted: an occluded
+  /// point says nothing, and someone standing near the lidar hides much of the room).
+  Real min_explained_share = static_cast<Real>(0.5);
   std::uint16_t min_compared = 20;  ///< kStill needs at least this many reference points seen in the scan.
   /// How far a far detection's yaw may be off, rad: the blur push_readings() allows each partial reading of a
   /// detection.
@@ -54,6 +55,15 @@ struct SceneVotes {
   std::uint16_t still_contradicted = 0;
   std::uint16_t moved_explained = 0;  ///< Explained under "the room moved by the correction".
   std::uint16_t moved_contradicted = 0;
+};
+
+/// Where the dock was expected, in the odometry frame: a disc about its origin that holds its outline. Under "still",
+/// a reference point in it that the scan reads beyond counts for neither hypothesis: the dock not being seen where it
+/// was is what brought a detection elsewhere to be judged, whether the dock was hidden or moved, so it cannot also
+/// tell which.
+struct ExpectedDock {
+  Vec2 centre_odom_m{0, 0};
+  Real radius_m = 0;
 };
 
 /// A turn on the spot by `yaw_rad` of the robot at `robot_in_odom`, as the odometry-frame correction it makes: the room
@@ -88,13 +98,14 @@ class SceneCheck {
   /// (odometry right), "moved" at correction ∘ point for each of the `n` candidate corrections (a push by an
   /// odometry-frame correction: the one the detection implies, detected ∘ expected⁻¹, and the readings of it that a
   /// noisy detection blurs, e.g. its shift alone or its turn alone), the best of them counting. kStill needs
-  /// min_compared points and a margin over every candidate. The last `probes` of the n candidates are pushes "still"
-  /// must also beat but that never make a kMoved verdict (shoves the room could show, not the one a detection
+  /// min_compared points, min_explained_share of the points that vote on it explained, and a margin over every
+  /// candidate. `dock`, if given, is the expectation (ExpectedDock). The last `probes` of the n candidates are pushes
+  /// "still" must also beat but that never make a kMoved verdict (shoves the room could show, not the one a detection
   /// implies). `votes`, if given, receives the counts (moved: the best candidate's, probes included). n ≥ 1,
   /// probes < n. O(n · kCapacity).
   SceneVerdict judge(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose, const Pose2* corrections,
-                     std::size_t n, const SceneCheckParams& params, SceneVotes* votes = nullptr,
-                     std::size_t probes = 0) const;
+                     std::size_t n, const SceneCheckParams& params, SceneVotes* votes = nullptr, std::size_t probes = 0,
+                     const ExpectedDock* dock = nullptr) const;
 
  private:
   Vec2 points_odom_m_[kCapacity];
