@@ -453,6 +453,28 @@ TEST(TaskManager, AWrongFirstLookIsNotAPushAwayWhenTheRoomStandsStill) {
   }
 }
 
+// The same wrong first look, confirmed: a second look agreed with it, so the filter followed clutter 1.9 m out. The
+// dock's detections at 2.4 m are overruled by the room (it stands still) until the filter restarts on the dock; then
+// they agree with the filter, and only the distance test is left to judge them. The start's distance must be the
+// dock's by then, or the filter's own dock fails it (178) with nothing off the expectation for the room to judge.
+TEST(TaskManager, AConfirmedWrongFirstLookIsNotAPushAwayWhenTheRoomStandsStill) {
+  auto s = std::make_unique<Sim>();
+  s->world = s->odom = Pose2{1.9, 0.05, kPi};
+  s->expectation_from_filter = true;  // the clutter's, confirmed
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->dock = Pose2{-0.5, 0, 0};  // where the dock really is: 2.4 m out, beyond the start's 1.9 m + 0.3 m
+  s->outlier_scene = SceneVerdict::kStill;
+  for (int i = 0; i < 3; ++i) s->outliers.push_back(s->dock);
+  for (int i = 0; i < 20 && !s->outliers.empty(); ++i) s->step();
+  CHECK(s->outliers.empty());
+  LONGS_EQUAL(3, static_cast<long>(s->tm.pushes_overruled()));
+  s->dock_in_odom = s->dock;  // the filter restarted on the dock: its detections agree with it
+  for (int i = 0; i < 40 && s->out.status.state == TaskState::kAlign; ++i) s->step();
+  CHECK(s->out.status.state == TaskState::kAlign);
+  LONGS_EQUAL(0, s->zero_violations);
+}
+
 TEST(TaskManager, TwoDisagreeingOutliersInARowAreNotAFault) {
   auto s = std::make_unique<Sim>();
   s->command(HostCommandType::kDock);

@@ -319,9 +319,10 @@ bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in)
   // the dock (furniture beside it, while the dock is hidden). It neither counts towards a push nor clears one.
   if (det.scene == SceneVerdict::kStill) {
     ++pushes_overruled_;
-    // Against a filter resting on one detection only the distance was tested: with the robot where odometry puts
-    // it, the start's distance came from a wrong first look. The farther distance seen now is the start's.
-    if (!det.expectation_confirmed && dist > start_distance_m_) start_distance_m_ = dist;
+    // With the robot where odometry puts it, a detection farther than the start's distance is no push away: the
+    // start's distance came from a wrong first look (against a filter resting on it, only the distance was tested),
+    // or from clutter a confirmed filter followed before this detection restarts it. It is the start's now.
+    if (dist > start_distance_m_) start_distance_m_ = dist;
     return false;
   }
   // A push moves every later detection to the same new place; an outlier is alone. Count only failing
