@@ -13,6 +13,9 @@ constexpr Real kSceneGateRad = static_cast<Real>(0.0873);  // 5°
 // The scene's reference is renewed at most this often: odometry drifts slowly, and each renewal costs a pass over
 // the scan.
 constexpr std::uint64_t kSceneReferencePeriodUs = 500000;
+// A scan that would keep under three quarters of the reference's points (the dock hidden, someone near the lidar)
+// does not replace it until the reference is this old.
+constexpr std::uint64_t kSceneReferenceMaxAgeUs = 3000000;
 // The turns "still" must beat when the implied push rests on one detection: well above a detection's yaw noise.
 constexpr Real kSceneProbeTurnRad = static_cast<Real>(0.1745);  // 10°
 }  // namespace
@@ -67,6 +70,7 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
   restart_ref_set_ = false;
   push_ref_set_ = false;
   confirmed_ref_set_ = false;
+  overruled_restart_set_ = false;
   last_estimate_ = DockEstimate{};
   prev_state_ = TaskState::kNotTasking;
   prev_drive_cmd_ = Twist2{};
@@ -239,13 +243,17 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
          std::fabs(wrap_angle(detected_in_odom.yaw_rad - expected_in_odom.yaw_rad)) > kSceneGateRad);
     if (off_expectation && scene_.reference_points() > 0) {
       // The push the detection implies, and the partial readings of it that a noisy detection allows.
-      const ExpectedDock dock{Vec2(expected_in_odom.x_m, expected_in_odom.y_m),
-                              estimator_.profile_radius_m() + config_.scene.range_tolerance_m};
+      const Real dock_radius_m = estimator_.profile_radius_m() + config_.scene.range_tolerance_m;
+      ExpectedDock docks[2] = {{Vec2(expected_in_odom.x_m, expected_in_odom.y_m), dock_radius_m}, {}};
+      std::size_t n_docks = 1;
+      if (overruled_restart_set_) {
+        docks[n_docks++] = {Vec2(overruled_restart_from_.x_m, overruled_restart_from_.y_m), dock_radius_m};
+      }
       Pose2 corrections[9];
       std::size_t readings = push_readings(expected_in_odom, detected_in_odom, odom_pose, config_.scene, corrections);
       if (d.expectation_confirmed) {
-        d.scene =
-            scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, readings, config_.scene, nullptr, 0, &dock);
+        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, readings, config_.scene, nullptr, 0,
+                               docks, n_docks);
       } else {
         // The implied push rests on one detection, which may be the wrong one. "Still" must then also beat a shove
         // of the push test's size in each direction and a turn either way: a room that could not show such a push
@@ -259,7 +267,7 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
         }
         // The probes never make "moved": the room vouches for the one detection only by the push it implies.
         d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, readings, config_.scene, nullptr,
-                               readings - pushes, &dock);
+                               readings - pushes, docks, n_docks);
       }
     }
     const Pose2 before = filter_.dock_in_odom();
@@ -281,6 +289,12 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
       scene_.set_reference(scan, config_.lidar_mount, odom_pose, config_.scene);
       scene_ref_us_ = stamp_us;
     }
+    // Restarted by a detection the room overruled (something else taken for the dock, which may just be hidden):
+    // where the filter had the dock stays a place the dock may be hidden at, for the rest of the task.
+    if (u == FilterUpdate::kReinitialised && d.expectation_confirmed && d.scene == SceneVerdict::kStill) {
+      overruled_restart_set_ = true;
+      overruled_restart_from_ = before;
+    }
     if (u == FilterUpdate::kReinitialised && was_confirmed) {  // the estimate a resume may still need
       restart_ref_set_ = true;
       restart_ref_in_odom_ = before;
@@ -294,7 +308,9 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
       // A scan whose detection agreed with the expectation shows the room where odometry puts it: the reference
       // for the next off-expectation detection, renewed now and then (the room does not move; odometry drifts).
       if (!off_expectation && (scene_.reference_points() == 0 || stamp_us < scene_ref_us_ ||
-                               stamp_us - scene_ref_us_ >= kSceneReferencePeriodUs)) {
+                               (stamp_us - scene_ref_us_ >= kSceneReferencePeriodUs &&
+                                (stamp_us - scene_ref_us_ >= kSceneReferenceMaxAgeUs ||
+                                 4 * SceneCheck::points_kept(scan, config_.scene) >= 3 * scene_.reference_points())))) {
         scene_.set_reference(scan, config_.lidar_mount, odom_pose, config_.scene);
         scene_ref_us_ = stamp_us;
       }
@@ -411,6 +427,7 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
     filter_.reset();
     filter_confirmed_ = false;
     scene_.clear();
+    overruled_restart_set_ = false;
   }
   // A detection in ALIGN agreed with the push test's reference: the reference has done its job (no push), and an
   // earlier restart was no push either (the restarted filter is the reference now). Both end with the task.

@@ -328,6 +328,9 @@ class DockcoreBase {
   bool restart_ref_set_ = false;
   bool push_ref_set_ = false;
   bool confirmed_ref_set_ = false;
+  bool overruled_restart_set_ = false;
+  /// The filter's dock before a detection the room overruled restarted it (this task): the dock may be hidden there.
+  Pose2 overruled_restart_from_{};
   /// The confirmed estimate from before the filter's most recent restart (this task), for a resumed command.
   Pose2 restart_ref_in_odom_{};
   std::uint64_t restart_ref_us_ = 0;  ///< Last detection fused into it.

@@ -44,6 +44,17 @@ std::size_t push_readings(const Pose2& expected_in_odom, const Pose2& detected_i
   return n;
 }
 
+std::size_t SceneCheck::points_kept(const ScanView& scan, const SceneCheckParams& params) {
+  if (scan.ranges_m == nullptr) return 0;
+  std::size_t returns = 0;
+  for (std::size_t i = 0; i < scan.count; ++i) {
+    const Real r = scan.ranges_m[i];
+    if (is_valid_range(r) && r <= params.max_range_m) ++returns;
+  }
+  const std::size_t stride = (returns + kCapacity - 1) / kCapacity;
+  return stride == 0 ? 0 : (returns + stride - 1) / stride;
+}
+
 void SceneCheck::set_reference(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose,
                                const SceneCheckParams& params) {
   count_ = 0;
@@ -69,7 +80,8 @@ void SceneCheck::set_reference(const ScanView& scan, const Pose2& lidar_mount, c
 
 SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose,
                                const Pose2* corrections, std::size_t n, const SceneCheckParams& params,
-                               SceneVotes* votes, std::size_t probes, const ExpectedDock* dock) const {
+                               SceneVotes* votes, std::size_t probes, const ExpectedDock* docks,
+                               std::size_t n_docks) const {
   SceneVotes v;
   int best_moved_net = 0;  // over every candidate: what "still" must beat
   bool have_moved = false;
@@ -111,7 +123,9 @@ SceneVerdict SceneCheck::judge(const ScanView& scan, const Pose2& lidar_mount, c
     for (std::size_t k = 0; k < count_; ++k) {
       bool seen = false;
       int still = vote(points_odom_m_[k], &seen);
-      if (still < 0 && dock != nullptr && (points_odom_m_[k] - dock->centre_odom_m).norm() <= dock->radius_m) still = 0;
+      for (std::size_t q = 0; still < 0 && q < n_docks; ++q) {
+        if ((points_odom_m_[k] - docks[q].centre_odom_m).norm() <= docks[q].radius_m) still = 0;
+      }
       if (seen) ++v.compared;
       if (still > 0) ++v.still_explained;
       if (still < 0) ++v.still_contradicted;

@@ -92,6 +92,9 @@ class SceneCheck {
   /// frame: the lidar at `odom_pose` ∘ `lidar_mount`. Returns beyond params.max_range_m are left out. O(scan.count).
   void set_reference(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose,
                      const SceneCheckParams& params);
+  /// How many points set_reference() would keep from `scan` (its returns within params.max_range_m, at most
+  /// kCapacity). O(scan.count).
+  static std::size_t points_kept(const ScanView& scan, const SceneCheckParams& params);
   /// Reference points kept. O(1).
   std::size_t reference_points() const { return count_; }
   /// Judges `scan`, taken at `odom_pose`, against the reference: "still" predicts each reference point where it was
@@ -99,13 +102,14 @@ class SceneCheck {
   /// odometry-frame correction: the one the detection implies, detected ∘ expected⁻¹, and the readings of it that a
   /// noisy detection blurs, e.g. its shift alone or its turn alone), the best of them counting. kStill needs
   /// min_compared points, min_explained_share of the points that vote on it explained, and a margin over every
-  /// candidate. `dock`, if given, is the expectation (ExpectedDock). The last `probes` of the n candidates are pushes
+  /// candidate. `docks`: the `n_docks` places the dock may be hidden at (ExpectedDock): the expectation, and where
+  /// the filter followed the dock before something else restarted it. The last `probes` of the n candidates are pushes
   /// "still" must also beat but that never make a kMoved verdict (shoves the room could show, not the one a detection
   /// implies). `votes`, if given, receives the counts (moved: the best candidate's, probes included). n ≥ 1,
   /// probes < n. O(n · kCapacity).
   SceneVerdict judge(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose, const Pose2* corrections,
                      std::size_t n, const SceneCheckParams& params, SceneVotes* votes = nullptr, std::size_t probes = 0,
-                     const ExpectedDock* dock = nullptr) const;
+                     const ExpectedDock* docks = nullptr, std::size_t n_docks = 0) const;
 
  private:
   Vec2 points_odom_m_[kCapacity];
