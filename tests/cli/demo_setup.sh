@@ -45,10 +45,12 @@ exit 0
 SH
 chmod +x "$WORK/bin/"*
 
-run_demo() { PATH="$WORK/bin:$PATH" "$SRC/tools/demo" >"$WORK/demo.out" 2>&1; echo $?; }
+run_demo() { PATH="$WORK/bin:$PATH" DOCKCORE_APT_RETRY_S=0 "$SRC/tools/demo" >"$WORK/demo.out" 2>&1; echo $?; }
 rc=$(FAKE_MISSING=1 run_demo)
 [ "$rc" -eq 2 ] || fail "demo, install fails: exit $rc (want 2): $(cat "$WORK/demo.out")"
 grep -q "installing .* with apt-get: cmake ninja-build" "$WORK/demo.out" || fail "setup-deps does not say what it installs: $(cat "$WORK/demo.out")"
+# A mirror caught mid-sync: the install is tried three times before setup-deps gives up.
+[ "$(grep -c "fake apt-get install" "$WORK/demo.out")" -eq 3 ] || fail "install not tried 3 times: $(cat "$WORK/demo.out")"
 grep -q "qemu" "$WORK/demo.out" && fail "demo setup mentions qemu: $(cat "$WORK/demo.out")"
 rc=$(FAKE_CMAKE_FAIL=configure run_demo)
 [ "$rc" -eq 2 ] || fail "demo, configure fails: exit $rc (want 2): $(cat "$WORK/demo.out")"
