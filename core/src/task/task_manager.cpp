@@ -325,6 +325,12 @@ bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in)
     if (dist > start_distance_m_) start_distance_m_ = dist;
     return false;
   }
+  // The room moved as this detection implies (SceneCheck): the push is seen, and needs no second look. A robot
+  // shoved so that it sees the dock only from the side may not get one.
+  if (det.scene == SceneVerdict::kMoved) {
+    raise(f, in);
+    return true;
+  }
   // A push moves every later detection to the same new place; an outlier is alone. Count only failing
   // detections that agree with an earlier failing one (same tolerances as the push test itself). Two places are
   // kept: a lone outlier between two detections of a pushed robot (sparse at range) starts a place of its own

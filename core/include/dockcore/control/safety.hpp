@@ -166,7 +166,8 @@ struct DeviationParams {
   /// Consecutive failing detections that raise the fault, each within the push tolerances of the previous one
   /// (mapped into the odometry frame). A pushed robot's detections all agree with each other; a single wrong
   /// detection (clutter taken for the dock) does not repeat at the same place. 1: fault on the first. Keep it below
-  /// DockFilterParams::reinit_after, or the filter adopts the pushed pose before the test fires.
+  /// DockFilterParams::reinit_after, or the filter adopts the pushed pose before the test fires. One detection
+  /// suffices when the room moved as it implies (SceneVerdict::kMoved).
   std::uint8_t confirm_detections = 2;
 };
 
