@@ -44,35 +44,47 @@ std::size_t push_readings(const Pose2& expected_in_odom, const Pose2& detected_i
   return n;
 }
 
-std::size_t SceneCheck::points_kept(const ScanView& scan, const SceneCheckParams& params) {
+namespace {
+
+// A return the reference may keep: valid and within params.max_range_m.
+bool keepable(Real r, const SceneCheckParams& params) {
+  return is_valid_range(r) && r <= params.max_range_m;
+}
+
+// The scan's keepable returns. The reference's stride runs over them, not over the beams: a room seen over a quarter
+// of the turn keeps all its points. O(scan.count).
+std::size_t keepable_returns(const ScanView& scan, const SceneCheckParams& params) {
   if (scan.ranges_m == nullptr) return 0;
   std::size_t returns = 0;
-  for (std::size_t i = 0; i < scan.count; ++i) {
-    const Real r = scan.ranges_m[i];
-    if (is_valid_range(r) && r <= params.max_range_m) ++returns;
-  }
-  const std::size_t stride = (returns + kCapacity - 1) / kCapacity;
-  return stride == 0 ? 0 : (returns + stride - 1) / stride;
+  for (std::size_t i = 0; i < scan.count; ++i) returns += keepable(scan.ranges_m[i], params) ? 1 : 0;
+  return returns;
+}
+
+// The stride over `returns` (> 0) that keeps at most SceneCheck::kCapacity of them.
+std::size_t stride_for(std::size_t returns) {
+  return (returns + SceneCheck::kCapacity - 1) / SceneCheck::kCapacity;
+}
+
+}  // namespace
+
+std::size_t SceneCheck::points_kept(const ScanView& scan, const SceneCheckParams& params) {
+  const std::size_t returns = keepable_returns(scan, params);
+  if (returns == 0) return 0;
+  const std::size_t stride = stride_for(returns);
+  return (returns + stride - 1) / stride;
 }
 
 void SceneCheck::set_reference(const ScanView& scan, const Pose2& lidar_mount, const Pose2& odom_pose,
                                const SceneCheckParams& params) {
   count_ = 0;
-  if (scan.ranges_m == nullptr || scan.count == 0) return;
-  const Pose2 lidar_in_odom = odom_pose.compose(lidar_mount);
-  // The stride runs over the returns, not the beams: a room seen over a quarter of the turn keeps all its points.
-  std::size_t returns = 0;
-  for (std::size_t i = 0; i < scan.count; ++i) {
-    const Real r = scan.ranges_m[i];
-    if (is_valid_range(r) && r <= params.max_range_m) ++returns;
-  }
+  const std::size_t returns = keepable_returns(scan, params);
   if (returns == 0) return;  // nothing to keep (and no stride to take)
-  const std::size_t stride = (returns + kCapacity - 1) / kCapacity;
+  const Pose2 lidar_in_odom = odom_pose.compose(lidar_mount);
+  const std::size_t stride = stride_for(returns);
   std::size_t seen = 0;
   for (std::size_t i = 0; i < scan.count && count_ < kCapacity; ++i) {
     const Real r = scan.ranges_m[i];
-    if (!is_valid_range(r) || r > params.max_range_m) continue;
-    if (seen++ % stride != 0) continue;
+    if (!keepable(r, params) || seen++ % stride != 0) continue;
     const Real a = scan.angle_rad(i);
     points_odom_m_[count_++] = lidar_in_odom.transform(Vec2(r * std::cos(a), r * std::sin(a)));
   }
