@@ -53,7 +53,7 @@ int Daemon::code_dock_id() const {
   // Another dock of this shape was refused: read its stripes where it stands and look its pattern up among the
   // database's docks of the same outline (their own stripes, or their taught code).
   const dockcore::ScanView scan = core.last_scan();
-  const dockcore::StripeRead r = dockcore::read_reflector_stripes(scan, cfg_.lidar_mount, core.estimator().profile(),
+  const dockcore::StripeRead r = dockcore::read_reflector_stripes(scan, core.lidar_mount(), core.estimator().profile(),
                                                                   e.refused_pose, stripe_read_params(cfg_));
   if (r.status != dockcore::StripeReadStatus::kOk || r.count == 0) return -1;
   // An edge is read to about half a beam spacing at the dock, plus the pose's own error.

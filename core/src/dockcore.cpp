@@ -55,6 +55,7 @@ ConfigureStatus detector_supports(DockDetector detector, const DockProfile& prof
 
 bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& config) {
   config_ = config;
+  lidar_mount_ = config.lidar_mount;
   watch_.configure(config.watchdog);
   intensity_.configure(config.intensity);
   filter_ = DockPoseFilter(config.filter);
@@ -119,7 +120,7 @@ DockEstimate DockcoreBase::breakpoint_estimate(const ScanView& scan) {
   }
   Pose2 native_in_robot;
   Mat3 cov;
-  if (!breakpoint_measurement(d, scan.angle_increment_rad, config_.lidar_mount, config_.estimator.range_sigma_m,
+  if (!breakpoint_measurement(d, scan.angle_increment_rad, lidar_mount_, config_.estimator.range_sigma_m,
                               &native_in_robot, &cov, breakpoint_->params().min_jump_m)) {
     return e;
   }
@@ -195,7 +196,7 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
     hint_ptr = &hint;
   }
   last_estimate_ = detector_ == DockDetector::kBreakpoint ? breakpoint_estimate(scan)
-                                                          : estimator_.estimate(scan, config_.lidar_mount, hint_ptr);
+                                                          : estimator_.estimate(scan, lidar_mount_, hint_ptr);
   // A scan taken during a gap in the odometry (a host that read no feedback for a while, a chassis outage) cannot
   // be placed: the pose before the gap may be a driven half-second off, and the detection would land that far from
   // the dock, which the push test reads as a push. Its estimate is reported; the filter and the push test skip it.
@@ -252,8 +253,8 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
       Pose2 corrections[9];
       std::size_t readings = push_readings(expected_in_odom, detected_in_odom, odom_pose, config_.scene, corrections);
       if (d.expectation_confirmed) {
-        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, readings, config_.scene, nullptr, 0,
-                               docks, n_docks);
+        d.scene = scene_.judge(scan, lidar_mount_, odom_pose, corrections, readings, config_.scene, nullptr, 0, docks,
+                               n_docks);
       } else {
         // The implied push rests on one detection, which may be the wrong one. "Still" must then also beat a shove
         // of the push test's size in each direction and a turn either way: a room that could not show such a push
@@ -266,7 +267,7 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
           corrections[readings++] = probe;
         }
         // The probes never make "moved": the room vouches for the one detection only by the push it implies.
-        d.scene = scene_.judge(scan, config_.lidar_mount, odom_pose, corrections, readings, config_.scene, nullptr,
+        d.scene = scene_.judge(scan, lidar_mount_, odom_pose, corrections, readings, config_.scene, nullptr,
                                readings - pushes, docks, n_docks);
       }
     }
@@ -286,7 +287,7 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
     // disagreement before any detection agrees can be judged too. Not when the detection is judged against an older
     // estimate (a resumed task's): the robot may have been pushed since, and this room would be the pushed one.
     if (u == FilterUpdate::kInitialised && !d.expectation_confirmed && scene_.reference_points() == 0) {
-      scene_.set_reference(scan, config_.lidar_mount, odom_pose, config_.scene);
+      scene_.set_reference(scan, lidar_mount_, odom_pose, config_.scene);
       scene_ref_us_ = stamp_us;
     }
     // Restarted by a detection the room overruled (something else taken for the dock, which may just be hidden):
@@ -311,7 +312,7 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
                                (stamp_us - scene_ref_us_ >= kSceneReferencePeriodUs &&
                                 (stamp_us - scene_ref_us_ >= kSceneReferenceMaxAgeUs ||
                                  4 * SceneCheck::points_kept(scan, config_.scene) >= 3 * scene_.reference_points())))) {
-        scene_.set_reference(scan, config_.lidar_mount, odom_pose, config_.scene);
+        scene_.set_reference(scan, lidar_mount_, odom_pose, config_.scene);
         scene_ref_us_ = stamp_us;
       }
     }
@@ -392,7 +393,7 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
   t.chassis_ok = watch_.chassis_ok(in.now_us);
   t.lidar_ok = watch_.lidar_ok(in.now_us);
   t.scan = have_scan_ ? &scan_ : nullptr;
-  t.lidar_mount = config_.lidar_mount;
+  t.lidar_mount = lidar_mount_;
   if (filter_.initialised()) {
     t.dock.valid = true;
     t.dock.pose = filter_.dock_in_robot(t.odom_pose, &t.dock.covariance);
@@ -404,6 +405,20 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
   pending_count_ = 0;
 
   static_cast<TaskOutput&>(out) = tasks_.tick(t);
+  if (out.mount_changed) {
+    // The calibration swing moved the lidar: the filter's dock, the room's reference and the push test's references
+    // were all placed through the old mount, centimetres off now. The robot stands at the staging distance and the
+    // next attempt starts with a search, which the next detection answers.
+    lidar_mount_ = config_.lidar_mount;
+    lidar_mount_.x_m += tasks_.mount_shift_m().x();
+    lidar_mount_.y_m += tasks_.mount_shift_m().y();
+    filter_.reset();
+    filter_confirmed_ = false;
+    scene_.clear();
+    restart_ref_set_ = false;
+    confirmed_ref_set_ = false;
+    overruled_restart_set_ = false;
+  }
   observe_drive(in, before, t);
   shape(watch_.hold(), &out);
   // A new dock task: forget the old dock (the robot may have been carried since), so the push test and the

@@ -206,9 +206,11 @@ TEST(SimRun, APushTimedOnAlignLandsInAlignAndRaises178) {
 }
 
 // A lidar 16 mm beside where its configuration says (a calibration error dockcore is not told) puts the attempts
-// about 16 mm beside the ±10 mm contacts. The task manager's lateral search aims the next attempts beside the axis
-// and finds them; without it every attempt misses the same way.
-TEST(SimRun, AnUntoldLidarCalibrationErrorIsFoundByTheLateralSearch) {
+// about 16 mm beside the ±10 mm contacts. After the first miss the robot swings on the spot and measures where the
+// lidar sits (TaskParams::calibrate_mount): the next attempt docks. Without the swing, the task manager's lateral
+// search aims the next attempts beside the axis and finds them later; without either, every attempt misses the same
+// way.
+TEST(SimRun, AnUntoldLidarCalibrationErrorIsMeasuredBySwingingOrFoundByTheLateralSearch) {
   docksim::Scenario sc = docksim::parse_scenario_toml("[robot.lidar]\nerror_y_m = 0.016\n", "calibration.toml");
   REAL_EQUAL(0.016, static_cast<double>(sc.true_lidar_mount().y_m), 1e-12);
   REAL_EQUAL(0.0, static_cast<double>(sc.lidar_mount.y_m), 0);
@@ -217,7 +219,16 @@ TEST(SimRun, AnUntoldLidarCalibrationErrorIsFoundByTheLateralSearch) {
   opt.start = &start;
   const docksim::SimRun r = docksim::run_docking(sc, "smooth", 7, opt);
   check_docked(r);
-  CHECK(r.outcome.retries >= 2);  // the first retry aims on the axis again
+  LONGS_EQUAL(1, r.outcome.retries);
+  LONGS_EQUAL(1, static_cast<long>(r.outcome.calibrations));
+  CHECK(r.outcome.last_calibration.status == dockcore::MountCalibrationStatus::kOk);
+  REAL_EQUAL(0.016, static_cast<double>(r.outcome.lidar_mount_in_use.y_m), 0.003);
+  sc.task.calibrate_mount = false;
+  const docksim::SimRun search = docksim::run_docking(sc, "smooth", 7, opt);
+  check_docked(search);
+  CHECK(search.outcome.retries >= 2);  // the first retry aims on the axis again
+  LONGS_EQUAL(0, static_cast<long>(search.outcome.calibrations));
+  REAL_EQUAL(0.0, static_cast<double>(search.outcome.lidar_mount_in_use.y_m), 0);
   sc.task.retry_lateral_step_m = 0;
   const docksim::SimRun off = docksim::run_docking(sc, "smooth", 7, opt);
   CHECK_FALSE(off.outcome.charging_confirmed);

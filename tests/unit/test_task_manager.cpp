@@ -105,6 +105,10 @@ struct Sim {
   bool chassis_ok = true, lidar_ok = true;
   double stop_short_m = 0;       // > 0: something the lidar does not see holds the front edge this far before the dock
   bool wheels_spin = false;      // held there, the wheels keep turning: odometry goes on as commanded
+  // The lidar's true mount and the one the task manager is told (plus its calibration's shift): detections are the
+  // dock seen by the true lidar, placed through the told mount, as Dockcore places them.
+  Pose2 lidar_true{0, 0, 0};
+  Pose2 lidar_configured{0, 0, 0};
   std::vector<Vec2> obstacles;   // box centres, 0.1 m boxes
   TaskOutput out;
   std::vector<TaskState> states;  // state changes in order
@@ -146,6 +150,10 @@ struct Sim {
     TaskInput in;
     in.now_us = now_us;
     in.command = cmd;
+    in.lidar_mount = lidar_configured;
+    in.lidar_mount.x_m += tm.mount_shift_m().x();
+    in.lidar_mount.y_m += tm.mount_shift_m().y();
+    const Pose2 placed = in.lidar_mount.compose(lidar_true.inverse());  // identity with both mounts at the origin
     const bool scan_tick = ticks % 5 == 0;
     if (scan_tick) {
       simulate_scan(world_model(), world, model, rng, &scan, now_us);
@@ -156,7 +164,7 @@ struct Sim {
         DetectionInput& det = in.detections[0];
         in.detection_count = 1;
         det.fresh = true;
-        det.dock_in_robot = world.inverse().compose(dock);
+        det.dock_in_robot = placed.compose(world.inverse().compose(dock));
         det.scene = scene;
         if (expectation_from_filter) {
           det.expectation_set = true;
@@ -164,7 +172,7 @@ struct Sim {
           det.expected_in_odom = dock_in_odom;
         }
         if (!outliers.empty()) {
-          det.dock_in_robot = world.inverse().compose(outliers.front());
+          det.dock_in_robot = placed.compose(world.inverse().compose(outliers.front()));
           det.scene = outlier_scene;
           outliers.erase(outliers.begin());
         }
@@ -1066,6 +1074,76 @@ TEST(TaskManager, ContactsThatDidNotStayClosedAreAMissForTheSidewaysSearch) {
   CHECK(s->run_until(TaskState::kAlign, 30));
   s->step();
   REAL_EQUAL(static_cast<double>(s->params.retry_lateral_step_m), s->ctrl.last_aim_m, 1e-9);
+}
+
+// After the first miss of the contacts the robot backs off, swings on the spot to ±calibration_swing and back (RETRY,
+// phase 1), measures from the dock's detections where its lidar sits, and moves the mount: reported once
+// (TaskOutput::mount_changed) and kept as mount_shift_m(). The next attempt follows; a second miss in the same task
+// does not swing again, and neither does a task with the swing switched off.
+TEST(TaskManager, AMissOfTheContactsIsFollowedByACalibrationSwingThatMovesTheMount) {
+  auto s = missing_sim(true);
+  s->lidar_true = dockcore_test::pose(0.05, 0.012, 0);  // 12 mm left of where it is told
+  s->lidar_configured = dockcore_test::pose(0.05, 0, 0);
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kRetry, 40));
+  double min_turn = 0, max_turn = 0;
+  int swing_ticks = 0, changed = 0;
+  double yaw0 = 0;
+  bool swinging = false;
+  while (s->out.status.state == TaskState::kRetry && s->ticks < 100000) {
+    s->step();
+    changed += s->out.mount_changed ? 1 : 0;
+    if (s->out.status.state != TaskState::kRetry || s->out.status.phase != 1) continue;
+    if (!swinging) yaw0 = static_cast<double>(s->world.yaw_rad);
+    swinging = true;
+    ++swing_ticks;
+    CHECK(s->out.cmd.vx_mps == 0);  // on the spot
+    const double turn = static_cast<double>(wrap_angle(s->world.yaw_rad - static_cast<Real>(yaw0)));
+    min_turn = turn < min_turn ? turn : min_turn;
+    max_turn = turn > max_turn ? turn : max_turn;
+  }
+  CHECK(swing_ticks > 50);
+  const double a = static_cast<double>(s->params.calibration_swing_rad);
+  REAL_EQUAL(a, max_turn, 0.03);
+  REAL_EQUAL(-a, min_turn, 0.03);
+  LONGS_EQUAL(1, changed);
+  LONGS_EQUAL(1, static_cast<long>(s->tm.calibrations()));
+  CHECK(s->tm.last_calibration().status == MountCalibrationStatus::kOk);
+  REAL_EQUAL(0.012, s->tm.mount_shift_m().y(), 0.001);
+  REAL_EQUAL(0.0, s->tm.mount_shift_m().x(), 0.001);
+  CHECK(s->out.status.state == TaskState::kReachTaskingPoint);
+  LONGS_EQUAL(1, s->out.status.retries);
+  LONGS_EQUAL(0, s->zero_violations);
+  // The second miss: backed off and straight on to the next attempt.
+  CHECK(s->run_until(TaskState::kRetry, 40));
+  CHECK(s->run_until(TaskState::kReachTaskingPoint, 30));
+  LONGS_EQUAL(1, static_cast<long>(s->tm.calibrations()));
+
+  auto off = missing_sim(true);
+  off->params.calibrate_mount = false;
+  off->reconfigure();
+  off->command(HostCommandType::kDock);
+  CHECK(off->run_until(TaskState::kRetry, 40));
+  CHECK(off->run_until(TaskState::kReachTaskingPoint, 30));
+  LONGS_EQUAL(0, static_cast<long>(off->tm.calibrations()));
+}
+
+// A swing that something stops (an obstacle where the robot's corners turn) measures nothing: the mount stays and
+// the retry goes on, with the motion stopped rather than waiting for the obstacle timeout.
+TEST(TaskManager, ASwingAnObstacleStopsChangesNothing) {
+  auto s = missing_sim(true);
+  s->lidar_true = dockcore_test::pose(0.05, 0.012, 0);
+  s->lidar_configured = dockcore_test::pose(0.05, 0, 0);
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kRetry, 40));
+  while (s->out.status.phase != 1 && s->ticks < 100000) s->step();
+  // A box at the robot's side: turning on the spot sweeps its corners into it.
+  s->obstacles.push_back(Vec2(static_cast<double>(s->world.x_m), static_cast<double>(s->world.y_m) + 0.30));
+  CHECK(s->run_until(TaskState::kReachTaskingPoint, 10));
+  LONGS_EQUAL(1, static_cast<long>(s->tm.calibrations()));
+  CHECK(s->tm.last_calibration().status == MountCalibrationStatus::kInterrupted);
+  REAL_EQUAL(0.0, s->tm.mount_shift_m().y(), 0);
+  CHECK(s->out.status.fault == FaultCode::kNone);
 }
 
 TEST(TaskManager, WithoutRememberAimEveryDockingStartsOnTheAxis) {

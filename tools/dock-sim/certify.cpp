@@ -12,6 +12,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -441,12 +442,20 @@ int run_certify(const CertifyOptions& o) {
   std::vector<docksim::SimRun> runs(n);
   std::vector<std::vector<double>> values(n);
   std::vector<std::string> errors(n);
+  // Where each robot's lidar sees its centre sideways, against the truth, m: with the configured mount, and with the
+  // mount in use at the end (moved by a calibration swing that measured, TaskParams::calibrate_mount).
+  std::vector<double> centre_err_configured(n), centre_err_in_use(n);
   docksim::SimOptions so;
   so.keep_last_scan = false;
   run_trials(n, o.jobs, [&](std::size_t t) {
     try {
       const docksim::Scenario sc = load(t, &values[t]);
       runs[t] = docksim::run_docking(sc, ctl, docksim::trial_seed(seed, t), so);
+      const double truth = static_cast<double>(sc.true_lidar_mount().inverse_transform(dockcore::Vec2(0, 0)).y());
+      centre_err_configured[t] =
+          static_cast<double>(sc.lidar_mount.inverse_transform(dockcore::Vec2(0, 0)).y()) - truth;
+      centre_err_in_use[t] =
+          static_cast<double>(runs[t].outcome.lidar_mount_in_use.inverse_transform(dockcore::Vec2(0, 0)).y()) - truth;
     } catch (const docksim::ScenarioError& e) {
       errors[t] = e.what();
     }
@@ -472,6 +481,19 @@ int run_certify(const CertifyOptions& o) {
   std::vector<std::size_t> touched;
   for (std::size_t t = 0; t < n; ++t) {
     if (runs[t].outcome.min_clearance_m < kTouchM) touched.push_back(t);
+  }
+  // The calibration swings: how many robots swung, what the swings said, and the sideways error they left.
+  int swung = 0;
+  std::map<std::string, int> swing_status;
+  std::vector<double> swing_before_mm, swing_after_mm;
+  for (std::size_t t = 0; t < n; ++t) {
+    const docksim::SimOutcome& oc = runs[t].outcome;
+    if (oc.calibrations == 0) continue;
+    ++swung;
+    ++swing_status[dockcore::to_string(oc.last_calibration.status)];
+    if (oc.last_calibration.status != dockcore::MountCalibrationStatus::kOk) continue;
+    swing_before_mm.push_back(std::fabs(centre_err_configured[t]) * 1e3);
+    swing_after_mm.push_back(std::fabs(centre_err_in_use[t]) * 1e3);
   }
   const double rate = static_cast<double>(successes) / static_cast<double>(n);
   const double lower = clopper_pearson_lower(o.trials, successes, 0.05);
@@ -533,6 +555,12 @@ int run_certify(const CertifyOptions& o) {
     j["time_to_charging_s"] = stats(s.time_s);
     j["reversals"] = s.reversals;
     j["retries"] = s.retries;
+    nlohmann::ordered_json ss = nlohmann::ordered_json::object();
+    for (const auto& kv : swing_status) ss[kv.first] = kv.second;
+    j["mount_swings"] = {{"robots", swung},
+                         {"by_status", ss},
+                         {"centre_error_before_mm", stats(swing_before_mm)},
+                         {"centre_error_after_mm", stats(swing_after_mm)}};
     j["min_clearance_m"] =
         std::isfinite(s.min_clearance_m) ? nlohmann::ordered_json(s.min_clearance_m) : nlohmann::ordered_json();
     j["obstacle_contacts"] = touched;
@@ -575,6 +603,15 @@ int run_certify(const CertifyOptions& o) {
     std::printf("reversals           %ld in %ld runs; retries %ld in %ld runs; minimum obstacle clearance %s\n",
                 s.reversals, s.runs_with_reversals, s.retries, s.runs_with_retries,
                 std::isfinite(s.min_clearance_m) ? fmt("%.3f m", s.min_clearance_m).c_str() : "- (no obstacle)");
+    std::string by_status;
+    for (const auto& kv : swing_status)
+      by_status += (by_status.empty() ? "" : ", ") + kv.first + " " + std::to_string(kv.second);
+    std::printf("mount swings        %d robots swung (%s)", swung, by_status.empty() ? "-" : by_status.c_str());
+    if (!swing_after_mm.empty()) {
+      std::printf("; their lidar's sideways error %s mm before, %s mm after (p50 / p95 / max)",
+                  triple(swing_before_mm, "%.1f").c_str(), triple(swing_after_mm, "%.1f").c_str());
+    }
+    std::printf("\n");
     std::string trials_touched;
     for (const std::size_t t : touched) trials_touched += " " + std::to_string(t);
     std::printf("obstacle contacts   %zu runs%s\n", touched.size(),

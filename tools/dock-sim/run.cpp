@@ -150,6 +150,12 @@ nlohmann::ordered_json outcome_json(const docksim::SimRun& r) {
   j["reversals"] = o.reversals;
   j["inplace_turns_45"] = o.inplace_turns_45;
   j["retries"] = o.retries;
+  j["mount_calibration"] = {{"swings", o.calibrations},
+                            {"last_status", dockcore::to_string(o.last_calibration.status)},
+                            {"last_lateral_error_m", r6(static_cast<double>(o.last_calibration.lateral_error_m))},
+                            {"mount_in_use",
+                             {{"x_m", r6(static_cast<double>(o.lidar_mount_in_use.x_m))},
+                              {"y_m", r6(static_cast<double>(o.lidar_mount_in_use.y_m))}}}};
   j["min_clearance_m"] =
       std::isfinite(o.min_clearance_m) ? nlohmann::ordered_json(r6(o.min_clearance_m)) : nlohmann::ordered_json();
   nlohmann::ordered_json f = nlohmann::ordered_json::object();
@@ -231,6 +237,17 @@ int run_one(const RunOptions& opt) {
     std::printf("  path %.2f m, reversals %d, in-place turns > 45 deg %d (largest %.0f deg), retries %d\n",
                 o.path_length_m, o.reversals, o.inplace_turns_45, o.max_inplace_turn_rad * kRadToDeg, o.retries);
     if (std::isfinite(o.min_clearance_m)) std::printf("  minimum obstacle clearance %.3f m\n", o.min_clearance_m);
+    if (o.calibrations > 0) {
+      const dockcore::MountCalibrationResult& c = o.last_calibration;
+      std::printf(
+          "  mount calibration: %u swing(s), the last %s (%u detections, sweep %.0f deg, rms %.1f mm, lidar "
+          "%+.1f mm sideways); mount in use x %+.4f y %+.4f m (configured %+.4f %+.4f, true %+.4f %+.4f)\n",
+          o.calibrations, dockcore::to_string(c.status), c.detections, static_cast<double>(c.sweep_rad) * kRadToDeg,
+          static_cast<double>(c.rms_m) * 1e3, static_cast<double>(c.lateral_error_m) * 1e3,
+          static_cast<double>(o.lidar_mount_in_use.x_m), static_cast<double>(o.lidar_mount_in_use.y_m),
+          static_cast<double>(sc.lidar_mount.x_m), static_cast<double>(sc.lidar_mount.y_m),
+          static_cast<double>(sc.true_lidar_mount().x_m), static_cast<double>(sc.true_lidar_mount().y_m));
+    }
     std::printf("  lidar intensity %s (%s: %u of %u judged scans flat)\n", dockcore::to_string(o.intensity),
                 docksim::to_string(sc.lidar.intensity_output), o.intensity_scans_flat, o.intensity_scans_judged);
     std::printf("  detector: %u scans, dock found in %u; candidates refused:", o.detector.scans, o.detector.found);

@@ -244,6 +244,9 @@ class DockcoreBase {
   std::size_t scan_copy_bytes() const { return scan_copy_bytes_; }
   const TaskManager& task_manager() const { return tasks_; }
   const DockcoreConfig& config() const { return config_; }
+  /// The lidar mount in use (robot frame): the configured one, moved sideways by the task manager's last calibration
+  /// swing that measured (TaskParams::calibrate_mount). O(1).
+  const Pose2& lidar_mount() const { return lidar_mount_; }
   /// The host sent the drive a zero command outside tick() (shutdown, a stop of its own): the next tick's
   /// acceleration limit starts from rest. O(1).
   void note_drive_stopped() {
@@ -286,6 +289,7 @@ class DockcoreBase {
   /// The attached breakpoint detector on `scan`, as an estimate of the configured profile's frame. O(beams).
   DockEstimate breakpoint_estimate(const ScanView& scan);
   DockcoreConfig config_{};
+  Pose2 lidar_mount_{};  ///< config_.lidar_mount plus the task manager's mount_shift_m().
   Odometry odometry_{};
   InputWatch watch_{};
   IntensityCheck intensity_{};

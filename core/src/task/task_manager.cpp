@@ -73,6 +73,11 @@ void TaskManager::configure(const TaskParams& params, const FootprintParams& foo
   for (Real& a : remembered_aim_m_) a = 0;
   phase_ = 0;
   have_prev_tick_ = false;
+  calibrate_next_ = calibrating_ = swung_this_task_ = false;
+  mount_shift_m_ = Vec2::Zero();
+  last_calibration_ = MountCalibrationResult{};
+  calibrations_ = 0;
+  mount_changed_ = false;
 }
 
 Real TaskManager::since_s(std::uint64_t t_us, const TaskInput& in) {
@@ -137,6 +142,8 @@ void TaskManager::enter(TaskState s, const TaskInput& in) {
   undock_backing_ = false;
   phase_ = 0;
   want_ = Twist2{};
+  calibrating_ = false;
+  if (s != TaskState::kRetry) calibrate_next_ = false;
   if (s == TaskState::kReachTaskingPoint) {
     swings_ = 0;
     swing_origin_rad_ = in.odom_pose.yaw_rad;
@@ -165,6 +172,7 @@ void TaskManager::handle_command(const TaskInput& in, TaskOutput& out) {
         fault_ = FaultCode::kNone;
         retries_ = 0;
         lateral_misses_ = 0;
+        swung_this_task_ = false;
         dock_id_ = id;
         task_since_us_ = in.now_us;
         ctrl_->reset();
@@ -252,12 +260,16 @@ bool TaskManager::run_backoff(const TaskInput& in) {
 
 void TaskManager::fail_attempt(FaultCode final_fault, const TaskInput& in, bool lateral_miss) {
   retry_reason_ = final_fault;
-  if ((lateral_miss || missed_contacts(final_fault)) && lateral_misses_ < 255) {
-    ++lateral_misses_;
-  }
+  const bool missed = lateral_miss || missed_contacts(final_fault);
+  if (missed && lateral_misses_ < 255) ++lateral_misses_;
   pending_fault_ = retries_ >= params_.max_retries ? final_fault : FaultCode::kNone;
   enter(TaskState::kRetry, in);
   start_backoff(in);
+  // A miss beside the contacts is what a lidar mounted off its configured pose causes: measure it before the next
+  // attempt. Once per task, and not again after a swing that measured: the bracket does not move, and later misses
+  // have other causes (the lidar's turn, the dock's installation), which the search and the remembered aim answer.
+  calibrate_next_ = missed && params_.calibrate_mount && !swung_this_task_ &&
+                    last_calibration_.status != MountCalibrationStatus::kOk && pending_fault_ == FaultCode::kNone;
 }
 
 void TaskManager::run_reach(const TaskInput& in) {
@@ -482,6 +494,10 @@ void TaskManager::run_finish(const TaskInput& in) {
 }
 
 void TaskManager::run_retry(const TaskInput& in) {
+  if (calibrating_) {
+    run_calibration(in);
+    return;
+  }
   if (run_backoff(in)) {
     want_ = Twist2{};
     if (pending_fault_ != FaultCode::kNone) {
@@ -490,12 +506,73 @@ void TaskManager::run_retry(const TaskInput& in) {
       raise(pending_fault_, in);
       return;
     }
-    ++retries_;
-    ctrl_->reset();
-    enter(TaskState::kReachTaskingPoint, in);
+    if (calibrate_next_) {
+      calibrate_next_ = false;
+      swung_this_task_ = true;
+      calibrating_ = true;
+      calibration_leg_ = 1;
+      calibration_origin_rad_ = in.odom_pose.yaw_rad;
+      calibration_since_us_ = in.now_us;
+      calibration_.begin(in.lidar_mount, in.odom_pose);
+      phase_ = 1;
+      return;
+    }
+    next_attempt(in);
     return;
   }
   if (since_s(state_since_us_, in) > params_.backoff_timeout_s) raise(retry_reason_, in);
+}
+
+void TaskManager::next_attempt(const TaskInput& in) {
+  ++retries_;
+  ctrl_->reset();
+  enter(TaskState::kReachTaskingPoint, in);
+}
+
+void TaskManager::run_calibration(const TaskInput& in) {
+  const std::size_t n = in.detection_count < kMaxDetectionsPerTick ? in.detection_count : kMaxDetectionsPerTick;
+  const Pose2 lidar_in_robot_inverse = in.lidar_mount.inverse();
+  for (std::size_t i = 0; i < n; ++i) {
+    const DetectionInput& d = in.detections[i];
+    if (d.fresh) calibration_.add(lidar_in_robot_inverse.compose(d.dock_in_robot), d.odom_at_scan);
+  }
+  // An obstacle stopped the turn (the previous tick), or the drive is far slower than asked: measure nothing rather
+  // than wait for the obstacle timeout on a swing the docking does not need.
+  const Real a = params_.calibration_swing_rad;
+  const Real nominal_s = params_.swing_speed_radps > 0 ? 4 * a / params_.swing_speed_radps : static_cast<Real>(0);
+  if (blocked_ || since_s(calibration_since_us_, in) > 3 * nominal_s + static_cast<Real>(2)) {
+    MountCalibrationResult r;
+    r.status = MountCalibrationStatus::kInterrupted;
+    r.mount = in.lidar_mount;
+    r.detections = calibration_.detections();
+    end_calibration(r, in);
+    return;
+  }
+  const Real target =
+      calibration_origin_rad_ + (calibration_leg_ == 1 ? a : (calibration_leg_ == 2 ? -a : static_cast<Real>(0)));
+  const Real err = wrap_angle(target - in.odom_pose.yaw_rad);
+  if (std::fabs(err) <= params_.swing_tolerance_rad) {
+    if (calibration_leg_ < 3) {
+      ++calibration_leg_;
+      return;  // one still tick between legs, as in the search's swing
+    }
+    end_calibration(calibration_.solve(params_.max_mount_correction_m), in);
+    return;
+  }
+  want_.wz_radps = err > 0 ? params_.swing_speed_radps : -params_.swing_speed_radps;
+}
+
+void TaskManager::end_calibration(const MountCalibrationResult& result, const TaskInput& in) {
+  calibrating_ = false;
+  last_calibration_ = result;
+  ++calibrations_;
+  if (result.status == MountCalibrationStatus::kOk) {
+    mount_shift_m_ += Vec2(result.mount.x_m - in.lidar_mount.x_m, result.mount.y_m - in.lidar_mount.y_m);
+    mount_changed_ = true;
+    // The remembered aims answered the old mount's error.
+    for (Real& aim : remembered_aim_m_) aim = 0;
+  }
+  next_attempt(in);
 }
 
 void TaskManager::run_undocking(const TaskInput& in) {
@@ -561,6 +638,8 @@ TaskOutput TaskManager::tick(const TaskInput& in) {
   }
 
   emit(in, out);
+  out.mount_changed = mount_changed_;
+  mount_changed_ = false;
   return out;
 }
 
@@ -594,7 +673,8 @@ void TaskManager::emit(const TaskInput& in, TaskOutput& out) {
 
   TaskStatus& s = out.status;
   s.state = state_;
-  s.phase = state_ == TaskState::kAlign ? phase_ : static_cast<std::uint8_t>(0);
+  s.phase = state_ == TaskState::kAlign || (state_ == TaskState::kRetry && calibrating_) ? phase_
+                                                                                         : static_cast<std::uint8_t>(0);
   s.fault = fault_;
   s.retries = retries_;
   s.retry_reason = state_ == TaskState::kRetry ? retry_reason_ : FaultCode::kNone;

@@ -340,6 +340,13 @@ const ParamSpec kTable[] = {
     DC_BOOL("task", "remember_aim", kBoth, task, remember_aim,
             "The aim that closed the contacts is the next docking's first aim at that dock (the search runs around "
             "it); a docking that misses them to the end forgets it."),
+    DC_BOOL("task", "calibrate_mount", kBoth, task, calibrate_mount,
+            "After the first attempt of a docking that reached the dock without the contacts closing, turn on the "
+            "spot at the staging distance, measure where the lidar sits sideways and move the mount in use by it."),
+    DC_DEG("task", "calibration_swing_deg", 5, 90, kBoth, task, calibration_swing_rad,
+           "The calibration swing turns to +this, to -this and back about the heading it starts from."),
+    DC_REAL("task", "max_mount_correction_m", "m", 0.001, 0.1, kBoth, task, max_mount_correction_m,
+            "Largest sideways move of the lidar mount a calibration swing may make; a larger measure changes nothing."),
     DC_REAL("task", "obstacle_timeout_s", "s", 0.1, 600, kBoth, task, obstacle_timeout_s,
             "Blocked this long: fault 180."),
     DC_BOOL("task", "turn_when_blocked", kBoth, task, turn_when_blocked,

@@ -769,6 +769,9 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
   out.intensity_scans_judged = core->intensity().scans_judged();
   out.intensity_scans_flat = core->intensity().scans_flat();
   out.detector = core->estimator().counters();
+  out.calibrations = core->task_manager().calibrations();
+  out.last_calibration = core->task_manager().last_calibration();
+  out.lidar_mount_in_use = core->lidar_mount();
   const ChassisState& fs = chassis.state();
   out.end_time_s = static_cast<double>(k) * dt;
   out.final_state = prev_state;

@@ -17,6 +17,7 @@
 #include "dockcore/geometry.hpp"
 #include "dockcore/laser_scan.hpp"
 #include "dockcore/perception/dock_profile.hpp"
+#include "dockcore/perception/mount_calibration.hpp"
 #include "dockcore/perception/scene_check.hpp"
 #include "dockcore/task/faults.hpp"
 
@@ -152,6 +153,17 @@ struct TaskParams {
   /// docking. A docking that ends in 188/190 after missing the contacts forgets its dock's aim. Kept until
   /// configure().
   bool remember_aim = true;
+  /// Measure where the lidar sits sideways on the robot (MountCalibration, docs/task-manager.md "Mount calibration")
+  /// after the first attempt of a docking that reached the dock without the contacts closing (188, 190, or contacts
+  /// that closed and did not stay closed) and has a retry left: backed off to the staging distance, the robot turns on
+  /// the spot to +calibration_swing_rad, to −calibration_swing_rad and back at swing_speed_radps, and the lidar mount
+  /// dockcore uses moves sideways by what the swing measured (at most max_mount_correction_m). The move is kept until
+  /// configure(), and no further swing runs once one has measured; the remembered aims (remember_aim) are forgotten
+  /// with it, since they answered the old mount. A swing an obstacle stops, or whose measure fails a check, changes
+  /// nothing and the retry goes on as before (the next docking that misses swings again).
+  bool calibrate_mount = true;
+  Real calibration_swing_rad = deg_to_rad(static_cast<Real>(25));  ///< Swing to ±this about the heading, rad.
+  Real max_mount_correction_m = static_cast<Real>(0.03);           ///< Largest sideways move a swing may make, m (> 0).
   // Backing off (RETRY, UNDOCKING).
   Real staging_distance_m = static_cast<Real>(0.6);   ///< Back off until the robot centre is this far from the dock.
   Real fallback_backoff_m = static_cast<Real>(0.3);   ///< Without a dock estimate: back off this far on odometry.
@@ -239,7 +251,7 @@ struct TaskInput {
 /// The status frame content for the host (CAN/UDP).
 struct TaskStatus {
   TaskState state = TaskState::kNotTasking;
-  std::uint8_t phase = 0;          ///< Controller phase in ALIGN, else 0.
+  std::uint8_t phase = 0;  ///< Controller phase in ALIGN; 1 in RETRY while the mount calibration swings; else 0.
   FaultCode fault = FaultCode::kNone;
   std::uint8_t retries = 0;        ///< Retries used in the current/last task.
   /// In RETRY: why the attempt ended (kAlignFailed: the controller gave up, e.g. pressed without contact;
@@ -268,6 +280,9 @@ struct TaskOutput {
   bool target_lost = false;         ///< ALIGN is holding because the estimate is stale or the controller lost it.
   ObstacleFlags obstacles{};        ///< Obstacle check of this tick (valid = false when none was needed).
   ControlStatus control = ControlStatus::kRunning;  ///< Controller status this tick (ALIGN only).
+  /// A calibration swing moved the lidar mount on this tick (TaskManager::mount_shift_m()): estimates made with the
+  /// old mount are that far off.
+  bool mount_changed = false;
 };
 
 class TaskManager {
@@ -300,6 +315,13 @@ class TaskManager {
   /// Time spent in the final push so far, s (at the last tick); that of the last push once ALIGN has ended, 0
   /// before any. O(1).
   Real push_elapsed_s() const { return push_elapsed_s_; }
+  /// What to add to the configured lidar mount's x and y (robot frame), m: the last calibration swing that measured
+  /// (TaskParams::calibrate_mount). Zero after configure(). O(1).
+  const Vec2& mount_shift_m() const { return mount_shift_m_; }
+  /// The last calibration swing's result; status kNone before any since configure(). O(1).
+  const MountCalibrationResult& last_calibration() const { return last_calibration_; }
+  /// Calibration swings ended since configure(), whatever their result. O(1).
+  std::uint32_t calibrations() const { return calibrations_; }
   FaultCode fault() const { return fault_; }
   const TaskParams& params() const { return params_; }
   const ObstacleChecker& obstacle_checker() const { return obstacles_; }
@@ -318,6 +340,12 @@ class TaskManager {
   void run_wait_for_charge(const TaskInput& in);
   void run_finish(const TaskInput& in);
   void run_retry(const TaskInput& in);
+  /// The next attempt: counts the retry and starts the search (REACH_TASKING_POINT).
+  void next_attempt(const TaskInput& in);
+  /// The calibration swing (RETRY, after the back-off): collects this tick's detections, turns, and at its end
+  /// measures and moves the mount.
+  void run_calibration(const TaskInput& in);
+  void end_calibration(const MountCalibrationResult& result, const TaskInput& in);
   void run_undocking(const TaskInput& in);
   /// Attempt failed (charge not confirmed, contacts not reached, controller failure): back off, then retry or fault
   /// with `final_fault`. A miss of the contacts (188, 190, or `lateral_miss`: they closed and did not stay closed)
@@ -395,6 +423,18 @@ class TaskManager {
   FaultCode retry_reason_ = FaultCode::kNone;   // why the current attempt failed
   bool undock_backing_ = false;
   std::uint64_t backoff_since_us_ = 0;
+  // Mount calibration (RETRY).
+  MountCalibration calibration_{};
+  bool calibrate_next_ = false;       // the current back-off ends in a calibration swing
+  bool calibrating_ = false;          // the swing runs
+  bool swung_this_task_ = false;      // one swing per docking task
+  std::uint8_t calibration_leg_ = 0;  // 1 to +A, 2 to −A, 3 back to the origin
+  Real calibration_origin_rad_ = 0;
+  std::uint64_t calibration_since_us_ = 0;
+  Vec2 mount_shift_m_ = Vec2::Zero();
+  MountCalibrationResult last_calibration_{};
+  std::uint32_t calibrations_ = 0;
+  bool mount_changed_ = false;  // reported in this tick's output
   Real dt_s_ = 0;
 };
 

@@ -124,6 +124,11 @@ struct SimOutcome {
   /// The dock estimator's counters at the end (scans, found, candidates refused by reason): why a dock was or was
   /// not taken.
   dockcore::EstimatorCounters detector{};
+  /// The task manager's mount calibration at the end: swings ended, the last one's result, and the lidar mount in
+  /// use (the configured one moved by the swings that measured; TaskParams::calibrate_mount).
+  std::uint32_t calibrations = 0;
+  dockcore::MountCalibrationResult last_calibration{};
+  dockcore::Pose2 lidar_mount_in_use{};
 };
 
 struct SimRun {
