@@ -97,10 +97,13 @@ std::size_t Daemon::status_json(char* buf, std::size_t size, std::uint64_t now_u
 }
 
 void Daemon::status_fields(JsonWriter& w, std::uint64_t now_us) const {
-  write_status(w, status_values(now_us));
-  // The camera's groups go in only when they fit (the status must stay one datagram); each is dropped whole. The
-  // camera part of the status (camera_fields) always has them.
+  const StatusValues v = status_values(now_us);
+  write_status(w, v);
+  // The camera's groups, then the mount calibration, go in only when they fit (the status must stay one datagram);
+  // each is dropped whole. The camera part of the status (camera_fields) always has the camera's, the counters part
+  // the mount calibration.
   write_camera_groups(w, camera_values(), true);
+  w.optional_group([&] { write_mount(w, v); });
 }
 
 void Daemon::camera_fields(JsonWriter& w) const {
@@ -108,7 +111,9 @@ void Daemon::camera_fields(JsonWriter& w) const {
 }
 
 void Daemon::counter_fields(JsonWriter& w, std::uint64_t now_us) const {
-  write_counters(w, status_values(now_us));
+  const StatusValues v = status_values(now_us);
+  write_counters(w, v);
+  write_mount(w, v);
 }
 
 StatusValues Daemon::status_values(std::uint64_t now_us) const {
@@ -158,6 +163,10 @@ StatusValues Daemon::status_values(std::uint64_t now_us) const {
     v.deadband_rev_radps[i] = static_cast<double>(db.floor_radps(i, true));
   }
   v.deadband_raises = db.raises();
+  v.mount_swings = core_->task_manager().calibrations();
+  v.mount_calibration = dockcore::to_string(core_->task_manager().last_calibration().status);
+  v.mount_x_m = static_cast<double>(core_->lidar_mount().x_m);
+  v.mount_y_m = static_cast<double>(core_->lidar_mount().y_m);
   v.teaching = teach_.active();
   v.taught = state_.find(s.dock_id) != nullptr;
   v.ticks = stats_.ticks;

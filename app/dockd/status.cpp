@@ -75,6 +75,13 @@ void write_status(JsonWriter& w, const StatusValues& v) {
   w.optional_group([&] { write_counters(w, v); });
 }
 
+void write_mount(JsonWriter& w, const StatusValues& v) {
+  w.uint("mount_swings", v.mount_swings)
+      .str("mount_calibration", v.mount_calibration)
+      .real("mount_x_m", reading(v.mount_x_m), 4)
+      .real("mount_y_m", reading(v.mount_y_m), 4);
+}
+
 void write_counters(JsonWriter& w, const StatusValues& v) {
   w.uint("ticks", v.ticks)
       .uint("tick_worst_us", v.tick_worst_us)

@@ -46,6 +46,9 @@ struct StatusValues {
   double deadband_fwd_radps[dockcore::kMaxDriveWheels] = {};
   double deadband_rev_radps[dockcore::kMaxDriveWheels] = {};
   std::uint32_t deadband_raises = 0;
+  std::uint32_t mount_swings = 0;       ///< Calibration swings ended since the core was configured.
+  const char* mount_calibration = "";   ///< The last swing's result (MountCalibrationStatus name).
+  double mount_x_m = 0, mount_y_m = 0;  ///< The lidar mount in use (the configured one moved by the swing).
   bool teaching = false, taught = false;
   std::uint64_t ticks = 0, tick_worst_us = 0, tick_overruns = 0, tick_work_worst_us = 0;
   std::uint32_t scans = 0, detections = 0;
@@ -85,6 +88,11 @@ void write_status(JsonWriter& w, const StatusValues& v);
 /// Writes the counters of `v` (ticks, scans, lidar, CAN, host commands, reloads): the status's counters part, and
 /// the group the main status drops when full. O(bytes written).
 void write_counters(JsonWriter& w, const StatusValues& v);
+
+/// Writes the task manager's lidar mount calibration of `v`: swings, the last one's result and the mount in use (in
+/// the counters part after the counters; dockd adds it to the main status after the camera groups when it fits).
+/// O(bytes written).
+void write_mount(JsonWriter& w, const StatusValues& v);
 
 /// Writes the camera groups present in `v`; with `only_if_fits` each group that does not fit `w` is left out whole
 /// (and `w` stays ok). O(bytes written).

@@ -189,14 +189,15 @@ TEST(DockdCamera, TagPosesReachTheCoreAndAreCountedInTheStatus) {
   CameraRig r(nullptr, 3);
   char st[dockcore::drivers::kMaxHostReply];
   r.daemon->status_json(st, sizeof st, 0);
-  STRCMP_CONTAINS(",\"tag_fused\":0,\"tag_refused\":[0,0,0,0,0,0,0,0]}", st);
+  // The tag counters, then the lidar mount calibration (the status's last group).
+  STRCMP_CONTAINS(",\"tag_fused\":0,\"tag_refused\":[0,0,0,0,0,0,0,0],\"mount_swings\":0,", st);
   // The active dock's tag, another dock's tag, the same frame again.
   r.tags.put(3, r.clock.t - 30000);
   r.tags.put(5, r.clock.t - 20000);
   r.tags.put(3, r.clock.t - 30000);
   r.daemon->on_camera_readable(r.clock.t);
   r.daemon->status_json(st, sizeof st, 0);
-  STRCMP_CONTAINS(",\"tag_fused\":1,\"tag_refused\":[1,0,0,0,0,0,1,0]}", st);
+  STRCMP_CONTAINS(",\"tag_fused\":1,\"tag_refused\":[1,0,0,0,0,0,1,0],", st);
   // A dock without a tag refuses every tag as another dock's.
   CameraRig none(nullptr, -1);
   none.tags.put(3, none.clock.t);

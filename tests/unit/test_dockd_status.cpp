@@ -42,7 +42,10 @@ struct FakeActions final : dockd::HostActions {
     dockd::write_camera_groups(w, camera, true);
   }
   void camera_fields(dockd::JsonWriter& w) const override { dockd::write_camera_groups(w, camera, false); }
-  void counter_fields(dockd::JsonWriter& w, std::uint64_t) const override { dockd::write_counters(w, status); }
+  void counter_fields(dockd::JsonWriter& w, std::uint64_t) const override {
+    dockd::write_counters(w, status);
+    dockd::write_mount(w, status);
+  }
   const dockd::DockdConfig& config() const override { return cfg; }
   std::uint16_t active_dock_id() const override { return 0; }
   dockcore::SubmitResult submit(dockcore::HostCommandType, std::uint16_t, std::uint32_t, std::uint32_t&) override {
@@ -119,6 +122,10 @@ StatusValues worst_status() {
   v.wheels = dockcore::kMaxDriveWheels;
   for (std::size_t i = 0; i < dockcore::kMaxDriveWheels; ++i) v.deadband_fwd_radps[i] = v.deadband_rev_radps[i] = r;
   v.deadband_raises = max_of(v.deadband_raises);
+  v.mount_swings = max_of(v.mount_swings);
+  v.mount_calibration = longest_name<std::uint8_t>(
+      [](std::uint8_t i) { return dockcore::to_string(static_cast<dockcore::MountCalibrationStatus>(i)); });
+  v.mount_x_m = v.mount_y_m = r;
   v.ticks = v.tick_worst_us = v.tick_overruns = v.tick_work_worst_us = max_of(v.ticks);
   v.scans = v.detections = max_of(v.scans);
   v.lidar_crc_errors = v.lidar_resyncs = v.lidar_dropped_bytes = v.lidar_foreign_datagrams = max_of(v.scans);
