@@ -115,14 +115,17 @@ constexpr std::uint64_t kFamilySalt = 0x63657274696679ull;  // the family's own 
 
 /// Writes one CSV row per trial: its index, whether the outcome was right, charging confirmed, the cause when not
 /// right, the pads' signed errors at the contacts (mm, mm, deg; empty when charging was not confirmed), time to
-/// charging, reversals and retries, then every factor's drawn value (empty when the trial did not draw it). What a
-/// user needs to see which factors drive the contact errors, not only the failures. False when the file cannot be
-/// written.
+/// charging, reversals and retries, the mount calibration (swings, the last one's result, and the robot's centre as
+/// the lidar sees it, signed mm beside the truth, through the configured mount and through the mount in use at the
+/// end), then every factor's drawn value (empty when the trial did not draw it). What a user needs to see which
+/// factors drive the contact errors, not only the failures. False when the file cannot be written.
 bool write_trials_csv(const std::string& path, const std::vector<docksim::SimRun>& runs,
                       const std::vector<std::vector<double>>& values, const std::vector<bool>& ok,
-                      const std::function<std::string(std::size_t)>& cause) {
+                      const std::function<std::string(std::size_t)>& cause,
+                      const std::vector<double>& centre_configured_m, const std::vector<double>& centre_in_use_m) {
   std::ofstream out(path, std::ios::binary);
-  out << "trial,right,charging_confirmed,cause,lateral_mm,longitudinal_mm,yaw_deg,time_to_charging_s,reversals,retries";
+  out << "trial,right,charging_confirmed,cause,lateral_mm,longitudinal_mm,yaw_deg,time_to_charging_s,reversals,retries,"
+         "mount_swings,mount_calibration,centre_error_configured_mm,centre_error_in_use_mm";
   for (const Factor& f : kFactors) out << "," << f.table << "." << f.key;
   out << "\n";
   auto num = [](double v, const char* format) { return std::isfinite(v) ? fmt(format, v) : std::string(); };
@@ -133,7 +136,9 @@ bool write_trials_csv(const std::string& path, const std::vector<docksim::SimRun
         << (docked ? fmt("%.2f", oc.lateral_m * 1e3) : "") << ","
         << (docked ? fmt("%.2f", oc.longitudinal_m * 1e3) : "") << ","
         << (docked ? fmt("%.3f", oc.yaw_rad * kRadToDeg) : "") << "," << num(oc.time_to_charging_s, "%.2f") << ","
-        << oc.reversals << "," << oc.retries;
+        << oc.reversals << "," << oc.retries << "," << oc.calibrations << ","
+        << (oc.calibrations > 0 ? dockcore::to_string(oc.last_calibration.status) : "") << ","
+        << fmt("%.2f", centre_configured_m[t] * 1e3) << "," << fmt("%.2f", centre_in_use_m[t] * 1e3);
     for (std::size_t i = 0; i < kFactorCount; ++i) out << "," << num(values[t][i], "%.6g");
     out << "\n";
   }
@@ -662,7 +667,7 @@ int run_certify(const CertifyOptions& o) {
         },
         false);
   }
-  if (!o.csv.empty() && !write_trials_csv(o.csv, runs, values, ok, cause)) {
+  if (!o.csv.empty() && !write_trials_csv(o.csv, runs, values, ok, cause, centre_err_configured, centre_err_in_use)) {
     std::cerr << "dock-sim certify: cannot write " << o.csv << "\n";
     return 2;
   }
