@@ -508,13 +508,7 @@ void TaskManager::run_retry(const TaskInput& in) {
     }
     if (calibrate_next_) {
       calibrate_next_ = false;
-      swung_this_task_ = true;
-      calibrating_ = true;
-      calibration_leg_ = 1;
-      calibration_origin_rad_ = in.odom_pose.yaw_rad;
-      calibration_since_us_ = in.now_us;
-      calibration_.begin(in.lidar_mount, in.odom_pose);
-      phase_ = 1;
+      start_calibration(in);
       return;
     }
     next_attempt(in);
@@ -527,6 +521,16 @@ void TaskManager::next_attempt(const TaskInput& in) {
   ++retries_;
   ctrl_->reset();
   enter(TaskState::kReachTaskingPoint, in);
+}
+
+void TaskManager::start_calibration(const TaskInput& in) {
+  swung_this_task_ = true;
+  calibrating_ = true;
+  calibration_leg_ = 1;
+  calibration_origin_rad_ = in.odom_pose.yaw_rad;
+  calibration_since_us_ = in.now_us;
+  calibration_.begin(in.lidar_mount, in.odom_pose);
+  phase_ = 1;
 }
 
 void TaskManager::run_calibration(const TaskInput& in) {
@@ -673,8 +677,7 @@ void TaskManager::emit(const TaskInput& in, TaskOutput& out) {
 
   TaskStatus& s = out.status;
   s.state = state_;
-  s.phase = state_ == TaskState::kAlign || (state_ == TaskState::kRetry && calibrating_) ? phase_
-                                                                                         : static_cast<std::uint8_t>(0);
+  s.phase = state_ == TaskState::kAlign || calibrating_ ? phase_ : static_cast<std::uint8_t>(0);
   s.fault = fault_;
   s.retries = retries_;
   s.retry_reason = state_ == TaskState::kRetry ? retry_reason_ : FaultCode::kNone;

@@ -342,8 +342,9 @@ class TaskManager {
   void run_retry(const TaskInput& in);
   /// The next attempt: counts the retry and starts the search (REACH_TASKING_POINT).
   void next_attempt(const TaskInput& in);
-  /// The calibration swing (RETRY, after the back-off): collects this tick's detections, turns, and at its end
-  /// measures and moves the mount.
+  /// Starts the calibration swing where the robot stands (RETRY, after the back-off).
+  void start_calibration(const TaskInput& in);
+  /// The calibration swing: collects this tick's detections, turns, and at its end measures and moves the mount.
   void run_calibration(const TaskInput& in);
   void end_calibration(const MountCalibrationResult& result, const TaskInput& in);
   void run_undocking(const TaskInput& in);
