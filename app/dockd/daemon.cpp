@@ -120,7 +120,12 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
   core_cfg_.tag.dock_tag = tag;
   core_cfg_.detector = d->detector;
   if (loop_record_) loop_record_->configure(loop_controller(), prof, core_cfg_);
+  // What the core learned about the robot — the wheels' deadband floors, the lidar mount's calibration, the aim that
+  // closed each dock's contacts — belongs to the robot, not to the dock: it goes on into the new configuration. A
+  // reload builds a new core, which starts afresh (dock-sim replay does the same).
+  const dockcore::DockcoreBase::Learned learned = core_->learned();
   if (!core_->configure(prof, core_cfg_)) return false;
+  core_->restore_learned(learned);
   active_dock_ = dock_id;
   active_raw_ = raw_profile;
   if (loop_record_) loop_record_->rescan();

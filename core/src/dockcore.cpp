@@ -93,6 +93,25 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
   return true;
 }
 
+DockcoreBase::Learned DockcoreBase::learned() const {
+  Learned l;
+  l.deadband = deadband_;
+  l.task = tasks_.learned();
+  return l;
+}
+
+void DockcoreBase::restore_learned(const Learned& l) {
+  deadband_.restore_floors(l.deadband);
+  tasks_.restore_learned(l.task);
+  take_mount_shift();
+}
+
+void DockcoreBase::take_mount_shift() {
+  lidar_mount_ = config_.lidar_mount;
+  lidar_mount_.x_m += tasks_.mount_shift_m().x();
+  lidar_mount_.y_m += tasks_.mount_shift_m().y();
+}
+
 DockEstimate DockcoreBase::breakpoint_estimate(const ScanView& scan) {
   DockEstimate e;
   Pose2 native_in_dock;
@@ -409,9 +428,7 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
     // The calibration swing moved the lidar: the filter's dock, the room's reference and the push test's references
     // were all placed through the old mount, centimetres off now. The robot stands at the staging distance and the
     // next attempt starts with a search, which the next detection answers.
-    lidar_mount_ = config_.lidar_mount;
-    lidar_mount_.x_m += tasks_.mount_shift_m().x();
-    lidar_mount_.y_m += tasks_.mount_shift_m().y();
+    take_mount_shift();
     filter_.reset();
     filter_confirmed_ = false;
     scene_.clear();

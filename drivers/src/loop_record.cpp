@@ -314,6 +314,10 @@ ReplayResult replay_loop_record(const std::string& path) {
         read_as(p, 0, &ctl);
         read_as(p, sizeof ctl, &profile);
         read_as(p, sizeof ctl + sizeof profile, &config);
+        // dockd carries what a core learned into its next configuration; a rebuilt core starts afresh.
+        const bool carry = rc && !rebuild;
+        DockcoreBase::Learned learned;
+        if (carry) learned = rc->core->learned();
         if (!rc || rebuild) {
           auto next = std::make_unique<ReplayCore>(ctl);
           const std::string name(ctl.name, strnlen(ctl.name, sizeof ctl.name));
@@ -328,7 +332,7 @@ ReplayResult replay_loop_record(const std::string& path) {
           rc->breakpoint = std::make_unique<BreakpointDetector>();
           rc->core->attach_breakpoint(rc->breakpoint.get());
         }
-        rc->core->configure(profile, config);
+        if (rc->core->configure(profile, config) && carry) rc->core->restore_learned(learned);
         break;
       }
       case LoopRecordKind::kTakeInputs:

@@ -1118,6 +1118,15 @@ TEST(TaskManager, AMissOfTheContactsIsFollowedByACalibrationSwingThatMovesTheMou
   CHECK(s->run_until(TaskState::kRetry, 40));
   CHECK(s->run_until(TaskState::kReachTaskingPoint, 30));
   LONGS_EQUAL(1, static_cast<long>(s->tm.calibrations()));
+  // configure() forgets the measure; a host configuring for another dock hands it back (TaskLearned).
+  const TaskLearned learned = s->tm.learned();
+  s->reconfigure();
+  REAL_EQUAL(0.0, s->tm.mount_shift_m().y(), 0);
+  CHECK(s->tm.last_calibration().status == MountCalibrationStatus::kNone);
+  s->tm.restore_learned(learned);
+  REAL_EQUAL(0.012, s->tm.mount_shift_m().y(), 0.001);
+  CHECK(s->tm.last_calibration().status == MountCalibrationStatus::kOk);
+  LONGS_EQUAL(1, static_cast<long>(s->tm.calibrations()));
 
   auto off = missing_sim(true);
   off->params.calibrate_mount = false;
@@ -1144,6 +1153,27 @@ TEST(TaskManager, ASwingAnObstacleStopsChangesNothing) {
   CHECK(s->tm.last_calibration().status == MountCalibrationStatus::kInterrupted);
   REAL_EQUAL(0.0, s->tm.mount_shift_m().y(), 0);
   CHECK(s->out.status.fault == FaultCode::kNone);
+}
+
+// The remembered aims go on into another configuration with the learned state (not with remember_aim off).
+TEST(TaskManager, RememberedAimsSurviveAReconfigurationWhenHandedBack) {
+  auto s = missing_sim(true);
+  s->params.calibrate_mount = false;
+  s->reconfigure();
+  const double step_m = static_cast<double>(s->params.retry_lateral_step_m);
+  dock_on_the_third_attempt(*s, 3);
+  undock(*s);
+  const TaskLearned learned = s->tm.learned();
+  REAL_EQUAL(step_m, learned.remembered_aim_m[3], 1e-9);
+  s->reconfigure();
+  s->tm.restore_learned(learned);
+  REAL_EQUAL(step_m, first_aim(*s, 3), 1e-9);
+  CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  undock(*s);
+  s->params.remember_aim = false;
+  s->reconfigure();
+  s->tm.restore_learned(learned);
+  REAL_EQUAL(0.0, first_aim(*s, 3), 0);
 }
 
 TEST(TaskManager, WithoutRememberAimEveryDockingStartsOnTheAxis) {
@@ -1634,6 +1664,26 @@ TEST(Dockcore, DocksWithTheRealEstimatorAndFilter) {
   LONGS_EQUAL(0, f.w.zero_violations);
   printf("\nsizeof(Dockcore) = %zu, TaskManager = %zu, DockPoseEstimator = %zu, LaserScan = %zu\n", sizeof(Dockcore),
          sizeof(TaskManager), sizeof(DockPoseEstimator), sizeof(LaserScan));
+}
+
+// The learned state handed back after configure() moves the lidar mount in use by the calibration's shift, and keeps
+// the deadband floors.
+TEST(Dockcore, LearnedStateHandedBackAfterConfigureMovesTheMount) {
+  FacadeSim f;
+  DockcoreBase::Learned l = f.core->learned();
+  l.task.mount_shift_m = Vec2(static_cast<Real>(0.002), static_cast<Real>(-0.011));
+  l.task.last_calibration.status = MountCalibrationStatus::kOk;
+  DockcoreConfig cfg = f.core->config();
+  cfg.lidar_mount = dockcore_test::pose(0.05, 0.01, 0.1);
+  CHECK(f.core->configure(f.w.profile, cfg));
+  REAL_EQUAL(0.01, f.core->lidar_mount().y_m, 1e-9);
+  f.core->restore_learned(l);
+  REAL_EQUAL(0.052, f.core->lidar_mount().x_m, 1e-6);
+  REAL_EQUAL(-0.001, f.core->lidar_mount().y_m, 1e-6);
+  REAL_EQUAL(0.1, f.core->lidar_mount().yaw_rad, 1e-6);
+  CHECK(f.core->task_manager().last_calibration().status == MountCalibrationStatus::kOk);
+  CHECK(f.core->configure(f.w.profile, cfg));  // a plain configure forgets it
+  REAL_EQUAL(0.01, f.core->lidar_mount().y_m, 1e-9);
 }
 
 TEST(Dockcore, ScanIsCopiedOnceAndRescanAfterConfigureCopiesNothing) {

@@ -141,6 +141,39 @@ TEST(WheelDeadband, FloorsGrowStepByStepUpToTheBoundAndConfigureForgetsThem) {
   LONGS_EQUAL(0, d.raises());
 }
 
+// What a drive taught one configuration goes on into the next (dockd configuring the core for another dock): the
+// floors and their count, clamped as configure() clamps the known deadband; a stall in progress is not carried.
+TEST(WheelDeadband, RestoredFloorsAreTheLearnedOnesWithinThisConfigurationsBounds) {
+  WheelDeadbandParams p;
+  p.stall_ms = 250;
+  WheelDeadband taught;
+  taught.configure(p);
+  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  std::uint64_t t = hold(taught, cmd, wheels(0, static_cast<Real>(0.6)), 0, 300);  // the left wheel stands
+  LONGS_EQUAL(1, taught.raises());
+  DOUBLES_EQUAL(0.75, static_cast<double>(taught.floor_radps(0, false)), kTol);
+  hold(taught, cmd, wheels(0, static_cast<Real>(0.6)), t, 200);  // standing again: a stall in progress
+
+  WheelDeadband next;
+  next.configure(p);
+  next.restore_floors(taught);
+  DOUBLES_EQUAL(0.75, static_cast<double>(next.floor_radps(0, false)), kTol);
+  DOUBLES_EQUAL(0.0, static_cast<double>(next.floor_radps(1, false)), kTol);
+  LONGS_EQUAL(1, next.raises());
+  // The carried stall would have raised the floor 60 ms from now; a fresh one needs its whole stall_ms.
+  t = hold(next, wheels(static_cast<Real>(0.75), static_cast<Real>(0.75)), wheels(0, static_cast<Real>(0.75)), t, 200);
+  LONGS_EQUAL(1, next.raises());
+
+  WheelDeadbandParams bounded = p;
+  bounded.known_radps = static_cast<Real>(0.3);
+  bounded.max_radps = static_cast<Real>(0.7);
+  WheelDeadband clamped;
+  clamped.configure(bounded);
+  clamped.restore_floors(taught);
+  DOUBLES_EQUAL(0.7, static_cast<double>(clamped.floor_radps(0, false)), kTol);  // at most max_radps
+  DOUBLES_EQUAL(0.3, static_cast<double>(clamped.floor_radps(1, false)), kTol);  // at least the known deadband
+}
+
 TEST(WheelDeadband, ACommandAtItsFloorUpToRoundingStillStalls) {
   WheelDeadbandParams p;
   p.known_radps = static_cast<Real>(0.75);

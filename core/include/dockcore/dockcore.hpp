@@ -164,6 +164,18 @@ class DockcoreBase {
   /// docks and configurations (rescan() runs that scan through the new profile). False (unusable until a good call)
   /// when the profile has no segments or config.detector cannot run on it (configure_status() says which). O(vertices).
   bool configure(const DockProfile& profile, const DockcoreConfig& config);
+
+  /// What the core learned about the robot while docking — the wheels' deadband floors and the task manager's
+  /// TaskLearned (the lidar mount's calibration, the aims that closed each dock's contacts) — which configure()
+  /// forgets. O(kDockIds).
+  struct Learned {
+    WheelDeadband deadband{};
+    TaskLearned task{};
+  };
+  Learned learned() const;
+  /// Takes `l` after configure() (for another dock, or a teach, on the same robot and configuration): the floors,
+  /// the aims, and the lidar mount moved by the calibration's shift. O(kDockIds).
+  void restore_learned(const Learned& l);
   /// What the last configure() decided (kOk before the first). O(1).
   ConfigureStatus configure_status() const { return configure_status_; }
   /// The BreakpointDetector docks configured with DockDetector::kBreakpoint run (nullptr: none; such a configure()
@@ -274,6 +286,8 @@ class DockcoreBase {
   ~DockcoreBase() = default;
 
  private:
+  /// The lidar mount in use: the configured one moved by the task manager's mount_shift_m().
+  void take_mount_shift();
   /// Fills out->drive_cmd and out->wheels from out->cmd (file comment). O(1).
   void shape(bool hold, TickOutput* out);
   /// Hands the deadband the last command and the measured wheel speeds; `state` is the task's state that command was

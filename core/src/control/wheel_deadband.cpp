@@ -13,6 +13,19 @@ void WheelDeadband::configure(const WheelDeadbandParams& params) {
   raises_ = 0;
 }
 
+void WheelDeadband::restore_floors(const WheelDeadband& learned) {
+  const Real known = params_.known_radps > 0 ? params_.known_radps : 0;
+  for (std::size_t i = 0; i < kMaxDriveWheels; ++i) {
+    for (std::size_t d = 0; d < 2; ++d) {
+      Real f = learned.floor_radps_[i][d] > known ? learned.floor_radps_[i][d] : known;
+      if (params_.adapt && f > params_.max_radps) f = params_.max_radps > 0 ? params_.max_radps : 0;
+      floor_radps_[i][d] = f;
+    }
+    stall_[i] = Stall{};
+  }
+  raises_ = learned.raises_;
+}
+
 Real WheelDeadband::scale(const DriveGeometry& geometry, const DriveLimits& limits, const Twist2& twist) const {
   const WheelSpeeds w = twist_to_wheels(geometry, twist);
   Real fastest = 0;

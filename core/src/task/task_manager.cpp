@@ -80,6 +80,22 @@ void TaskManager::configure(const TaskParams& params, const FootprintParams& foo
   mount_changed_ = false;
 }
 
+TaskLearned TaskManager::learned() const {
+  TaskLearned l;
+  for (std::size_t i = 0; i < kDockIds; ++i) l.remembered_aim_m[i] = remembered_aim_m_[i];
+  l.mount_shift_m = mount_shift_m_;
+  l.last_calibration = last_calibration_;
+  l.calibrations = calibrations_;
+  return l;
+}
+
+void TaskManager::restore_learned(const TaskLearned& l) {
+  for (std::size_t i = 0; i < kDockIds; ++i) remembered_aim_m_[i] = params_.remember_aim ? l.remembered_aim_m[i] : 0;
+  mount_shift_m_ = l.mount_shift_m;
+  last_calibration_ = l.last_calibration;
+  calibrations_ = l.calibrations;
+}
+
 Real TaskManager::since_s(std::uint64_t t_us, const TaskInput& in) {
   if (in.now_us <= t_us) return 0;
   return static_cast<Real>(in.now_us - t_us) * static_cast<Real>(1e-6);

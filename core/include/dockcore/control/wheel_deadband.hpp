@@ -65,6 +65,10 @@ class WheelDeadband {
   Real floor_radps(std::size_t wheel, bool reverse) const { return floor_radps_[wheel][reverse ? 1 : 0]; }
   /// Times a floor grew since configure(). O(1).
   std::uint32_t raises() const { return raises_; }
+  /// Takes `learned`'s floors and raise count (not any stall in progress): what a drive taught one configuration,
+  /// kept across another (the wheels are the same). Each floor is clamped as configure() clamps the starting one, and
+  /// never lowered below this configuration's known deadband. O(wheels).
+  void restore_floors(const WheelDeadband& learned);
 
  private:
   struct Stall {

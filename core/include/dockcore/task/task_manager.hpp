@@ -285,6 +285,16 @@ struct TaskOutput {
   bool mount_changed = false;
 };
 
+/// What the task manager learned about the robot and its docks while docking, which configure() forgets: the lidar
+/// mount's calibration and the aim that closed each dock's contacts. A host that configures the core for another dock
+/// (or for a teach) hands it back (TaskManager::restore_learned) so the robot need not learn it again.
+struct TaskLearned {
+  Real remembered_aim_m[kDockIds] = {};
+  Vec2 mount_shift_m = Vec2::Zero();
+  MountCalibrationResult last_calibration{};
+  std::uint32_t calibrations = 0;
+};
+
 class TaskManager {
  public:
   /// `controller` must outlive this object; it is reset() at the start of every attempt.
@@ -322,6 +332,10 @@ class TaskManager {
   const MountCalibrationResult& last_calibration() const { return last_calibration_; }
   /// Calibration swings ended since configure(), whatever their result. O(1).
   std::uint32_t calibrations() const { return calibrations_; }
+  /// The learned state (TaskLearned). O(kDockIds).
+  TaskLearned learned() const;
+  /// Takes `l` as this configuration's learned state (after configure(), before a task runs). O(kDockIds).
+  void restore_learned(const TaskLearned& l);
   FaultCode fault() const { return fault_; }
   const TaskParams& params() const { return params_; }
   const ObstacleChecker& obstacle_checker() const { return obstacles_; }
