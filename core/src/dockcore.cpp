@@ -106,6 +106,15 @@ void DockcoreBase::restore_learned(const Learned& l) {
   take_mount_shift();
 }
 
+void DockcoreBase::forget_dock() {
+  filter_.reset();
+  filter_confirmed_ = false;
+  scene_.clear();
+  restart_ref_set_ = false;
+  confirmed_ref_set_ = false;
+  overruled_restart_set_ = false;
+}
+
 void DockcoreBase::take_mount_shift() {
   lidar_mount_ = config_.lidar_mount;
   lidar_mount_.x_m += tasks_.mount_shift_m().x();
@@ -429,12 +438,7 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
     // were all placed through the old mount, centimetres off now. The robot stands at the staging distance and the
     // next attempt starts with a search, which the next detection answers.
     take_mount_shift();
-    filter_.reset();
-    filter_confirmed_ = false;
-    scene_.clear();
-    restart_ref_set_ = false;
-    confirmed_ref_set_ = false;
-    overruled_restart_set_ = false;
+    forget_dock();
   }
   observe_drive(in, before, t);
   shape(watch_.hold(), &out);
@@ -454,12 +458,7 @@ TickOutput DockcoreBase::tick(const TickInput& in) {
         push_ref_in_odom_ = own ? filter_.dock_in_odom() : restart_ref_in_odom_;
       }
     }
-    restart_ref_set_ = false;
-    confirmed_ref_set_ = false;
-    filter_.reset();
-    filter_confirmed_ = false;
-    scene_.clear();
-    overruled_restart_set_ = false;
+    forget_dock();
   }
   // A detection in ALIGN agreed with the push test's reference: the reference has done its job (no push), and an
   // earlier restart was no push either (the restarted filter is the reference now). Both end with the task.

@@ -456,11 +456,13 @@ int run_certify(const CertifyOptions& o) {
     try {
       const docksim::Scenario sc = load(t, &values[t]);
       runs[t] = docksim::run_docking(sc, ctl, docksim::trial_seed(seed, t), so);
-      const double truth = static_cast<double>(sc.true_lidar_mount().inverse_transform(dockcore::Vec2(0, 0)).y());
-      centre_err_configured[t] =
-          static_cast<double>(sc.lidar_mount.inverse_transform(dockcore::Vec2(0, 0)).y()) - truth;
-      centre_err_in_use[t] =
-          static_cast<double>(runs[t].outcome.lidar_mount_in_use.inverse_transform(dockcore::Vec2(0, 0)).y()) - truth;
+      // The robot's centre across the lidar's line of sight, as a mount puts it (what the swing measures).
+      const auto centre_y = [](const dockcore::Pose2& mount) {
+        return static_cast<double>(mount.inverse_transform(dockcore::Vec2(0, 0)).y());
+      };
+      const double truth = centre_y(sc.true_lidar_mount());
+      centre_err_configured[t] = centre_y(sc.lidar_mount) - truth;
+      centre_err_in_use[t] = centre_y(runs[t].outcome.lidar_mount_in_use) - truth;
     } catch (const docksim::ScenarioError& e) {
       errors[t] = e.what();
     }

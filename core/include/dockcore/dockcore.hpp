@@ -288,6 +288,9 @@ class DockcoreBase {
  private:
   /// The lidar mount in use: the configured one moved by the task manager's mount_shift_m().
   void take_mount_shift();
+  /// Forgets the dock the filter follows and what was placed with it: the filter, the room's reference, the push
+  /// test's references from this task (not a resumed command's pre-outage one, push_ref_). O(1).
+  void forget_dock();
   /// Fills out->drive_cmd and out->wheels from out->cmd (file comment). O(1).
   void shape(bool hold, TickOutput* out);
   /// Hands the deadband the last command and the measured wheel speeds; `state` is the task's state that command was

@@ -6,21 +6,22 @@ namespace dockcore {
 
 void WheelDeadband::configure(const WheelDeadbandParams& params) {
   params_ = params;
-  Real start = params.known_radps > 0 ? params.known_radps : 0;
-  if (params.adapt && start > params.max_radps) start = params.max_radps > 0 ? params.max_radps : 0;
+  const Real start = bounded_floor(0);
   for (auto& wheel : floor_radps_) wheel[0] = wheel[1] = start;
   for (Stall& s : stall_) s = Stall{};
   raises_ = 0;
 }
 
-void WheelDeadband::restore_floors(const WheelDeadband& learned) {
+Real WheelDeadband::bounded_floor(Real floor_radps) const {
   const Real known = params_.known_radps > 0 ? params_.known_radps : 0;
+  Real f = floor_radps > known ? floor_radps : known;
+  if (params_.adapt && f > params_.max_radps) f = params_.max_radps > 0 ? params_.max_radps : 0;
+  return f;
+}
+
+void WheelDeadband::restore_floors(const WheelDeadband& learned) {
   for (std::size_t i = 0; i < kMaxDriveWheels; ++i) {
-    for (std::size_t d = 0; d < 2; ++d) {
-      Real f = learned.floor_radps_[i][d] > known ? learned.floor_radps_[i][d] : known;
-      if (params_.adapt && f > params_.max_radps) f = params_.max_radps > 0 ? params_.max_radps : 0;
-      floor_radps_[i][d] = f;
-    }
+    for (std::size_t d = 0; d < 2; ++d) floor_radps_[i][d] = bounded_floor(learned.floor_radps_[i][d]);
     stall_[i] = Stall{};
   }
   raises_ = learned.raises_;

@@ -303,23 +303,25 @@ void TaskManager::run_reach(const TaskInput& in) {
     if (since_s(state_since_us_, in) < params_.detect_wait_s) return;
     swing_leg_ = 1;
   }
-  const Real a = params_.swing_amplitude_rad;
-  const Real target = swing_origin_rad_ + (swing_leg_ == 1 ? a : (swing_leg_ == 2 ? -a : static_cast<Real>(0)));
+  if (!swing(swing_origin_rad_, params_.swing_amplitude_rad, &swing_leg_, in)) return;
+  ++swings_;
+  if (swings_ >= params_.max_swings) {
+    raise(FaultCode::kDetectionFailed, in);
+    return;
+  }
+  swing_leg_ = 1;  // the next swing, after this still tick
+}
+
+bool TaskManager::swing(Real origin_rad, Real amplitude_rad, std::uint8_t* leg, const TaskInput& in) {
+  const Real target = origin_rad + (*leg == 1 ? amplitude_rad : (*leg == 2 ? -amplitude_rad : static_cast<Real>(0)));
   const Real err = wrap_angle(target - in.odom_pose.yaw_rad);
   if (std::fabs(err) <= params_.swing_tolerance_rad) {
-    if (swing_leg_ < 3) {
-      ++swing_leg_;
-    } else {
-      ++swings_;
-      if (swings_ >= params_.max_swings) {
-        raise(FaultCode::kDetectionFailed, in);
-        return;
-      }
-      swing_leg_ = 1;
-    }
-    return;  // one still tick between legs: the new leg's direction starts next tick
+    if (*leg >= 3) return true;
+    ++*leg;
+    return false;  // one still tick between legs: the new leg's direction starts next tick
   }
   want_.wz_radps = err > 0 ? params_.swing_speed_radps : -params_.swing_speed_radps;
+  return false;
 }
 
 bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in) {
@@ -568,18 +570,9 @@ void TaskManager::run_calibration(const TaskInput& in) {
     end_calibration(r, in);
     return;
   }
-  const Real target =
-      calibration_origin_rad_ + (calibration_leg_ == 1 ? a : (calibration_leg_ == 2 ? -a : static_cast<Real>(0)));
-  const Real err = wrap_angle(target - in.odom_pose.yaw_rad);
-  if (std::fabs(err) <= params_.swing_tolerance_rad) {
-    if (calibration_leg_ < 3) {
-      ++calibration_leg_;
-      return;  // one still tick between legs, as in the search's swing
-    }
+  if (swing(calibration_origin_rad_, a, &calibration_leg_, in)) {
     end_calibration(calibration_.solve(params_.max_mount_correction_m), in);
-    return;
   }
-  want_.wz_radps = err > 0 ? params_.swing_speed_radps : -params_.swing_speed_radps;
 }
 
 void TaskManager::end_calibration(const MountCalibrationResult& result, const TaskInput& in) {

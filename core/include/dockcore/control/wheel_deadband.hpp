@@ -71,6 +71,9 @@ class WheelDeadband {
   void restore_floors(const WheelDeadband& learned);
 
  private:
+  /// `floor_radps` raised to the known deadband and, when adapting, capped at max_radps (0 when that is not > 0): the
+  /// bounds every configured or restored floor keeps. O(1).
+  Real bounded_floor(Real floor_radps) const;
   struct Stall {
     bool active = false;
     bool reverse = false;

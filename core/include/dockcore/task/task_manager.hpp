@@ -348,6 +348,10 @@ class TaskManager {
   /// Backs off; returns true when done. Sets want_.
   bool run_backoff(const TaskInput& in);
   void run_reach(const TaskInput& in);
+  /// One tick of a swing on the spot about `origin_rad` at swing_speed_radps: to +amplitude_rad (*leg 1), to
+  /// −amplitude_rad (2), back to the origin (3), one still tick between legs. Sets want_ while turning; true on the
+  /// tick the third leg ends (*leg stays 3).
+  bool swing(Real origin_rad, Real amplitude_rad, std::uint8_t* leg, const TaskInput& in);
   void run_align(const TaskInput& in, TaskOutput& out);
   /// Push test (178/179) on one detection; returns true when it raised the fault.
   bool test_detection(const DetectionInput& det, const TaskInput& in);
