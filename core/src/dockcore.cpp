@@ -509,7 +509,10 @@ void DockcoreBase::observe_drive(const TickInput& in, TaskState state, const Tas
                        std::fabs(t.dock.pose.x_m) - body_front_m(config_.footprint) < kDeadbandDockClearanceM &&
                        std::fabs(t.dock.pose.y_m) < body_half_width_m(config_.footprint);
   const bool learn = is_moving_state(state) && !in.contact && !watch_.hold() && !at_dock;
-  deadband_.observe(sent_wheels_, twist_to_wheels(config_.drive, odometry_.twist()), in.now_us, learn);
+  // Timed by the feedback's own stamp: ticks that brought no new wheel speeds (a slower chassis, one falling silent
+  // before it counts as stale) add no time to a stall.
+  deadband_.observe(sent_wheels_, twist_to_wheels(config_.drive, odometry_.twist()), odometry_.stamp_us(),
+                    learn && odometry_.stamp_us() > 0);
 }
 
 void DockcoreBase::shape(bool hold, TickOutput* out) {

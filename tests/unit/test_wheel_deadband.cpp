@@ -264,3 +264,57 @@ TEST(WheelDeadband, FollowingForStallMsOrAStoppedCommandForgetsTheStands) {
     LONGS_EQUAL(0, d.raises());
   }
 }
+
+namespace {
+
+/// The left wheel on a first-order motor (time constant tau_s) behind a deadband: it runs towards `command` when
+/// |command| reaches `deadband`, towards standing otherwise; the right one is not commanded. Observed every 20 ms from
+/// `t0_us` for `duration_ms`; returns the time after the last, and leaves the motor's speed in `*speed`.
+std::uint64_t motor(WheelDeadband& d, Real command, Real deadband, double tau_s, Real* speed, std::uint64_t t0_us,
+                    std::uint64_t duration_ms) {
+  std::uint64_t t = t0_us;
+  const Real a = static_cast<Real>(1.0 - std::exp(-0.02 / tau_s));
+  for (; t <= t0_us + duration_ms * kMs; t += 20 * kMs) {
+    const Real target = std::fabs(command) >= deadband ? command : 0;
+    *speed += a * (target - *speed);
+    d.observe(wheels(command, 0), wheels(*speed, 0), t, true);
+  }
+  return t;
+}
+
+}  // namespace
+
+TEST(WheelDeadband, ASlowMotorRunningDownInItsDeadbandIsCaughtBeforeItFallsUnderAQuarter) {
+  WheelDeadband d;
+  d.configure(WheelDeadbandParams{});
+  // Turning at 1.2 rad/s, then commanded 0.9 under a 1.0 rad/s deadband: with a 0.25 s motor the wheel takes
+  // 0.35 s to run down under a quarter of the command, far longer than the creep's corrections stay there.
+  Real speed = static_cast<Real>(1.2);
+  std::uint64_t t = motor(d, static_cast<Real>(1.2), 1, 0.25, &speed, 0, 500);
+  LONGS_EQUAL(0, d.raises());
+  t = motor(d, static_cast<Real>(0.9), 1, 0.25, &speed, t, WheelDeadbandParams{}.stall_ms + 120);
+  CHECK(speed > static_cast<Real>(0.25 * 0.9));  // the old test alone would not have begun the stall
+  LONGS_EQUAL(1, d.raises());
+  DOUBLES_EQUAL(1.25 * 0.9, static_cast<double>(d.floor_radps(0, false)), kTol);
+}
+
+TEST(WheelDeadband, ASlowMotorStartingOrTurningRoundIsNoStall) {
+  WheelDeadband d;
+  d.configure(WheelDeadbandParams{});
+  // A 0.25 s motor without a deadband, started from rest and later turned round: under a quarter of the command for
+  // longer than stall_ms each time from reverse (0.25 s), but speeding up towards it all the while.
+  Real speed = 0;
+  std::uint64_t t = motor(d, static_cast<Real>(0.8), 0, 0.25, &speed, 0, 1000);
+  t = motor(d, static_cast<Real>(-0.8), 0, 0.25, &speed, t, 1000);
+  motor(d, static_cast<Real>(0.8), 0, 0.25, &speed, t, 1000);
+  LONGS_EQUAL(0, d.raises());
+}
+
+TEST(WheelDeadband, ARepeatedStampAddsNoTime) {
+  WheelDeadband d;
+  d.configure(WheelDeadbandParams{});
+  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  // A chassis that has fallen silent: the last feedback (standing) is handed over tick after tick.
+  for (int i = 0; i < 100; ++i) d.observe(cmd, wheels(0, 0), 40 * kMs, true);
+  LONGS_EQUAL(0, d.raises());
+}

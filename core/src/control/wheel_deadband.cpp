@@ -9,6 +9,7 @@ void WheelDeadband::configure(const WheelDeadbandParams& params) {
   const Real start = bounded_floor(0);
   for (auto& wheel : floor_radps_) wheel[0] = wheel[1] = start;
   for (Stall& s : stall_) s = Stall{};
+  for (Trend& t : trend_) t = Trend{};
   raises_ = 0;
 }
 
@@ -56,6 +57,15 @@ void WheelDeadband::observe(const WheelSpeeds& commanded, const WheelSpeeds& mea
     const bool reverse = c < 0;
     // Along the command: a wheel turning the wrong way follows it even less than one standing still.
     const Real along = i < n ? (reverse ? -measured.radps[i] : measured.radps[i]) : 0;
+    Trend& tr = trend_[i];
+    if (!tr.have_ref || now_us < tr.ref_us || tr.reverse != reverse) {
+      tr = Trend{now_us, along, true, reverse, false, false};
+    } else if (now_us - tr.ref_us >= kSlowingUs) {
+      tr.slowing = tr.ref_along_radps > 0 && along < kSlowingShare * tr.ref_along_radps;
+      tr.rising = along - tr.ref_along_radps > kRisingShare * a;
+      tr.ref_us = now_us;
+      tr.ref_along_radps = along;
+    }
     Real& f = floor_radps_[i][reverse ? 1 : 0];
     if (!learn || !params_.adapt || !(a > 0) || !(f < params_.max_radps) || (s.active && s.reverse != reverse) ||
         now_us < s.last_us) {
@@ -68,7 +78,8 @@ void WheelDeadband::observe(const WheelSpeeds& commanded, const WheelSpeeds& mea
       s.last_us = now_us;
       continue;
     }
-    const bool stalled = along < kStallShare * a;
+    // Under a quarter of the command, or under nine tenths and running down; never while speeding up towards it.
+    const bool stalled = !tr.rising && (along < kStallShare * a || (along < kFollowShare * a && tr.slowing));
     if (!s.active) {
       if (stalled) s = Stall{true, reverse, false, now_us, 0, 0, a};
       continue;

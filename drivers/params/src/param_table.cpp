@@ -300,8 +300,8 @@ const ParamSpec kTable[] = {
     DC_REAL("robot.deadband", "max_radps", "rad/s", 0, 20, kBoth, deadband, max_radps,
             "Largest deadband learned: bounds how fast the slowest creep can become."),
     DC_INT("robot.deadband", "stall_ms", "ms", 50, 10000, kBoth, deadband, stall_ms,
-           "A wheel turning at under a quarter of its command this long in all (short stands add up) has stalled: its "
-           "deadband grows by 25 %."),
+           "A wheel turning at under a quarter of its command, or under nine tenths and slowing down, and not speeding "
+           "up, this long in all (short stands add up) has stalled: its deadband grows by 25 %."),
 
     // [task]: TaskParams (docs/task-manager.md).
     DC_REAL("task", "detect_wait_s", "s", 0, 60, kBoth, task, detect_wait_s,
