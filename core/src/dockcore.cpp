@@ -95,7 +95,7 @@ bool DockcoreBase::configure(const DockProfile& profile, const DockcoreConfig& c
 
 DockcoreBase::Learned DockcoreBase::learned() const {
   Learned l;
-  l.deadband = deadband_;
+  l.deadband = deadband_.floors();
   l.task = tasks_.learned();
   return l;
 }

@@ -27,9 +27,10 @@ static_assert(std::is_trivially_copyable<TickDigest>::value, "TickDigest is reco
 std::string layout_line() {
   char buf[256];
   std::snprintf(buf, sizeof buf,
-                "layout real=%zu profile=%zu config=%zu controller=%zu tickin=%zu digest=%zu tag=%zu queued=%zu\n",
+                "layout real=%zu profile=%zu config=%zu controller=%zu tickin=%zu digest=%zu tag=%zu queued=%zu "
+                "learned=%zu\n",
                 sizeof(Real), sizeof(DockProfile), sizeof(DockcoreConfig), sizeof(LoopController), sizeof(TickInput),
-                sizeof(TickDigest), sizeof(TagObservation), sizeof(QueuedCommand));
+                sizeof(TickDigest), sizeof(TagObservation), sizeof(QueuedCommand), sizeof(DockcoreBase::Learned));
   return buf;
 }
 
@@ -229,6 +230,10 @@ void LoopRecordWriter::take_inputs() {
   put(LoopRecordKind::kTakeInputs, nullptr, 0);
 }
 
+void LoopRecordWriter::restore_learned(const DockcoreBase::Learned& learned) {
+  put(LoopRecordKind::kRestoreLearned, &learned, sizeof learned);
+}
+
 // --- replay --------------------------------------------------------------------------------------------------------
 
 namespace {
@@ -419,6 +424,13 @@ ReplayResult replay_loop_record(const std::string& path) {
       case LoopRecordKind::kRescan:
         rc->core->rescan();
         break;
+      case LoopRecordKind::kRestoreLearned: {
+        DockcoreBase::Learned learned;
+        if (len != sizeof learned) return fail("restore-learned record of the wrong size");
+        read_as(p, 0, &learned);
+        rc->core->restore_learned(learned);
+        break;
+      }
       default:
         return fail("unknown record kind " + std::to_string(static_cast<unsigned>(h[0])));
     }

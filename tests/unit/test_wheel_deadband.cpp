@@ -156,7 +156,7 @@ TEST(WheelDeadband, RestoredFloorsAreTheLearnedOnesWithinThisConfigurationsBound
 
   WheelDeadband next;
   next.configure(p);
-  next.restore_floors(taught);
+  next.restore_floors(taught.floors());
   DOUBLES_EQUAL(0.75, static_cast<double>(next.floor_radps(0, false)), kTol);
   DOUBLES_EQUAL(0.0, static_cast<double>(next.floor_radps(1, false)), kTol);
   LONGS_EQUAL(1, next.raises());
@@ -169,7 +169,7 @@ TEST(WheelDeadband, RestoredFloorsAreTheLearnedOnesWithinThisConfigurationsBound
   bounded.max_radps = static_cast<Real>(0.7);
   WheelDeadband clamped;
   clamped.configure(bounded);
-  clamped.restore_floors(taught);
+  clamped.restore_floors(taught.floors());
   DOUBLES_EQUAL(0.7, static_cast<double>(clamped.floor_radps(0, false)), kTol);  // at most max_radps
   DOUBLES_EQUAL(0.3, static_cast<double>(clamped.floor_radps(1, false)), kTol);  // at least the known deadband
 }

@@ -169,7 +169,7 @@ class DockcoreBase {
   /// TaskLearned (the lidar mount's calibration, the aims that closed each dock's contacts) — which configure()
   /// forgets. O(kDockIds).
   struct Learned {
-    WheelDeadband deadband{};
+    WheelDeadband::Floors deadband{};
     TaskLearned task{};
   };
   Learned learned() const;

@@ -20,12 +20,24 @@ Real WheelDeadband::bounded_floor(Real floor_radps) const {
   return f;
 }
 
-void WheelDeadband::restore_floors(const WheelDeadband& learned) {
+WheelDeadband::Floors WheelDeadband::floors() const {
+  Floors f;
   for (std::size_t i = 0; i < kMaxDriveWheels; ++i) {
-    for (std::size_t d = 0; d < 2; ++d) floor_radps_[i][d] = bounded_floor(learned.floor_radps_[i][d]);
+    for (std::size_t d = 0; d < 2; ++d) f.radps[i][d] = floor_radps_[i][d];
+  }
+  f.raises = raises_;
+  return f;
+}
+
+void WheelDeadband::restore_floors(const Floors& learned) {
+  for (std::size_t i = 0; i < kMaxDriveWheels; ++i) {
+    for (std::size_t d = 0; d < 2; ++d) {
+      const Real f = learned.radps[i][d];
+      floor_radps_[i][d] = bounded_floor(std::isfinite(f) ? f : static_cast<Real>(0));
+    }
     stall_[i] = Stall{};
   }
-  raises_ = learned.raises_;
+  raises_ = learned.raises;
 }
 
 Real WheelDeadband::scale(const DriveGeometry& geometry, const DriveLimits& limits, const Twist2& twist) const {

@@ -90,9 +90,14 @@ TaskLearned TaskManager::learned() const {
 }
 
 void TaskManager::restore_learned(const TaskLearned& l) {
-  for (std::size_t i = 0; i < kDockIds; ++i) remembered_aim_m_[i] = params_.remember_aim ? l.remembered_aim_m[i] : 0;
-  mount_shift_m_ = l.mount_shift_m;
-  last_calibration_ = l.last_calibration;
+  for (std::size_t i = 0; i < kDockIds; ++i) {
+    const Real aim = l.remembered_aim_m[i];
+    remembered_aim_m_[i] = params_.remember_aim && std::isfinite(aim) ? aim : 0;
+  }
+  // A shift that is not finite cannot be the one a swing measured: the mount stays as configured, measured again.
+  const bool shift_ok = std::isfinite(l.mount_shift_m.x()) && std::isfinite(l.mount_shift_m.y());
+  mount_shift_m_ = shift_ok ? l.mount_shift_m : Vec2::Zero();
+  last_calibration_ = shift_ok ? l.last_calibration : MountCalibrationResult{};
   calibrations_ = l.calibrations;
 }
 

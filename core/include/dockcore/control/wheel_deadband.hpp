@@ -78,10 +78,18 @@ class WheelDeadband {
   Real floor_radps(std::size_t wheel, bool reverse) const { return floor_radps_[wheel][reverse ? 1 : 0]; }
   /// Times a floor grew since configure(). O(1).
   std::uint32_t raises() const { return raises_; }
+  /// What a drive taught: every wheel's floors, rad/s ([wheel][0] forward, [wheel][1] backward), and the raise count.
+  struct Floors {
+    Real radps[kMaxDriveWheels][2] = {};
+    std::uint32_t raises = 0;
+  };
+  /// The floors now. O(wheels).
+  Floors floors() const;
   /// Takes `learned`'s floors and raise count (not any stall in progress): what a drive taught one configuration,
-  /// kept across another (the wheels are the same). Each floor is clamped as configure() clamps the starting one, and
-  /// never lowered below this configuration's known deadband. O(wheels).
-  void restore_floors(const WheelDeadband& learned);
+  /// kept across another or a restart (the wheels are the same). Each floor is clamped as configure() clamps the
+  /// starting one, and never lowered below this configuration's known deadband; a non-finite one is taken as 0.
+  /// O(wheels).
+  void restore_floors(const Floors& learned);
 
  private:
   /// `floor_radps` raised to the known deadband and, when adapting, capped at max_radps (0 when that is not > 0): the

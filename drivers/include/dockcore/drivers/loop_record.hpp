@@ -21,16 +21,17 @@ namespace dockcore::drivers {
 
 /// Record kinds.
 enum class LoopRecordKind : std::uint8_t {
-  kConfigure = 1,    ///< LoopConfig: controller, its parameters, profile, DockcoreConfig.
-  kWheels = 2,       ///< WheelSpeeds + stamp.
-  kOdometry = 3,     ///< Pose2 + Twist2 + stamp.
-  kScan = 4,         ///< stamp, read time, geometry, then count ranges and count intensities.
-  kTag = 5,          ///< TagObservation.
-  kSubmit = 6,       ///< QueuedCommand.
-  kCheckInputs = 7,  ///< now_us.
-  kTick = 8,         ///< TickInput + the TickDigest of its output.
-  kRescan = 9,       ///< (no payload)
-  kTakeInputs = 10,  ///< A rebuilt core continues this one's inputs: the next kConfigure builds it (no payload).
+  kConfigure = 1,        ///< LoopConfig: controller, its parameters, profile, DockcoreConfig.
+  kWheels = 2,           ///< WheelSpeeds + stamp.
+  kOdometry = 3,         ///< Pose2 + Twist2 + stamp.
+  kScan = 4,             ///< stamp, read time, geometry, then count ranges and count intensities.
+  kTag = 5,              ///< TagObservation.
+  kSubmit = 6,           ///< QueuedCommand.
+  kCheckInputs = 7,      ///< now_us.
+  kTick = 8,             ///< TickInput + the TickDigest of its output.
+  kRescan = 9,           ///< (no payload)
+  kTakeInputs = 10,      ///< A rebuilt core continues this one's inputs: the next kConfigure builds it (no payload).
+  kRestoreLearned = 11,  ///< DockcoreBase::Learned handed to the core (a host's kept state, e.g. dockd's state file).
 };
 
 /// Which controller a configure uses and its parameters (the other three keep their defaults).
@@ -85,6 +86,7 @@ class LoopRecordWriter {
   void tick(const TickInput& in, const TickOutput& out);
   void rescan();
   void take_inputs();
+  void restore_learned(const DockcoreBase::Learned& learned);
   /// Writes what is buffered (one write(2)); the host calls it once per control tick. O(buffered bytes).
   void flush();
 
