@@ -37,6 +37,8 @@ struct DaemonCounters {
   std::uint32_t status_sent = 0;
   std::uint32_t config_reloads = 0;           ///< Reloads applied.
   std::uint32_t config_reloads_rejected = 0;  ///< Reloads refused (invalid file, restart-only key changed).
+  std::uint32_t learned_saves = 0;            ///< Learned files written (a task's end changed what was learned).
+  std::uint32_t learned_save_failures = 0;    ///< ... and writes that failed (reported; tried again at the next end).
   std::uint32_t events_too_long = 0;          ///< Event lines that did not fit EventLine and were not written.
   /// UDP replies and status stream objects that did not fit one datagram: a reply_too_long error went instead.
   std::uint32_t replies_too_long = 0;

@@ -122,7 +122,7 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
   if (loop_record_) loop_record_->configure(loop_controller(), prof, core_cfg_);
   // What the core learned about the robot — the wheels' deadband floors, the lidar mount's calibration, the aim that
   // closed each dock's contacts — belongs to the robot, not to the dock: it goes on into the new configuration. A
-  // reload builds a new core, which starts afresh (dock-sim replay does the same).
+  // reload builds a new core, which starts afresh from the learned file (restore_learned_state).
   const dockcore::DockcoreBase::Learned learned = core_->learned();
   if (!core_->configure(prof, core_cfg_)) return false;
   core_->restore_learned(learned);
@@ -133,11 +133,75 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
   return true;
 }
 
+void Daemon::restore_learned_state(std::uint64_t now_us) {
+  kept_learned_ = core_->learned();
+  if (!have_learned_file_) return;
+  EventLine e(now_us, "learned");
+  if (!learned_file_.learned_on(cfg_.lidar_mount, cfg_.drive)) {
+    e.w.str("result", "not_restored")
+        .str_cut(
+            "message",
+            (learned_paths_.file + ": learned on another lidar mount or drive: not restored, learned again").c_str(),
+            1024);
+    log_event(e, LogLevel::kWarn);
+    return;
+  }
+  core_->restore_learned(learned_file_.learned);
+  if (loop_record_) loop_record_->restore_learned(learned_file_.learned);
+  kept_learned_ = core_->learned();
+  const dockcore::TaskManager& tm = core_->task_manager();
+  e.w.str("result", "restored")
+      .uint("deadband_raises", kept_learned_.deadband.raises)
+      .uint("mount_swings", tm.calibrations())
+      .str("mount_calibration", dockcore::to_string(tm.last_calibration().status))
+      .real("mount_x_m", static_cast<double>(core_->lidar_mount().x_m), 4)
+      .real("mount_y_m", static_cast<double>(core_->lidar_mount().y_m), 4);
+  log_event(e);
+}
+
+void Daemon::keep_learned_state(std::uint64_t now_us) {
+  const dockcore::DockcoreBase::Learned now = core_->learned();
+  if (same_learned(now, kept_learned_)) return;
+  LearnedState l;
+  l.lidar_mount = cfg_.lidar_mount;
+  l.drive = cfg_.drive;
+  l.saved_unix_s = static_cast<std::uint64_t>(std::time(nullptr));
+  l.learned = now;
+  char err[256];
+  EventLine e(now_us, "learned");
+  if (!save_learned(learned_paths_, l, learned_buf_, sizeof learned_buf_, err, sizeof err)) {
+    ++counters_.learned_save_failures;
+    e.w.str("result", "save_failed").str("message", err);
+    log_event(e, LogLevel::kWarn);
+    return;
+  }
+  ++counters_.learned_saves;
+  learned_file_ = l;
+  have_learned_file_ = true;
+  kept_learned_ = now;
+  e.w.str("result", "saved")
+      .uint("deadband_raises", now.deadband.raises)
+      .uint("mount_swings", now.task.calibrations)
+      .str("mount_calibration", dockcore::to_string(now.task.last_calibration.status));
+  log_event(e, LogLevel::kDebug);
+}
+
 bool Daemon::start(std::string& error) {
   const std::uint64_t now = io_.clock->now_us();
   std::string msg;
   std::vector<std::string> warnings;
   const StateLoadStatus st = load_state(cfg_.state_file, state_, msg, &warnings);
+  learned_paths_ = LearnedPaths::beside(cfg_.state_file);
+  {
+    std::string why;
+    const LearnedLoadStatus ls = load_learned(learned_paths_.file, learned_file_, why);
+    have_learned_file_ = ls == LearnedLoadStatus::kOk;
+    if (ls == LearnedLoadStatus::kCorrupt) {
+      EventLine e(now, "learned");
+      e.w.str("result", "corrupt").str_cut("message", why.c_str(), 1024);
+      log_event(e, LogLevel::kWarn);
+    }
+  }
   if (st == StateLoadStatus::kRecoveredBackup || st == StateLoadStatus::kCorruptNoBackup) {
     EventLine e(now, "state_file");
     e.w.str("level", st == StateLoadStatus::kCorruptNoBackup ? "error" : "warn").str_cut("message", msg.c_str(), 1024);
@@ -172,6 +236,7 @@ bool Daemon::start(std::string& error) {
     error = "dock profile of dock " + std::to_string(cfg_.default_dock_id) + " refused by the estimator";
     return false;
   }
+  restore_learned_state(now);
   start_us_ = now;
   started_ = true;
   EventLine e(now, "start");
@@ -474,6 +539,11 @@ void Daemon::on_tick(std::uint64_t now_us) {
 
   // Events.
   const dockcore::TaskStatus& s = out.status;
+  // A task's end, the robot standing: what it taught about the robot goes into the learned file (once per change,
+  // never while the robot moves: an fsync may take longer than a tick).
+  const bool task_ended =
+      s.state == TaskState::kFinishTasking || s.state == TaskState::kFault || s.state == TaskState::kNotTasking;
+  if (prev_status_valid_ && s.state != prev_status_.state && task_ended) keep_learned_state(now_us);
   if (!prev_status_valid_ || s.state != prev_status_.state) {
     EventLine e(now_us, "state");
     e.w.str("from", prev_status_valid_ ? dockcore::to_string(prev_status_.state) : "START")

@@ -32,6 +32,7 @@
 #include "dockcore/hal/log_sink.hpp"
 #include "events.hpp"
 #include "host_protocol.hpp"
+#include "learned_file.hpp"
 #include "state_file.hpp"
 #include "status.hpp"
 #include "teach.hpp"
@@ -189,6 +190,13 @@ class Daemon final : private HostActions, private TeachHooks {
   void build_core();
   /// The active controller and every controller's parameters, as the loop record keeps them. O(1).
   dockcore::drivers::LoopController loop_controller() const;
+  /// Hands the core the learned file's state when it was learned on this configuration's lidar mount and drive
+  /// (records the hand-over for replay); reports either way in the `learned` event. O(kDockIds).
+  void restore_learned_state(std::uint64_t now_us);
+  /// At the end of a task: when the core's learned state differs from the one kept, saves it in the learned file
+  /// (with this configuration's mount and drive) and keeps it; a failed save is reported and tried again at the next
+  /// end. No heap. O(kDockIds), plus the file's write when it changed.
+  void keep_learned_state(std::uint64_t now_us);
   bool reload_can_apply() const;
   bool apply_reload(std::uint64_t now_us, std::string& message);
   void log_reload(std::uint64_t now_us, const char* result, const std::string& message, LogLevel level);
@@ -202,6 +210,13 @@ class Daemon final : private HostActions, private TeachHooks {
   std::unique_ptr<dockcore::Dockcore> core_;
   dockcore::DockcoreConfig core_cfg_{};
   StateData state_;
+  /// The learned file (LearnedPaths::beside the state file), what it held at start, and what dockd last kept: the
+  /// file's state restored for this configuration, or the core's at start.
+  LearnedPaths learned_paths_;
+  LearnedState learned_file_{};
+  bool have_learned_file_ = false;
+  dockcore::DockcoreBase::Learned kept_learned_{};
+  char learned_buf_[kMaxLearnedFileBytes] = {};
   std::uint16_t active_dock_ = 0;
   bool active_raw_ = false;
 

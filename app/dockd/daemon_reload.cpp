@@ -77,6 +77,7 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
     core_->take_inputs(*previous);
     if (loop_record_) loop_record_->take_inputs();
     configure_core(cfg_.default_dock_id, false);
+    restore_learned_state(now_us);
     host_.set_allowlist(cfg_.host.allowlist, err);
     ++counters_.config_reloads_rejected;
     message = next->source +
@@ -85,6 +86,9 @@ bool Daemon::apply_reload(std::uint64_t now_us, std::string& message) {
     log_reload(now_us, "rejected", message, LogLevel::kError);
     return false;
   }
+  // The new core starts afresh; what the robot taught the old one is in the learned file (kept at every task's end,
+  // and a reload waits for an idle task) and goes on when the lidar mount and drive are the same.
+  restore_learned_state(now_us);
   io_.stderr_level = cfg_.log_level;
   ++counters_.config_reloads;
   message = cfg_.source + ": config reloaded";

@@ -112,8 +112,7 @@ void Daemon::camera_fields(JsonWriter& w) const {
 
 void Daemon::counter_fields(JsonWriter& w, std::uint64_t now_us) const {
   const StatusValues v = status_values(now_us);
-  write_counters(w, v);
-  write_mount(w, v);
+  write_counters_part(w, v);
 }
 
 StatusValues Daemon::status_values(std::uint64_t now_us) const {
@@ -192,6 +191,8 @@ StatusValues Daemon::status_values(std::uint64_t now_us) const {
   v.replies_too_long = counters_.replies_too_long;
   v.config_reloads = counters_.config_reloads;
   v.config_reloads_rejected = counters_.config_reloads_rejected;
+  v.learned_saves = counters_.learned_saves;
+  v.learned_save_failures = counters_.learned_save_failures;
   v.config_reload_pending = pending_cfg_ != nullptr;
   v.det_found = e.found;
   v.det_evidence_nats = static_cast<double>(e.evidence.total_nats);

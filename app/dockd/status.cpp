@@ -82,6 +82,12 @@ void write_mount(JsonWriter& w, const StatusValues& v) {
       .real("mount_y_m", reading(v.mount_y_m), 4);
 }
 
+void write_counters_part(JsonWriter& w, const StatusValues& v) {
+  write_counters(w, v);
+  write_mount(w, v);
+  w.uint("learned_saves", v.learned_saves).uint("learned_save_failures", v.learned_save_failures);
+}
+
 void write_counters(JsonWriter& w, const StatusValues& v) {
   w.uint("ticks", v.ticks)
       .uint("tick_worst_us", v.tick_worst_us)

@@ -59,6 +59,7 @@ struct StatusValues {
   std::uint32_t commands = 0, commands_rejected = 0, resumes = 0, can_host_rejected = 0, udp_not_allowed = 0;
   std::uint32_t replies_too_long = 0;
   std::uint32_t config_reloads = 0, config_reloads_rejected = 0;
+  std::uint32_t learned_saves = 0, learned_save_failures = 0;
   bool config_reload_pending = false;
   bool det_found = false;
   double det_evidence_nats = 0;
@@ -93,6 +94,10 @@ void write_counters(JsonWriter& w, const StatusValues& v);
 /// the counters part after the counters; dockd adds it to the main status after the camera groups when it fits).
 /// O(bytes written).
 void write_mount(JsonWriter& w, const StatusValues& v);
+
+/// Writes the counters part of the status: write_counters(), write_mount(), then the learned file's counters (files
+/// written, writes that failed; only here). O(bytes written).
+void write_counters_part(JsonWriter& w, const StatusValues& v);
 
 /// Writes the camera groups present in `v`; with `only_if_fits` each group that does not fit `w` is left out whole
 /// (and `w` stays ok). O(bytes written).

@@ -52,6 +52,7 @@ struct Rig {
   std::unique_ptr<dockcore::drivers::UdpHostLink> udp;
 
   std::string record_dir;  ///< The session record's directory when `record`.
+  dockd::DaemonIo io;
   dockd::RotatingLog event_log;
 
   /// The own camera's frame arrivals (with `watch_camera`): every 33 ms while camera_live, then none.
@@ -73,6 +74,7 @@ struct Rig {
     state_file = std::string("/tmp/dockd_test_") + std::to_string(::getpid()) + "_" + state_name;
     std::remove(state_file.c_str());
     std::remove((state_file + ".bak").c_str());
+    std::remove((state_file + ".learned").c_str());
     cfg.state_file = state_file;
     if (record) {
       record_dir = state_file + "_record";
@@ -93,7 +95,6 @@ struct Rig {
     const docksim::StartPose sp = docksim::start_from(sc, start_distance, 0.2, 0.1);
     chassis->set_true_pose(sp.robot_world);
     world = docksim::scenario_world(sc, true);
-    dockd::DaemonIo io;
     io.lidar = &lidar;
     io.chassis = &link;
     io.can_host = &host;
@@ -112,10 +113,18 @@ struct Rig {
     std::string err;
     CHECK_TRUE(daemon->start(err));
   }
+  /// dockd stops and starts again (a restart, a reboot) on the same robot, configuration and files.
+  void restart() {
+    daemon.reset();
+    daemon = std::make_unique<dockd::Daemon>(cfg, io);
+    std::string err;
+    CHECK_TRUE_TEXT(daemon->start(err), err.c_str());
+  }
   ~Rig() {
     daemon.reset();  // its shutdown event goes to event_log, declared (so destroyed) after it
     std::remove(state_file.c_str());
     std::remove((state_file + ".bak").c_str());
+    std::remove((state_file + ".learned").c_str());
     if (!record_dir.empty()) remove_record();
   }
   void remove_record() const {
@@ -293,6 +302,49 @@ TEST(DockdDaemon, TheMeasuredLidarMountGoesOnToTheNextDock) {
   CHECK_TRUE_TEXT(rep.error.empty(), rep.error.c_str());
   CHECK_TRUE_TEXT(!rep.diverged, rep.diverged_field.c_str());
   CHECK_EQUAL(ticks, rep.ticks);
+}
+
+TEST(DockdDaemon, WhatTheRobotLearnedOutlivesARestartOnTheSameConfiguration) {
+  Rig r("learned", false, 1.2, true, false, "lidar-miscalibrated.toml");
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 120.0));
+  CHECK(r.daemon->last_status().retries >= 1);  // missed once, swung, docked
+  CHECK(r.daemon->counters().learned_saves >= 1);
+  char json[dockcore::drivers::kMaxHostReply];
+  CHECK(r.daemon->status_json(json, sizeof json, r.clock.t) > 0);
+  STRCMP_CONTAINS("\"mount_swings\":1,\"mount_calibration\":\"ok\",", json);
+  const char* at = std::strstr(json, "\"mount_y_m\":");
+  CHECK(at != nullptr);
+  const std::string mount_y(at, std::strcspn(at, ","));
+  r.host.command(3, 0);  // undock
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kNotTasking; }, 40.0));
+
+  // Restarted: the measured mount (and the deadband floors, the remembered aim) are in use before any docking, and
+  // the next docking closes the contacts at its first attempt.
+  r.restart();
+  CHECK(r.daemon->status_json(json, sizeof json, r.clock.t) > 0);
+  STRCMP_CONTAINS("\"mount_swings\":1,\"mount_calibration\":\"ok\",", json);
+  STRCMP_CONTAINS(mount_y.c_str(), json);
+  STRCMP_CONTAINS("\"result\":\"restored\"", r.events("learned").c_str());
+  CHECK_TRUE(r.run_until([&] { return !r.daemon->lidar_stale() && !r.daemon->chassis_stale(); }, 1.0));
+  r.host.command(1, 0);
+  CHECK_TRUE(r.run_until([&] { return r.daemon->state() == TaskState::kFinishTasking; }, 120.0));
+  CHECK_EQUAL(0, r.daemon->last_status().retries);
+  // The restarted session's record replays the hand-over: bit for bit.
+  const std::uint64_t ticks = r.daemon->tick_stats().ticks;
+  r.daemon.reset();
+  const dockcore::drivers::ReplayResult rep = dockcore::drivers::replay_loop_record(r.record_dir + "/loop.rec");
+  CHECK_TRUE_TEXT(rep.error.empty(), rep.error.c_str());
+  CHECK_TRUE_TEXT(!rep.diverged, rep.diverged_field.c_str());
+  CHECK_EQUAL(ticks, rep.ticks);
+
+  // Restarted with the lidar configured elsewhere: what was learned on the old mount is not used.
+  r.cfg.lidar_mount.x_m += static_cast<dockcore::Real>(0.01);
+  r.restart();
+  CHECK(r.daemon->status_json(json, sizeof json, r.clock.t) > 0);
+  STRCMP_CONTAINS("\"mount_swings\":0,\"mount_calibration\":\"none\",", json);
+  STRCMP_CONTAINS("\"result\":\"not_restored\"", r.events("learned").c_str());
 }
 
 TEST(DockdDaemon, DocksChargesAndUndocksInSimulation) {

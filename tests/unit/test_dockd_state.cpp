@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "../support/fake_can_bus.hpp"
+#include "learned_file.hpp"
 #include "session_record.hpp"
 #include "state_file.hpp"
 
@@ -234,4 +235,127 @@ TEST(DockdState, RecordedCanFramesAreWrittenPerDrainAndInOrder) {
   }
   std::remove((dir + "/can.log").c_str());
   ::rmdir(dir.c_str());
+}
+
+// The learned file: what the core learned about the robot, kept across restarts with the configuration it belongs to.
+namespace {
+
+dockd::LearnedState sample_learned() {
+  dockd::LearnedState l;
+  l.lidar_mount = dockcore::Pose2{static_cast<dockcore::Real>(0.12), static_cast<dockcore::Real>(-0.03),
+                                  static_cast<dockcore::Real>(0.087)};
+  l.drive.kind = dockcore::DriveKind::kDifferential;
+  l.drive.wheel_radius_m = static_cast<dockcore::Real>(0.076);
+  l.drive.wheel_base_m = static_cast<dockcore::Real>(0.36);
+  l.saved_unix_s = 1796000000;
+  l.learned.deadband.radps[0][0] = static_cast<dockcore::Real>(1.1);
+  l.learned.deadband.radps[1][0] = static_cast<dockcore::Real>(0.65);
+  l.learned.deadband.radps[1][1] = static_cast<dockcore::Real>(0.7);
+  l.learned.deadband.raises = 4;
+  dockcore::TaskLearned& t = l.learned.task;
+  t.remembered_aim_m[0] = static_cast<dockcore::Real>(-0.006);
+  t.remembered_aim_m[31] = static_cast<dockcore::Real>(0.012);
+  t.mount_shift_m = dockcore::Vec2(static_cast<dockcore::Real>(-0.0011), static_cast<dockcore::Real>(0.0087));
+  t.calibrations = 1;
+  t.last_calibration.status = dockcore::MountCalibrationStatus::kOk;
+  t.last_calibration.lateral_error_m = static_cast<dockcore::Real>(0.0088);
+  t.last_calibration.rms_m = static_cast<dockcore::Real>(0.0014);
+  t.last_calibration.sweep_rad = static_cast<dockcore::Real>(0.96);
+  t.last_calibration.detections = 36;
+  t.last_calibration.mount = dockcore::Pose2{static_cast<dockcore::Real>(0.119), static_cast<dockcore::Real>(-0.021),
+                                             static_cast<dockcore::Real>(0.087)};
+  return l;
+}
+
+std::string formatted(const dockd::LearnedState& l) {
+  char buf[dockd::kMaxLearnedFileBytes];
+  const std::size_t n = dockd::format_learned(l, buf, sizeof buf);
+  return std::string(buf, n);
+}
+
+/// `text` with its checksum line made right again (a well-formed file saying something wrong).
+std::string resealed(const std::string& text) {
+  const std::string body = text.substr(0, text.rfind("crc32 "));
+  char crc[32];
+  std::snprintf(crc, sizeof crc, "crc32 %08x\n", dockd::crc32_ieee(body.data(), body.size()));
+  return body + crc;
+}
+
+}  // namespace
+
+TEST(DockdState, TheLearnedStateRoundTripsAndBelongsToItsConfiguration) {
+  const dockd::LearnedState l = sample_learned();
+  const dockd::LearnedPaths paths = dockd::LearnedPaths::beside(path);
+  STRCMP_EQUAL((path + ".learned").c_str(), paths.file.c_str());
+  char buf[dockd::kMaxLearnedFileBytes];
+  char err[128] = "";
+  CHECK_TRUE_TEXT(dockd::save_learned(paths, l, buf, sizeof buf, err, sizeof err), err);
+  dockd::LearnedState back;
+  std::string msg;
+  CHECK_EQUAL(static_cast<int>(dockd::LearnedLoadStatus::kOk),
+              static_cast<int>(dockd::load_learned(paths.file, back, msg)));
+  CHECK_TRUE(dockd::same_learned(l.learned, back.learned));
+  CHECK_TRUE(back.learned_on(l.lidar_mount, l.drive));
+  CHECK_EQUAL(l.saved_unix_s, back.saved_unix_s);
+  // Another mount or another drive is another robot.
+  dockcore::Pose2 moved = l.lidar_mount;
+  moved.yaw_rad += static_cast<dockcore::Real>(0.01);
+  CHECK_FALSE(back.learned_on(moved, l.drive));
+  dockcore::DriveGeometry mecanum = l.drive;
+  mecanum.kind = dockcore::DriveKind::kMecanum;
+  CHECK_FALSE(back.learned_on(l.lidar_mount, mecanum));
+  // Any learned value that changes is a change.
+  dockd::LearnedState other = l;
+  other.learned.task.remembered_aim_m[5] = static_cast<dockcore::Real>(0.001);
+  CHECK_FALSE(dockd::same_learned(l.learned, other.learned));
+  other = l;
+  other.learned.deadband.raises = 5;
+  CHECK_FALSE(dockd::same_learned(l.learned, other.learned));
+  // A buffer too small formats nothing.
+  CHECK_EQUAL(0u, dockd::format_learned(l, buf, 64));
+  std::remove(paths.file.c_str());
+}
+
+TEST(DockdState, ABadLearnedFileIsReportedMovedAsideAndLearnedAgain) {
+  const std::string good = formatted(sample_learned());
+  dockd::LearnedState out;
+  std::string why;
+  CHECK_TRUE(dockd::parse_learned(good, out, why));
+  // Each of these is refused whole, with the line that is wrong.
+  const struct {
+    std::string text;
+    const char* reason;
+  } bad[] = {
+      {good.substr(0, good.size() - 3), "checksum"},
+      {std::string(good).replace(good.find("deadband 4"), 10, "deadband 5"), "checksum mismatch"},
+      {resealed(std::string(good).replace(good.find("aim 31"), 6, "aim 32")), "line 6"},
+      {resealed(std::string(good).replace(good.find(" 1.100000000"), 12, " nan")), "line 3"},
+      {resealed(std::string(good).replace(good.find("mount 1 1"), 9, "mount 1 9")), "line 4"},
+      {resealed(std::string(good).replace(good.find("\nlearned ") + 1, 8, "learnt ")), "line 2"},
+      {resealed("dockd-learned 1\ndeadband 0 0 0 0 0 0 0 0 0\ncrc32 00000000\n"), "no 'learned' line before it"},
+      {resealed("dockd-learned 2\ncrc32 00000000\n"), "unknown header"},
+  };
+  for (const auto& b : bad) {
+    why.clear();
+    CHECK_FALSE_TEXT(dockd::parse_learned(b.text, out, why), b.text.c_str());
+    STRCMP_CONTAINS(b.reason, why.c_str());
+  }
+  // Loaded from disk: reported, moved to .corrupt, and the next start finds none.
+  const std::string file = path + ".learned";
+  write_all(file, bad[3].text);
+  std::string msg;
+  CHECK_EQUAL(static_cast<int>(dockd::LearnedLoadStatus::kCorrupt),
+              static_cast<int>(dockd::load_learned(file, out, msg)));
+  STRCMP_CONTAINS("line 3", msg.c_str());
+  STRCMP_CONTAINS(".corrupt", msg.c_str());
+  CHECK_EQUAL(bad[3].text, read_all(file + ".corrupt"));
+  CHECK_EQUAL(static_cast<int>(dockd::LearnedLoadStatus::kMissing),
+              static_cast<int>(dockd::load_learned(file, out, msg)));
+  std::remove((file + ".corrupt").c_str());
+  // A directory that cannot be written: the save fails with the reason, and no file appears.
+  dockd::LearnedPaths nowhere = dockd::LearnedPaths::beside("/nonexistent-dir/state");
+  char buf[dockd::kMaxLearnedFileBytes];
+  char err[128] = "";
+  CHECK_FALSE(dockd::save_learned(nowhere, sample_learned(), buf, sizeof buf, err, sizeof err));
+  STRCMP_CONTAINS("cannot create /nonexistent-dir/state.learned.tmp", err);
 }

@@ -42,10 +42,7 @@ struct FakeActions final : dockd::HostActions {
     dockd::write_camera_groups(w, camera, true);
   }
   void camera_fields(dockd::JsonWriter& w) const override { dockd::write_camera_groups(w, camera, false); }
-  void counter_fields(dockd::JsonWriter& w, std::uint64_t) const override {
-    dockd::write_counters(w, status);
-    dockd::write_mount(w, status);
-  }
+  void counter_fields(dockd::JsonWriter& w, std::uint64_t) const override { dockd::write_counters_part(w, status); }
   const dockd::DockdConfig& config() const override { return cfg; }
   std::uint16_t active_dock_id() const override { return 0; }
   dockcore::SubmitResult submit(dockcore::HostCommandType, std::uint16_t, std::uint32_t, std::uint32_t&) override {
@@ -136,6 +133,7 @@ StatusValues worst_status() {
   v.commands = v.commands_rejected = v.resumes = v.can_host_rejected = v.udp_not_allowed = max_of(v.commands);
   v.replies_too_long = max_of(v.replies_too_long);
   v.config_reloads = v.config_reloads_rejected = max_of(v.config_reloads);
+  v.learned_saves = v.learned_save_failures = max_of(v.learned_saves);
   v.det_evidence_nats = r;
   for (double& c : v.det_cues_nats) c = r;
   const char* reject = longest_name<std::uint8_t>(
@@ -234,6 +232,7 @@ TEST(DockdStatus, TheLongestCountersPartFitsWhole) {
   STRCMP_EQUAL("counters", j.at("part").get<std::string>().c_str());
   CHECK_EQUAL(actions.status.ticks, j.at("ticks").get<std::uint64_t>());
   CHECK_EQUAL(actions.status.config_reloads_rejected, j.at("config_reloads_rejected").get<std::uint32_t>());
+  CHECK_EQUAL(actions.status.learned_save_failures, j.at("learned_save_failures").get<std::uint32_t>());
   CHECK_FALSE(j.contains("state"));
 }
 
