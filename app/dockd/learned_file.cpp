@@ -12,7 +12,7 @@
 #include <initializer_list>
 #include <sstream>
 
-#include "state_file.hpp"  // crc32_ieee
+#include "state_file.hpp"  // crc32_ieee, checked_body
 
 namespace dockd {
 
@@ -192,21 +192,8 @@ bool parse_learned_line(const std::string& line, bool started, LearnedState& l, 
 }  // namespace
 
 bool parse_learned(const std::string& text, LearnedState& out, std::string& error) {
-  const std::size_t pos = text.rfind("crc32 ");
-  if (pos == std::string::npos || (pos > 0 && text[pos - 1] != '\n')) {
-    error = "no checksum line (truncated?)";
-    return false;
-  }
-  unsigned crc = 0;
-  char tail = 0;
-  if (std::sscanf(text.c_str() + pos, "crc32 %8x%c", &crc, &tail) != 2 || tail != '\n' || pos + 15 != text.size()) {
-    error = "malformed checksum line";
-    return false;
-  }
-  if (crc32_ieee(text.data(), pos) != crc) {
-    error = "checksum mismatch (file corrupted)";
-    return false;
-  }
+  std::size_t pos = 0;
+  if (!checked_body(text, &pos, error)) return false;
   std::istringstream in(text.substr(0, pos));
   std::string line;
   if (!std::getline(in, line) || line != "dockd-learned 1") {

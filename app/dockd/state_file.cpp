@@ -55,6 +55,26 @@ std::uint32_t crc32_ieee(const char* data, std::size_t len) {
   return ~c;
 }
 
+bool checked_body(const std::string& text, std::size_t* body_size, std::string& error) {
+  const std::size_t pos = text.rfind("crc32 ");
+  if (pos == std::string::npos || (pos > 0 && text[pos - 1] != '\n')) {
+    error = "no checksum line (truncated?)";
+    return false;
+  }
+  unsigned crc = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str() + pos, "crc32 %8x%c", &crc, &tail) != 2 || tail != '\n' || pos + 15 != text.size()) {
+    error = "malformed checksum line";
+    return false;
+  }
+  if (crc32_ieee(text.data(), pos) != crc) {
+    error = "checksum mismatch (file corrupted)";
+    return false;
+  }
+  *body_size = pos;
+  return true;
+}
+
 std::string serialize_state(const StateData& s) {
   std::string body = "dockd-state 1\n";
   for (const TaughtTarget& t : s.targets) {
@@ -137,21 +157,8 @@ bool parse_code_line(const std::string& line, TaughtTarget& t, unsigned* id_out,
 }  // namespace
 
 bool parse_state(const std::string& text, StateData& out, std::string& error, std::vector<std::string>* warnings) {
-  const std::size_t pos = text.rfind("crc32 ");
-  if (pos == std::string::npos || (pos > 0 && text[pos - 1] != '\n')) {
-    error = "no checksum line (truncated?)";
-    return false;
-  }
-  unsigned crc = 0;
-  char tail = 0;
-  if (std::sscanf(text.c_str() + pos, "crc32 %8x%c", &crc, &tail) != 2 || tail != '\n' || pos + 15 != text.size()) {
-    error = "malformed checksum line";
-    return false;
-  }
-  if (crc32_ieee(text.data(), pos) != crc) {
-    error = "checksum mismatch (file corrupted)";
-    return false;
-  }
+  std::size_t pos = 0;
+  if (!checked_body(text, &pos, error)) return false;
   std::istringstream in(text.substr(0, pos));
   std::string line;
   if (!std::getline(in, line) || line != "dockd-state 1") {

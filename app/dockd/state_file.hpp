@@ -61,6 +61,9 @@ std::string serialize_state(const StateData& s);
 /// reported in `warnings` ("line N: ..."), changing nothing else. O(size).
 bool parse_state(const std::string& text, StateData& out, std::string& error,
                  std::vector<std::string>* warnings = nullptr);
+/// The length of `text` before its last line, a `crc32 <8 hex digits>` line that ends the text and matches the CRC-32
+/// of everything before it (dockd's state and learned files end so); false + reason otherwise. O(size).
+bool checked_body(const std::string& text, std::size_t* body_size, std::string& error);
 /// CRC-32 (IEEE, reflected, as zlib) of `len` bytes.
 std::uint32_t crc32_ieee(const char* data, std::size_t len);
 
