@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cinttypes>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -45,10 +46,15 @@ bool same_learned(const dockcore::DockcoreBase::Learned& a, const dockcore::Dock
 namespace {
 
 /// Appends printf-formatted text at buf + *len; false when it does not fit (nothing more is written then).
-template <typename... Args>
-bool append(char* buf, std::size_t size, std::size_t* len, const char* format, Args... args) {
+#if defined(__GNUC__)
+__attribute__((format(printf, 4, 5)))
+#endif
+bool append(char* buf, std::size_t size, std::size_t* len, const char* format, ...) {
   if (*len >= size) return false;
-  const int n = std::snprintf(buf + *len, size - *len, format, args...);
+  std::va_list args;
+  va_start(args, format);
+  const int n = std::vsnprintf(buf + *len, size - *len, format, args);
+  va_end(args);
   if (n < 0 || static_cast<std::size_t>(n) >= size - *len) {
     *len = size;
     return false;
