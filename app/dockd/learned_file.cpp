@@ -1,19 +1,13 @@
 #include "learned_file.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cinttypes>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <initializer_list>
 #include <sstream>
 
-#include "state_file.hpp"  // crc32_ieee, checked_body
+#include "state_file.hpp"  // crc32_ieee, checked_body, read_bounded, write_synced, replace_synced
 
 namespace dockd {
 
@@ -230,22 +224,14 @@ bool parse_learned(const std::string& text, LearnedState& out, std::string& erro
 }
 
 LearnedLoadStatus load_learned(const std::string& path, LearnedState& out, std::string& message) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    if (errno == ENOENT) return LearnedLoadStatus::kMissing;
-    message = path + ": cannot open: " + std::strerror(errno);
+  std::string text, why;
+  const FileRead r = read_bounded(path, kMaxLearnedFileBytes, text, why);
+  if (r == FileRead::kMissing) return LearnedLoadStatus::kMissing;
+  if (r == FileRead::kOk && parse_learned(text, out, why)) return LearnedLoadStatus::kOk;
+  if (r == FileRead::kBad && text.empty()) {  // could not be opened: nothing to move aside
+    message = path + ": " + why;
     return LearnedLoadStatus::kCorrupt;
   }
-  std::string text(kMaxLearnedFileBytes + 1, '\0');
-  in.read(&text[0], static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
-  std::string why;
-  if (text.size() > kMaxLearnedFileBytes) {
-    why = "larger than " + std::to_string(kMaxLearnedFileBytes) + " bytes";
-  } else if (parse_learned(text, out, why)) {
-    return LearnedLoadStatus::kOk;
-  }
-  in.close();
   std::rename(path.c_str(), (path + ".corrupt").c_str());
   message = path + ": " + why + "; moved to " + path + ".corrupt, learned again";
   return LearnedLoadStatus::kCorrupt;
@@ -255,60 +241,21 @@ LearnedPaths LearnedPaths::beside(const std::string& state_file) {
   LearnedPaths p;
   p.file = state_file + ".learned";
   p.tmp = p.file + ".tmp";
-  const std::size_t slash = p.file.find_last_of('/');
-  p.dir = slash == std::string::npos ? std::string(".") : (slash == 0 ? std::string("/") : p.file.substr(0, slash));
+  p.dir = directory_of(p.file);
   return p;
 }
 
 bool save_learned(const LearnedPaths& paths, const LearnedState& l, char* buf, std::size_t size, char* error,
                   std::size_t error_size) {
-  auto fail = [&](const char* what, const char* path) {
-    if (error != nullptr && error_size > 0)
-      std::snprintf(error, error_size, "%s %s: %s", what, path, std::strerror(errno));
-    return false;
-  };
   const std::size_t len = format_learned(l, buf, size);
   if (len == 0) {
-    errno = ENOSPC;
-    return fail("cannot format", paths.file.c_str());
-  }
-  const int fd = ::open(paths.tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return fail("cannot create", paths.tmp.c_str());
-  std::size_t done = 0;
-  while (done < len) {
-    const ssize_t n = ::write(fd, buf + done, len - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      if (n == 0) errno = EIO;
-      fail("cannot write", paths.tmp.c_str());
-      ::close(fd);
-      ::unlink(paths.tmp.c_str());
-      return false;
+    if (error != nullptr && error_size > 0) {
+      std::snprintf(error, error_size, "cannot format %s: more than %zu bytes", paths.file.c_str(), size);
     }
-    done += static_cast<std::size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    fail("cannot fsync", paths.tmp.c_str());
-    ::close(fd);
-    ::unlink(paths.tmp.c_str());
     return false;
   }
-  if (::close(fd) != 0) {
-    fail("cannot close", paths.tmp.c_str());
-    ::unlink(paths.tmp.c_str());
-    return false;
-  }
-  if (std::rename(paths.tmp.c_str(), paths.file.c_str()) != 0) {
-    fail("cannot rename", paths.tmp.c_str());
-    ::unlink(paths.tmp.c_str());
-    return false;
-  }
-  const int dfd = ::open(paths.dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
-  return true;
+  return write_synced(paths.tmp.c_str(), buf, len, error, error_size) &&
+         replace_synced(paths.tmp.c_str(), paths.file.c_str(), paths.dir.c_str(), error, error_size);
 }
 
 }  // namespace dockd

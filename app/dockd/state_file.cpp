@@ -217,32 +217,98 @@ bool parse_state(const std::string& text, StateData& out, std::string& error, st
   return true;
 }
 
+FileRead read_bounded(const std::string& path, std::size_t max_bytes, std::string& text, std::string& why) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    if (errno == ENOENT) return FileRead::kMissing;
+    why = std::string("cannot open: ") + std::strerror(errno);
+    return FileRead::kBad;
+  }
+  // Bounded: a legitimate file is small; a runaway one is corrupt, not read whole.
+  text.assign(max_bytes + 1, '\0');
+  in.read(&text[0], static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > max_bytes) {
+    why = "larger than " + std::to_string(max_bytes) + " bytes";
+    return FileRead::kBad;
+  }
+  return FileRead::kOk;
+}
+
+std::string directory_of(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string(".") : (slash == 0 ? std::string("/") : path.substr(0, slash));
+}
+
+namespace {
+
+/// Writes "WHAT PATH[ to TO]: strerror(errno)" into `error` (when there is room for it); false.
+bool fail_with_errno(char* error, std::size_t error_size, const char* what, const char* path,
+                     const char* to = nullptr) {
+  const int e = errno;
+  if (error != nullptr && error_size > 0) {
+    std::snprintf(error, error_size, "%s %s%s%s: %s", what, path, to != nullptr ? " to " : "", to != nullptr ? to : "",
+                  std::strerror(e));
+  }
+  return false;
+}
+
+}  // namespace
+
+bool write_synced(const char* tmp, const char* data, std::size_t len, char* error, std::size_t error_size) {
+  const int fd = ::open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return fail_with_errno(error, error_size, "cannot create", tmp);
+  std::size_t done = 0;
+  while (done < len) {
+    const ssize_t n = ::write(fd, data + done, len - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n == 0) errno = EIO;
+      fail_with_errno(error, error_size, "cannot write", tmp);
+      ::close(fd);
+      ::unlink(tmp);
+      return false;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0) {
+    fail_with_errno(error, error_size, "cannot fsync", tmp);
+    ::close(fd);
+    ::unlink(tmp);
+    return false;
+  }
+  if (::close(fd) != 0) {
+    fail_with_errno(error, error_size, "cannot close", tmp);
+    ::unlink(tmp);
+    return false;
+  }
+  return true;
+}
+
+bool replace_synced(const char* tmp, const char* path, const char* dir, char* error, std::size_t error_size) {
+  if (std::rename(tmp, path) != 0) {
+    fail_with_errno(error, error_size, "cannot rename", tmp, path);
+    ::unlink(tmp);
+    return false;
+  }
+  const int dfd = ::open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+  return true;
+}
+
 namespace {
 
 enum class ReadResult { kOk, kMissing, kBad };
 
 ReadResult read_file(const std::string& path, StateData& out, std::string& why,
                      std::vector<std::string>* warnings = nullptr) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    if (errno == ENOENT) return ReadResult::kMissing;
-    why = std::string("cannot open: ") + std::strerror(errno);
-    return ReadResult::kBad;
-  }
-  // Bounded: a legitimate file holds at most a few hundred bytes per dock; a runaway one is corrupt, not read whole.
-  std::string text(kMaxStateFileBytes + 1, '\0');
-  in.read(&text[0], static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
-  if (text.size() > kMaxStateFileBytes) {
-    why = "larger than " + std::to_string(kMaxStateFileBytes) + " bytes";
-    return ReadResult::kBad;
-  }
+  std::string text;
+  const FileRead r = read_bounded(path, kMaxStateFileBytes, text, why);
+  if (r != FileRead::kOk) return r == FileRead::kMissing ? ReadResult::kMissing : ReadResult::kBad;
   return parse_state(text, out, why, warnings) ? ReadResult::kOk : ReadResult::kBad;
-}
-
-std::string dir_of(const std::string& path) {
-  const std::size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? std::string(".") : (slash == 0 ? std::string("/") : path.substr(0, slash));
 }
 
 }  // namespace
@@ -291,40 +357,18 @@ StateLoadStatus load_state(const std::string& path, StateData& out, std::string&
 bool save_state(const std::string& path, const StateData& s, std::string& error) {
   const std::string text = serialize_state(s);
   const std::string tmp = path + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) {
-    error = "cannot create " + tmp + ": " + std::strerror(errno);
-    return false;
-  }
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      error = "cannot write " + tmp + ": " + std::strerror(errno);
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      return false;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    error = "cannot fsync " + tmp + ": " + std::strerror(errno);
-    ::unlink(tmp.c_str());
+  char why[512];
+  if (!write_synced(tmp.c_str(), text.data(), text.size(), why, sizeof why)) {
+    error = why;
     return false;
   }
   // The current file becomes the backup only if it is good: a corrupt file must never replace a good backup.
   StateData current;
-  std::string why;
-  if (read_file(path, current, why) == ReadResult::kOk) std::rename(path.c_str(), (path + ".bak").c_str());
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    error = "cannot rename " + tmp + " to " + path + ": " + std::strerror(errno);
+  std::string bad;
+  if (read_file(path, current, bad) == ReadResult::kOk) std::rename(path.c_str(), (path + ".bak").c_str());
+  if (!replace_synced(tmp.c_str(), path.c_str(), directory_of(path).c_str(), why, sizeof why)) {
+    error = why;
     return false;
-  }
-  const int dfd = ::open(dir_of(path).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
   }
   return true;
 }

@@ -67,6 +67,22 @@ bool checked_body(const std::string& text, std::size_t* body_size, std::string& 
 /// CRC-32 (IEEE, reflected, as zlib) of `len` bytes.
 std::uint32_t crc32_ieee(const char* data, std::size_t len);
 
+// The durable-file steps both of dockd's files use (the state file here, the learned file in learned_file.hpp).
+
+/// How read_bounded() ended.
+enum class FileRead : std::uint8_t { kOk, kMissing, kBad };
+/// Reads `path` whole into `text` when it holds at most `max_bytes`; kMissing when it does not exist; kBad with
+/// `why` ("cannot open: ...", "larger than N bytes") otherwise, without reading a runaway file whole. O(size).
+FileRead read_bounded(const std::string& path, std::size_t max_bytes, std::string& text, std::string& why);
+/// The directory `path` lies in, as open() takes it ("." for a bare name, "/" at the root).
+std::string directory_of(const std::string& path);
+/// Creates (or truncates) `tmp`, writes `len` bytes and fsyncs it; false with `tmp` removed and the reason ("cannot
+/// create|write|fsync|close TMP: ...") in `error` (NUL-terminated, at most `error_size`). No heap. O(len).
+bool write_synced(const char* tmp, const char* data, std::size_t len, char* error, std::size_t error_size);
+/// Renames `tmp` over `path` and fsyncs `dir`, the directory both lie in, so the new file outlives a power cut; false
+/// with `tmp` removed and the reason ("cannot rename TMP to PATH: ...") in `error`. No heap. O(1).
+bool replace_synced(const char* tmp, const char* path, const char* dir, char* error, std::size_t error_size);
+
 /// Loads `path` as described in the file comment; `message` explains anything other than kOk / kMissing.
 /// `warnings` receives the code lines left out of the file used ("FILE:LINE: ..."); they make no other change.
 StateLoadStatus load_state(const std::string& path, StateData& out, std::string& message,
