@@ -126,6 +126,7 @@ bool Daemon::configure_core(std::uint16_t dock_id, bool raw_profile) {
   const dockcore::DockcoreBase::Learned learned = core_->learned();
   if (!core_->configure(prof, core_cfg_)) return false;
   core_->restore_learned(learned);
+  if (loop_record_) loop_record_->restore_learned(learned);
   active_dock_ = dock_id;
   active_raw_ = raw_profile;
   if (loop_record_) loop_record_->rescan();

@@ -319,10 +319,6 @@ ReplayResult replay_loop_record(const std::string& path) {
         read_as(p, 0, &ctl);
         read_as(p, sizeof ctl, &profile);
         read_as(p, sizeof ctl + sizeof profile, &config);
-        // dockd carries what a core learned into its next configuration; a rebuilt core starts afresh.
-        const bool carry = rc && !rebuild;
-        DockcoreBase::Learned learned;
-        if (carry) learned = rc->core->learned();
         if (!rc || rebuild) {
           auto next = std::make_unique<ReplayCore>(ctl);
           const std::string name(ctl.name, strnlen(ctl.name, sizeof ctl.name));
@@ -337,7 +333,7 @@ ReplayResult replay_loop_record(const std::string& path) {
           rc->breakpoint = std::make_unique<BreakpointDetector>();
           rc->core->attach_breakpoint(rc->breakpoint.get());
         }
-        if (rc->core->configure(profile, config) && carry) rc->core->restore_learned(learned);
+        rc->core->configure(profile, config);
         break;
       }
       case LoopRecordKind::kTakeInputs:

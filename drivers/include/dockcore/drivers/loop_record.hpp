@@ -21,17 +21,19 @@ namespace dockcore::drivers {
 
 /// Record kinds.
 enum class LoopRecordKind : std::uint8_t {
-  kConfigure = 1,        ///< LoopConfig: controller, its parameters, profile, DockcoreConfig.
-  kWheels = 2,           ///< WheelSpeeds + stamp.
-  kOdometry = 3,         ///< Pose2 + Twist2 + stamp.
-  kScan = 4,             ///< stamp, read time, geometry, then count ranges and count intensities.
-  kTag = 5,              ///< TagObservation.
-  kSubmit = 6,           ///< QueuedCommand.
-  kCheckInputs = 7,      ///< now_us.
-  kTick = 8,             ///< TickInput + the TickDigest of its output.
-  kRescan = 9,           ///< (no payload)
-  kTakeInputs = 10,      ///< A rebuilt core continues this one's inputs: the next kConfigure builds it (no payload).
-  kRestoreLearned = 11,  ///< DockcoreBase::Learned handed to the core (a host's kept state, e.g. dockd's state file).
+  kConfigure = 1,    ///< LoopConfig: controller, its parameters, profile, DockcoreConfig.
+  kWheels = 2,       ///< WheelSpeeds + stamp.
+  kOdometry = 3,     ///< Pose2 + Twist2 + stamp.
+  kScan = 4,         ///< stamp, read time, geometry, then count ranges and count intensities.
+  kTag = 5,          ///< TagObservation.
+  kSubmit = 6,       ///< QueuedCommand.
+  kCheckInputs = 7,  ///< now_us.
+  kTick = 8,         ///< TickInput + the TickDigest of its output.
+  kRescan = 9,       ///< (no payload)
+  kTakeInputs = 10,  ///< A rebuilt core continues this one's inputs: the next kConfigure builds it (no payload).
+  /// DockcoreBase::Learned handed to the core: what dockd carries into each new configuration, or restores from its
+  /// learned file. A replay applies it as recorded; a configure alone starts afresh.
+  kRestoreLearned = 11,
 };
 
 /// Which controller a configure uses and its parameters (the other three keep their defaults).
