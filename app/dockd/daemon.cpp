@@ -192,17 +192,6 @@ bool Daemon::start(std::string& error) {
   std::string msg;
   std::vector<std::string> warnings;
   const StateLoadStatus st = load_state(cfg_.state_file, state_, msg, &warnings);
-  learned_paths_ = LearnedPaths::beside(cfg_.state_file);
-  {
-    std::string why;
-    const LearnedLoadStatus ls = load_learned(learned_paths_.file, learned_file_, why);
-    have_learned_file_ = ls == LearnedLoadStatus::kOk;
-    if (ls == LearnedLoadStatus::kCorrupt) {
-      EventLine e(now, "learned");
-      e.w.str("result", "corrupt").str_cut("message", why.c_str(), 1024);
-      log_event(e, LogLevel::kWarn);
-    }
-  }
   if (st == StateLoadStatus::kRecoveredBackup || st == StateLoadStatus::kCorruptNoBackup) {
     EventLine e(now, "state_file");
     e.w.str("level", st == StateLoadStatus::kCorruptNoBackup ? "error" : "warn").str_cut("message", msg.c_str(), 1024);
@@ -223,6 +212,16 @@ bool Daemon::start(std::string& error) {
   for (const std::string& w : warnings) {
     EventLine e(now, "state_file");
     e.w.str("level", "warn").str_cut("message", w.c_str(), 1024);
+    log_event(e, LogLevel::kWarn);
+  }
+  // What the robot learned, restored once the core is configured (restore_learned_state).
+  learned_paths_ = LearnedPaths::beside(cfg_.state_file);
+  std::string learned_why;
+  const LearnedLoadStatus ls = load_learned(learned_paths_.file, learned_file_, learned_why);
+  have_learned_file_ = ls == LearnedLoadStatus::kOk;
+  if (ls == LearnedLoadStatus::kCorrupt) {
+    EventLine e(now, "learned");
+    e.w.str("result", "corrupt").str_cut("message", learned_why.c_str(), 1024);
     log_event(e, LogLevel::kWarn);
   }
   if (cfg_.record_loop && !cfg_.record_dir.empty()) {

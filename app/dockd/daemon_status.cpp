@@ -111,8 +111,7 @@ void Daemon::camera_fields(JsonWriter& w) const {
 }
 
 void Daemon::counter_fields(JsonWriter& w, std::uint64_t now_us) const {
-  const StatusValues v = status_values(now_us);
-  write_counters_part(w, v);
+  write_counters_part(w, status_values(now_us));
 }
 
 StatusValues Daemon::status_values(std::uint64_t now_us) const {

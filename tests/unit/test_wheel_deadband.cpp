@@ -31,6 +31,19 @@ WheelSpeeds wheels(Real left, Real right) {
   return w;
 }
 
+/// Both wheels at `radps`.
+WheelSpeeds both(Real radps) {
+  return wheels(radps, radps);
+}
+
+/// The default parameters with stall_ms at 250 ms: the tests that time stands against it keep their timings whatever
+/// the default.
+WheelDeadbandParams stands_timed_at_250_ms() {
+  WheelDeadbandParams p;
+  p.stall_ms = 250;
+  return p;
+}
+
 /// Feeds `commanded` and `measured` every 20 ms from `t0_us` for `duration_ms`; returns the time after the last.
 std::uint64_t hold(WheelDeadband& d, const WheelSpeeds& commanded, const WheelSpeeds& measured, std::uint64_t t0_us,
                    std::uint64_t duration_ms, bool learn = true) {
@@ -93,7 +106,7 @@ TEST(WheelDeadband, APivotingWheelStaysInTheDeadbandAndTheWheelLimitCapsTheScale
 TEST(WheelDeadband, AStalledWheelRaisesItsOwnFloorForItsOwnDirectionOnly) {
   WheelDeadband d;
   d.configure(WheelDeadbandParams{});
-  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  const WheelSpeeds cmd = both(static_cast<Real>(0.6));
   // The left wheel stands, the right one follows.
   const std::uint64_t stall_ms = WheelDeadbandParams{}.stall_ms;
   const std::uint64_t t = hold(d, cmd, wheels(0, static_cast<Real>(0.58)), 0, stall_ms - 20);
@@ -108,7 +121,7 @@ TEST(WheelDeadband, AStalledWheelRaisesItsOwnFloorForItsOwnDirectionOnly) {
 TEST(WheelDeadband, AWheelSlowToFollowOrToldNotToLearnIsNoStall) {
   WheelDeadband d;
   d.configure(WheelDeadbandParams{});
-  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  const WheelSpeeds cmd = both(static_cast<Real>(0.6));
   // Standing for most of stall_ms (latency and motor lag), then following: the stall never lasts stall_ms.
   std::uint64_t t = hold(d, cmd, wheels(0, 0), 0, WheelDeadbandParams{}.stall_ms - 60);
   t = hold(d, cmd, wheels(static_cast<Real>(0.5), static_cast<Real>(0.5)), t, 2000);
@@ -144,11 +157,10 @@ TEST(WheelDeadband, FloorsGrowStepByStepUpToTheBoundAndConfigureForgetsThem) {
 // What a drive taught one configuration goes on into the next (dockd configuring the core for another dock): the
 // floors and their count, clamped as configure() clamps the known deadband; a stall in progress is not carried.
 TEST(WheelDeadband, RestoredFloorsAreTheLearnedOnesWithinThisConfigurationsBounds) {
-  WheelDeadbandParams p;
-  p.stall_ms = 250;
+  const WheelDeadbandParams p = stands_timed_at_250_ms();
   WheelDeadband taught;
   taught.configure(p);
-  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  const WheelSpeeds cmd = both(static_cast<Real>(0.6));
   std::uint64_t t = hold(taught, cmd, wheels(0, static_cast<Real>(0.6)), 0, 300);  // the left wheel stands
   LONGS_EQUAL(1, taught.raises());
   DOUBLES_EQUAL(0.75, static_cast<double>(taught.floor_radps(0, false)), kTol);
@@ -193,11 +205,10 @@ TEST(WheelDeadband, ACommandAtItsFloorUpToRoundingStillStalls) {
 // A wheel whose deadband lies inside the range the controller's corrections sweep stands, turns and stands again;
 // no stand lasts stall_ms, but they add up.
 TEST(WheelDeadband, StandsInterruptedByShortTurnsAddUpToAStall) {
-  WheelDeadbandParams p;
-  p.stall_ms = 250;
+  const WheelDeadbandParams p = stands_timed_at_250_ms();
   WheelDeadband d;
   d.configure(p);
-  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  const WheelSpeeds cmd = both(static_cast<Real>(0.6));
   const WheelSpeeds turning = wheels(static_cast<Real>(0.55), static_cast<Real>(0.55));
   std::uint64_t t = 0;
   for (int k = 0; k < 2; ++k) {
@@ -216,11 +227,9 @@ TEST(WheelDeadband, StandsInterruptedByShortTurnsAddUpToAStall) {
 // below, so the stands still add up, and the floor comes from the latest stand (the first one, a start from rest at a
 // smaller command, would teach a floor the wheel still stands above).
 TEST(WheelDeadband, TurningFasterThanItStoodKeepsTheStandsAndTheLatestOneSetsTheFloor) {
-  WheelDeadbandParams p;
-  p.stall_ms = 250;
+  const WheelDeadbandParams p = stands_timed_at_250_ms();
   WheelDeadband d;
   d.configure(p);
-  const auto both = [](Real radps) { return wheels(radps, radps); };
   const auto left_stands = [](Real radps) { return wheels(0, radps); };
   std::uint64_t t = hold(d, both(static_cast<Real>(0.3)), left_stands(static_cast<Real>(0.3)), 0, 140);  // 140 ms
   t = hold(d, both(static_cast<Real>(0.9)), both(static_cast<Real>(0.88)), t, 400);       // turns well past stall_ms
@@ -235,9 +244,8 @@ TEST(WheelDeadband, TurningFasterThanItStoodKeepsTheStandsAndTheLatestOneSetsThe
 // A stand that ends in stall_ms of following was the drive being slow, and a command that stops or turns round
 // starts afresh: neither lets two stands add up.
 TEST(WheelDeadband, FollowingForStallMsOrAStoppedCommandForgetsTheStands) {
-  WheelDeadbandParams p;
-  p.stall_ms = 250;
-  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  const WheelDeadbandParams p = stands_timed_at_250_ms();
+  const WheelSpeeds cmd = both(static_cast<Real>(0.6));
   const WheelSpeeds standing = wheels(0, 0);
   {
     WheelDeadband d;
@@ -313,7 +321,7 @@ TEST(WheelDeadband, ASlowMotorStartingOrTurningRoundIsNoStall) {
 TEST(WheelDeadband, ARepeatedStampAddsNoTime) {
   WheelDeadband d;
   d.configure(WheelDeadbandParams{});
-  const WheelSpeeds cmd = wheels(static_cast<Real>(0.6), static_cast<Real>(0.6));
+  const WheelSpeeds cmd = both(static_cast<Real>(0.6));
   // A chassis that has fallen silent: the last feedback (standing) is handed over tick after tick.
   for (int i = 0; i < 100; ++i) d.observe(cmd, wheels(0, 0), 40 * kMs, true);
   LONGS_EQUAL(0, d.raises());
