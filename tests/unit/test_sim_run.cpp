@@ -545,6 +545,36 @@ TEST(SimRun, APasserByStepsAroundTheRobotAndTheRobotDocks) {
   CHECK(r.outcome.min_clearance_m < 0.5);  // it did come by
 }
 
+// Someone stepping in front of the robot stands in front of it, not inside it: a standing obstacle due to appear on
+// the robot appears just clear of its outline, further from its centre; one already clear stays where it was put (a
+// disc 1.5 cm from the bumper is a case of its own).
+TEST(SimRun, SomeoneSteppingInFrontOfTheRobotAppearsBesideItNotInsideIt) {
+  const docksim::Scenario sc = default_scenario();
+  const std::vector<dockcore::Vec2> outline = docksim::footprint_outline(sc.chassis);
+  double front_m = -1e9;
+  for (const auto& q : outline) front_m = std::max(front_m, static_cast<double>(q.x()));
+  const dockcore::Pose2 robot = dockcore_test::pose(1.0, 0.5, 30 * kDeg);
+  docksim::ScenarioEvent ev;
+  ev.kind = docksim::EventKind::kObstacle;
+  ev.r_m = 0.15;
+  // 0.1 m ahead of the robot's centre: the disc would cover the lidar.
+  const dockcore::Vec2 inside = robot.transform(dockcore::Vec2(static_cast<dockcore::Real>(0.1), 0));
+  ev.x_m = static_cast<double>(inside.x());
+  ev.y_m = static_cast<double>(inside.y());
+  const dockcore::Vec2 at = robot.inverse_transform(docksim::obstacle_entry(sc, ev, robot, 0));
+  const double near_edge_m = static_cast<double>(at.x()) - ev.r_m;
+  CHECK(near_edge_m > front_m);                           // clear of the bumper
+  CHECK(near_edge_m <= front_m + 0.011);                  // and no further than a step beyond it
+  DOUBLES_EQUAL(0.0, static_cast<double>(at.y()), 1e-9);  // straight ahead, away from the centre
+  // A disc 1.5 cm ahead of the bumper is left where it is.
+  const dockcore::Vec2 near = robot.transform(dockcore::Vec2(static_cast<dockcore::Real>(front_m + 0.015 + ev.r_m), 0));
+  ev.x_m = static_cast<double>(near.x());
+  ev.y_m = static_cast<double>(near.y());
+  const dockcore::Vec2 kept = docksim::obstacle_entry(sc, ev, robot, 0);
+  DOUBLES_EQUAL(ev.x_m, static_cast<double>(kept.x()), 1e-12);
+  DOUBLES_EQUAL(ev.y_m, static_cast<double>(kept.y()), 1e-12);
+}
+
 // A start 1 m out, 30° off the axis, facing the box that stands beside the dock: straight ahead is blocked, turning
 // on the spot is not. The robot turns away on its controller's turn and docks; stopping the whole command instead
 // holds it there until fault 180.

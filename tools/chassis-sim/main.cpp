@@ -274,8 +274,8 @@ int run(const Options& opt) {
         case docksim::EventKind::kPush: chassis.apply_pose_jump(ev.dx_m, ev.dy_m, ev.dyaw_rad); break;
         case docksim::EventKind::kOccludeDock: occluded_until = std::max(occluded_until, mt + ev.duration_s); break;
         case docksim::EventKind::kObstacle:
-          discs.push_back({dockcore::Vec2(static_cast<dockcore::Real>(ev.x_m), static_cast<dockcore::Real>(ev.y_m)),
-                           ev.r_m, ev.duration_s > 0 ? mt + ev.duration_s : 1e300});
+          discs.push_back({docksim::obstacle_entry(sc, ev, chassis.state().true_pose, 0), ev.r_m,
+                           ev.duration_s > 0 ? mt + ev.duration_s : 1e300});
           break;
         case docksim::EventKind::kLidarDropout: dropout_until = std::max(dropout_until, mt + ev.duration_s); break;
         case docksim::EventKind::kChargingNeverStarts: chassis.set_charging_inhibited(true); break;

@@ -314,6 +314,23 @@ double robot_clearance(const Scenario& sc, const std::vector<Vec2>& outline, con
                    obs);
 }
 
+Vec2 obstacle_entry(const Scenario& sc, const ScenarioEvent& ev, const Pose2& robot_pose, double clearance_m) {
+  const std::vector<Vec2> outline = footprint_outline(sc.chassis);
+  const bool walks = ev.vx_mps != 0 || ev.vy_mps != 0;
+  Vec2 at = v2(ev.x_m, ev.y_m);
+  // A passer-by comes from further back on its way; someone standing stands further from the robot's centre.
+  const Vec2 away = walks ? v2(-ev.vx_mps, -ev.vy_mps) : at - Vec2(robot_pose.x_m, robot_pose.y_m);
+  const Vec2 step = (away.norm() > 0 ? Vec2(away.normalized()) : v2(1, 0)) * static_cast<Real>(walks ? 0.05 : 0.01);
+  for (int i = 0; i < (walks ? 100 : 500); ++i) {
+    Obstacles one;
+    one.discs.push_back({pd(at), ev.r_m});
+    const double c = robot_clearance(sc, outline, robot_pose, one);  // 0 when touching or overlapping
+    if (clearance_m > 0 ? c >= clearance_m : c > 0) break;
+    at = at + step;
+  }
+  return at;
+}
+
 StartPose draw_start(const Scenario& sc, std::uint64_t seed) {
   Rng rng(mix64(seed ^ 0x5354415254ull));
   const StartEnvelope& e = sc.start;
@@ -485,24 +502,16 @@ SimRun run_docking(const Scenario& sc, const std::string& controller, std::uint6
           break;
         case EventKind::kObstacle:
           if (ev.vx_mps != 0 || ev.vy_mps != 0) {
-            // A passer-by enters where the robot is not: one due to appear at the robot comes from further back on
-            // its way.
-            Vec2 from = v2(ev.x_m, ev.y_m);
-            const Vec2 back = v2(-ev.vx_mps, -ev.vy_mps).normalized() * static_cast<Real>(0.05);
-            for (int i = 0; i < 100; ++i) {
-              Obstacles one;
-              one.discs.push_back({pd(from), ev.r_m});
-              if (robot_clearance(sc, outline, chassis.state().true_pose, one) >= kPasserGiveWayM) break;
-              from = from + back;
-            }
+            const Vec2 from = obstacle_entry(sc, ev, chassis.state().true_pose, kPasserGiveWayM);
             active_obs.push_back(
                 {from, ev.r_m, 1e300, v2(ev.vx_mps, ev.vy_mps), ev.duration_s > 0 ? ev.duration_s : 1e300});
             std::snprintf(buf, sizeof buf, "passer-by r %.2f m from (%.2f, %.2f) at (%.2f, %.2f) m/s for %.2f s",
                           ev.r_m, ev.x_m, ev.y_m, ev.vx_mps, ev.vy_mps, ev.duration_s);
           } else {
-            active_obs.push_back({v2(ev.x_m, ev.y_m), ev.r_m, ev.duration_s > 0 ? t + ev.duration_s : 1e300});
-            std::snprintf(buf, sizeof buf, "obstacle r %.2f m at (%.2f, %.2f) for %.2f s", ev.r_m, ev.x_m, ev.y_m,
-                          ev.duration_s);
+            const Vec2 at = obstacle_entry(sc, ev, chassis.state().true_pose, 0);
+            active_obs.push_back({at, ev.r_m, ev.duration_s > 0 ? t + ev.duration_s : 1e300});
+            std::snprintf(buf, sizeof buf, "obstacle r %.2f m at (%.2f, %.2f) for %.2f s", ev.r_m,
+                          static_cast<double>(at.x()), static_cast<double>(at.y()), ev.duration_s);
           }
           break;
         case EventKind::kLidarDropout:

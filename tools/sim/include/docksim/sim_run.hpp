@@ -162,6 +162,13 @@ DockPlacement dock_placement(const Scenario& sc);
 /// The robot's outline in the body frame (rectangle corners or a 24-gon). O(1).
 std::vector<dockcore::Vec2> footprint_outline(const ChassisParams& chassis);
 
+/// Where an `obstacle` event's disc appears when the robot stands at `robot_pose` (world): at the event's place, or,
+/// when that would put it within `clearance_m` of the robot's outline (0: touching or inside it), further away until
+/// it is not (at most 5 m): a walking one further back on its way in 5 cm steps, a standing one further from the
+/// robot's centre in 1 cm steps. Someone entering does not appear inside the robot. O(outline) per step.
+dockcore::Vec2 obstacle_entry(const Scenario& sc, const ScenarioEvent& ev, const dockcore::Pose2& robot_pose,
+                              double clearance_m);
+
 /// The wall behind the dock (Scenario::wall, wall_gap_m, wall_half_length_m) as a world segment a-b, glass or not;
 /// false when the dock is free-standing. O(vertices).
 bool dock_wall(const Scenario& sc, dockcore::Vec2* a, dockcore::Vec2* b);
