@@ -270,6 +270,11 @@ const DockEstimate& DockcoreBase::estimate_scan(const ScanView& scan, std::uint6
         ((Vec2(detected_in_odom.x_m, detected_in_odom.y_m) - Vec2(expected_in_odom.x_m, expected_in_odom.y_m)).norm() >
              kSceneGateM ||
          std::fabs(wrap_angle(detected_in_odom.yaw_rad - expected_in_odom.yaw_rad)) > kSceneGateRad);
+    // Where the filter had the dock before something the room overruled restarted it: a detection back there is the
+    // dock seen again (the push test leaves it alone unless the room says the robot was moved).
+    d.at_overruled_place = off_expectation && overruled_restart_set_ &&
+                           check_pose_deviation(detected_in_odom, overruled_restart_from_, 0, 0,
+                                                config_.task.deviation) == FaultCode::kNone;
     if (off_expectation && scene_.reference_points() > 0) {
       // The push the detection implies, and the partial readings of it that a noisy detection allows.
       const Real dock_radius_m = estimator_.profile_radius_m() + config_.scene.range_tolerance_m;

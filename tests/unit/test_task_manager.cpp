@@ -90,6 +90,7 @@ struct Sim {
   bool dock_confirmed = true;             // DockInput::confirmed
   std::vector<Pose2> outliers;            // next detections report these dock poses (world frame), in order
   SceneVerdict outlier_scene = SceneVerdict::kUnknown;  // what the room says on an outlier's scan (SceneCheck)
+  bool outlier_at_overruled_place = false;              // outliers lie where the filter was before an overruled restart
   SceneVerdict scene = SceneVerdict::kUnknown;          // what the room says on the other scans
   bool expectation_from_filter = false;  // detections carry the filter's expectation, as Dockcore records it
   double start_yaw = kPi;
@@ -174,6 +175,7 @@ struct Sim {
         if (!outliers.empty()) {
           det.dock_in_robot = placed.compose(world.inverse().compose(outliers.front()));
           det.scene = outlier_scene;
+          det.at_overruled_place = outlier_at_overruled_place;
           outliers.erase(outliers.begin());
         }
         det.odom_at_scan = odom;
@@ -430,6 +432,29 @@ TEST(TaskManager, ARepeatedOutlierWhileTheRoomStandsStillIsNotAPush) {
       CHECK(s->out.status.state == TaskState::kFault);
       LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
       LONGS_EQUAL(0, static_cast<long>(s->tm.pushes_overruled()));
+    }
+  }
+}
+
+// The filter followed furniture taken for the hidden dock (a restart the room overruled); the dock, seen again where
+// the filter had it before, fails the push test against the furniture, and the room is too bare to say anything. It
+// is the dock back, not a push. The same detections anywhere else are one.
+TEST(TaskManager, TheDockSeenAgainWhereItStoodBeforeFurnitureTookOverIsNotAPush) {
+  for (const bool at_old_place : {true, false}) {
+    auto s = std::make_unique<Sim>();
+    s->command(HostCommandType::kDock);
+    CHECK(s->run_until(TaskState::kAlign, 5));
+    s->run_for(0.5);
+    s->outlier_scene = SceneVerdict::kUnknown;
+    s->outlier_at_overruled_place = at_old_place;
+    for (int i = 0; i < 5; ++i) s->outliers.push_back(Pose2{0.1, 0.9, 0});
+    for (int i = 0; i < 30 && s->out.status.state == TaskState::kAlign; ++i) s->step();
+    if (at_old_place) {
+      CHECK(s->out.status.state == TaskState::kAlign);
+      LONGS_EQUAL(5, static_cast<long>(s->tm.pushes_overruled()));
+    } else {
+      CHECK(s->out.status.state == TaskState::kFault);
+      LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
     }
   }
 }

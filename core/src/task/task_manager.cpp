@@ -366,6 +366,12 @@ bool TaskManager::test_detection(const DetectionInput& det, const TaskInput& in)
     raise(f, in);
     return true;
   }
+  // The dock back where it stood before furniture was taken for it while it was hidden, in a room too bare to say
+  // whether the robot moved: the filter followed the furniture, not the robot a push.
+  if (det.at_overruled_place) {
+    ++pushes_overruled_;
+    return false;
+  }
   // A push moves every later detection to the same new place; an outlier is alone. Count only failing
   // detections that agree with an earlier failing one (same tolerances as the push test itself). Two places are
   // kept: a lone outlier between two detections of a pushed robot (sparse at range) starts a place of its own

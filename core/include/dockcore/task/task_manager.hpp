@@ -222,6 +222,10 @@ struct DetectionInput {
   /// kMoved means the room moved as the detection implies, so even an expectation that rests on one detection
   /// (expectation_confirmed false) is the push test's reference.
   SceneVerdict scene = SceneVerdict::kUnknown;
+  /// The detection lies, within the push test's tolerances, where the filter had the dock before a detection the room
+  /// overruled restarted it on something else (furniture taken for the hidden dock): the dock seen again, not a push,
+  /// unless the room says the robot was moved.
+  bool at_overruled_place = false;
 };
 
 /// Detections one tick can carry: a host draining a scan backlog after a stall hands several scans to
@@ -311,7 +315,8 @@ class TaskManager {
   /// A detection failed the push test and the next agreeing one would raise 178/179 (ALIGN). O(1).
   bool push_suspected() const { return suspects_ > 0; }
   /// Detections that failed the push test while their scan showed the room standing where odometry puts it
-  /// (DetectionInput::scene kStill): taken for other objects, not counted towards 178/179. Since configure(). O(1).
+  /// (DetectionInput::scene kStill), or that saw the dock again where it stood before furniture was taken for it
+  /// (DetectionInput::at_overruled_place): not counted towards 178/179. Since configure(). O(1).
   std::uint32_t pushes_overruled() const { return pushes_overruled_; }
   /// Where this attempt aims beside the dock's axis (retry_lateral_step_m), m in the dock frame's y. O(1).
   Real retry_lateral_offset_m() const;
