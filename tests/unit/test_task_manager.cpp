@@ -412,51 +412,44 @@ TEST(TaskManager, SingleOutlierDetectionIsNotAFault) {
   CHECK(s->run_until(TaskState::kFinishTasking, 30));
 }
 
+// Five detections of one place 0.9 m beside the dock, agreeing with each other and failing the push test, with what
+// the room says of them (`scene`) and whether they lie where the filter had the dock before an overruled restart:
+// `not_a_push` they are counted as overruled and the docking goes on, otherwise they fault 178.
+namespace {
+void repeated_outliers(SceneVerdict scene, bool at_overruled_place, bool not_a_push) {
+  auto s = std::make_unique<Sim>();
+  s->command(HostCommandType::kDock);
+  CHECK(s->run_until(TaskState::kAlign, 5));
+  s->run_for(0.5);
+  s->outlier_scene = scene;
+  s->outlier_at_overruled_place = at_overruled_place;
+  for (int i = 0; i < 5; ++i) s->outliers.push_back(Pose2{0.1, 0.9, 0});
+  for (int i = 0; i < 30 && s->out.status.state == TaskState::kAlign; ++i) s->step();
+  if (not_a_push) {
+    CHECK(s->out.status.state == TaskState::kAlign);
+    LONGS_EQUAL(5, static_cast<long>(s->tm.pushes_overruled()));
+    CHECK(s->run_until(TaskState::kFinishTasking, 30));
+  } else {
+    CHECK(s->out.status.state == TaskState::kFault);
+    LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
+    LONGS_EQUAL(0, static_cast<long>(s->tm.pushes_overruled()));
+  }
+}
+}  // namespace
+
 // Furniture taken for the dock scan after scan while the dock is hidden: the detections agree with each other and
 // fail the push test, but the room stands where odometry puts it, so it is no push. The same detections without
 // the room's word are one.
 TEST(TaskManager, ARepeatedOutlierWhileTheRoomStandsStillIsNotAPush) {
-  for (const bool still : {true, false}) {
-    auto s = std::make_unique<Sim>();
-    s->command(HostCommandType::kDock);
-    CHECK(s->run_until(TaskState::kAlign, 5));
-    s->run_for(0.5);
-    s->outlier_scene = still ? SceneVerdict::kStill : SceneVerdict::kUnknown;
-    for (int i = 0; i < 5; ++i) s->outliers.push_back(Pose2{0.1, 0.9, 0});
-    for (int i = 0; i < 30 && s->out.status.state == TaskState::kAlign; ++i) s->step();
-    if (still) {
-      CHECK(s->out.status.state == TaskState::kAlign);
-      LONGS_EQUAL(5, static_cast<long>(s->tm.pushes_overruled()));
-      CHECK(s->run_until(TaskState::kFinishTasking, 30));
-    } else {
-      CHECK(s->out.status.state == TaskState::kFault);
-      LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
-      LONGS_EQUAL(0, static_cast<long>(s->tm.pushes_overruled()));
-    }
-  }
+  repeated_outliers(SceneVerdict::kStill, false, true);
+  repeated_outliers(SceneVerdict::kUnknown, false, false);
 }
 
 // The filter followed furniture taken for the hidden dock (a restart the room overruled); the dock, seen again where
 // the filter had it before, fails the push test against the furniture, and the room is too bare to say anything. It
-// is the dock back, not a push. The same detections anywhere else are one.
+// is the dock back, not a push. The same detections anywhere else are one (above).
 TEST(TaskManager, TheDockSeenAgainWhereItStoodBeforeFurnitureTookOverIsNotAPush) {
-  for (const bool at_old_place : {true, false}) {
-    auto s = std::make_unique<Sim>();
-    s->command(HostCommandType::kDock);
-    CHECK(s->run_until(TaskState::kAlign, 5));
-    s->run_for(0.5);
-    s->outlier_scene = SceneVerdict::kUnknown;
-    s->outlier_at_overruled_place = at_old_place;
-    for (int i = 0; i < 5; ++i) s->outliers.push_back(Pose2{0.1, 0.9, 0});
-    for (int i = 0; i < 30 && s->out.status.state == TaskState::kAlign; ++i) s->step();
-    if (at_old_place) {
-      CHECK(s->out.status.state == TaskState::kAlign);
-      LONGS_EQUAL(5, static_cast<long>(s->tm.pushes_overruled()));
-    } else {
-      CHECK(s->out.status.state == TaskState::kFault);
-      LONGS_EQUAL(178, static_cast<int>(s->out.status.fault));
-    }
-  }
+  repeated_outliers(SceneVerdict::kUnknown, true, true);
 }
 
 // A first look from afar put the dock 0.5 m too near, and the task started on it. Later detections see it where it
