@@ -228,7 +228,7 @@ LearnedLoadStatus load_learned(const std::string& path, LearnedState& out, std::
   const FileRead r = read_bounded(path, kMaxLearnedFileBytes, text, why);
   if (r == FileRead::kMissing) return LearnedLoadStatus::kMissing;
   if (r == FileRead::kOk && parse_learned(text, out, why)) return LearnedLoadStatus::kOk;
-  if (r == FileRead::kBad && text.empty()) {  // could not be opened: nothing to move aside
+  if (r == FileRead::kUnreadable) {  // nothing to move aside
     message = path + ": " + why;
     return LearnedLoadStatus::kCorrupt;
   }

@@ -222,7 +222,7 @@ FileRead read_bounded(const std::string& path, std::size_t max_bytes, std::strin
   if (!in) {
     if (errno == ENOENT) return FileRead::kMissing;
     why = std::string("cannot open: ") + std::strerror(errno);
-    return FileRead::kBad;
+    return FileRead::kUnreadable;
   }
   // Bounded: a legitimate file is small; a runaway one is corrupt, not read whole.
   text.assign(max_bytes + 1, '\0');
@@ -230,7 +230,7 @@ FileRead read_bounded(const std::string& path, std::size_t max_bytes, std::strin
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > max_bytes) {
     why = "larger than " + std::to_string(max_bytes) + " bytes";
-    return FileRead::kBad;
+    return FileRead::kTooLarge;
   }
   return FileRead::kOk;
 }

@@ -69,10 +69,11 @@ std::uint32_t crc32_ieee(const char* data, std::size_t len);
 
 // The durable-file steps both of dockd's files use (the state file here, the learned file in learned_file.hpp).
 
-/// How read_bounded() ended.
-enum class FileRead : std::uint8_t { kOk, kMissing, kBad };
-/// Reads `path` whole into `text` when it holds at most `max_bytes`; kMissing when it does not exist; kBad with
-/// `why` ("cannot open: ...", "larger than N bytes") otherwise, without reading a runaway file whole. O(size).
+/// How read_bounded() ended: read, no such file, could not be opened, or over its size bound.
+enum class FileRead : std::uint8_t { kOk, kMissing, kUnreadable, kTooLarge };
+/// Reads `path` whole into `text` when it holds at most `max_bytes`; kMissing when it does not exist; kUnreadable
+/// ("cannot open: ...") or kTooLarge ("larger than N bytes", without reading a runaway file whole) with `why`
+/// otherwise. O(size).
 FileRead read_bounded(const std::string& path, std::size_t max_bytes, std::string& text, std::string& why);
 /// The directory `path` lies in, as open() takes it ("." for a bare name, "/" at the root).
 std::string directory_of(const std::string& path);

@@ -320,12 +320,13 @@ Vec2 obstacle_entry(const Scenario& sc, const ScenarioEvent& ev, const Pose2& ro
   Vec2 at = v2(ev.x_m, ev.y_m);
   // A passer-by comes from further back on its way; someone standing stands further from the robot's centre.
   const Vec2 away = walks ? v2(-ev.vx_mps, -ev.vy_mps) : at - Vec2(robot_pose.x_m, robot_pose.y_m);
-  const Vec2 step = (away.norm() > 0 ? Vec2(away.normalized()) : v2(1, 0)) * static_cast<Real>(walks ? 0.05 : 0.01);
-  for (int i = 0; i < (walks ? 100 : 500); ++i) {
+  const double step_m = walks ? 0.05 : 0.01;
+  const Vec2 step = (away.norm() > 0 ? Vec2(away.normalized()) : v2(1, 0)) * static_cast<Real>(step_m);
+  for (int i = 0; i < static_cast<int>(std::lround(5.0 / step_m)); ++i) {
     Obstacles one;
     one.discs.push_back({pd(at), ev.r_m});
     const double c = robot_clearance(sc, outline, robot_pose, one);  // 0 when touching or overlapping
-    if (clearance_m > 0 ? c >= clearance_m : c > 0) break;
+    if (c >= clearance_m && c > 0) break;
     at = at + step;
   }
   return at;
