@@ -32,6 +32,29 @@ if fail:
     print("\n".join(fail), file=sys.stderr)
     sys.exit(1)
 PY
+# --min-evidence-nats reaches every estimator: far above any dock's evidence nothing is found, far below it no
+# fewer docks are found than with the default, and the JSON says which floor was used.
+"$docksim" perception --sections generated --gen-scenes 60 --seed 3 --jobs 2 --json --min-evidence-nats 100 \
+  >"$dir/hi.json" 2>/dev/null
+"$docksim" perception --sections generated --gen-scenes 60 --seed 3 --jobs 2 --json --min-evidence-nats=-100 \
+  >"$dir/lo.json" 2>/dev/null
+/usr/bin/python3 - "$dir/a.json" "$dir/hi.json" "$dir/lo.json" <<'PY'
+import json, sys
+a, hi, lo = (json.load(open(p)) for p in sys.argv[1:4])
+found = lambda j: j["generated"]["overall"]["told"]["found"] + j["generated"]["overall"]["unknown"]["found"]
+fail = []
+if "overrides" in a:
+    fail.append("a default run reports an override")
+if hi.get("overrides", {}).get("min_evidence_nats") != 100:
+    fail.append("the override is not in the JSON")
+if found(hi) != 0:
+    fail.append("%d docks found with a floor of 100 nats" % found(hi))
+if found(lo) < found(a) or found(a) == 0:
+    fail.append("floor -100 found %d docks, the default %d" % (found(lo), found(a)))
+if fail:
+    print("\n".join(fail), file=sys.stderr)
+    sys.exit(1)
+PY
 # To a file first: `grep -q` would close the pipe on its match while the report still writes (EPIPE under pipefail).
 /usr/bin/python3 "$report" "$dir/a.json" >"$dir/a.md"
 grep -q "^#### Targets" "$dir/a.md" || { echo "perception-report lost the section" >&2; exit 1; }

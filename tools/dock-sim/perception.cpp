@@ -69,6 +69,7 @@ struct PerceptionOptions {
   bool reflective_clutter = false;           // real: scans with intensities and reflective clutter pasted in
   int reflective_objects = 3;                // ... at most this many objects per window
   bool stripe_hypotheses = false;            // reflectors, real: EstimatorParams::stripe_hypotheses
+  docksim::EstimatorOverrides overrides;     // every section's estimators
 };
 
 /// Accumulates one cell of a results table.
@@ -129,8 +130,8 @@ std::string band_name(int b) {
 }
 
 /// Thresholds of the estimator for a lidar whose range noise is sigma_m (the user configures the same).
-dockcore::EstimatorParams params_for(double sigma_m) {
-  return dockcore::estimator_params_for_noise(static_cast<Real>(sigma_m));
+dockcore::EstimatorParams params_for(const PerceptionOptions& o, double sigma_m) {
+  return o.overrides.applied(dockcore::estimator_params_for_noise(static_cast<Real>(sigma_m)));
 }
 
 docksim::LidarModel lidar(const std::string& name, double sigma) {
@@ -182,7 +183,7 @@ json run_accuracy(const PerceptionOptions& o) {
     for (const auto& lname : o.lidars) {
       for (double sigma : o.sigmas) {
         const docksim::LidarModel m = lidar(lname, sigma);
-        DetectorSet set(prof, params_for(sigma), {Detector::kEstimator, Detector::kBreakpoint, Detector::kVMarker});
+        DetectorSet set(prof, params_for(o, sigma), {Detector::kEstimator, Detector::kBreakpoint, Detector::kVMarker});
         std::map<std::string, std::vector<Cell>> cells;  // detector -> bands
         docksim::Rng rng(o.seed);
         Progress pr{"accuracy", o.trials};
@@ -230,7 +231,7 @@ json run_targets(const PerceptionOptions& o) {
   auto scene = std::make_unique<Scene>();
   for (const auto& pname : o.profiles) {
     const dockcore::DockProfile prof = docksim::resolve_profile(pname);
-    DetectorSet set(prof, params_for(sigma), {Detector::kEstimator, Detector::kBreakpoint, Detector::kVMarker});
+    DetectorSet set(prof, params_for(o, sigma), {Detector::kEstimator, Detector::kBreakpoint, Detector::kVMarker});
     json pj;
     // Detection over the zone: d <= 2.0 m, |bearing| <= 45°, |yaw| <= 30°.
     std::map<std::string, Cell> zone;
@@ -268,7 +269,7 @@ json run_targets(const PerceptionOptions& o) {
     }
     // One second of filtering (10 LD06 scans) from a standing robot at d <= 1.0 m, estimator in tracking mode.
     auto est = std::make_unique<dockcore::DockPoseEstimator>();
-    est->configure(prof, params_for(sigma));
+    est->configure(prof, params_for(o, sigma));
     Cell filtered;
     Progress pr3{"targets: filtered", o.filter_runs};
     for (int t = 0; t < o.filter_runs; ++t) {
@@ -311,15 +312,15 @@ json run_false_positives(const PerceptionOptions& o) {
   const docksim::LidarModel m = lidar("ld06", sigma);
   for (const auto& pname : o.profiles) {
     const dockcore::DockProfile prof = docksim::resolve_profile(pname);
-    DetectorSet set(prof, params_for(sigma), {Detector::kEstimator, Detector::kBreakpoint, Detector::kVMarker});
+    DetectorSet set(prof, params_for(o, sigma), {Detector::kEstimator, Detector::kBreakpoint, Detector::kVMarker});
     // Hinted search: the dock is expected 1 m ahead (a dock database / staging pose), within 0.5 m.
-    dockcore::EstimatorParams hinted = params_for(sigma);
+    dockcore::EstimatorParams hinted = params_for(o, sigma);
     hinted.hint_radius_m = static_cast<Real>(0.5);
     auto est_hint = std::make_unique<dockcore::DockPoseEstimator>();
     est_hint->configure(prof, hinted);
     const Pose2 hint = docksim::dock_pose_from_lidar(1.0, 0.0, 0.0);
     auto est_confirm = std::make_unique<dockcore::DockPoseEstimator>();
-    est_confirm->configure(prof, params_for(sigma));
+    est_confirm->configure(prof, params_for(o, sigma));
     json pj;
     for (int kind = 0; kind < 2; ++kind) {
       const char* label = kind == 0 ? "clutter" : "clutter+look-alikes";
@@ -402,7 +403,7 @@ json run_cost(const PerceptionOptions& o) {
     out[name] = {
         {"points", o.points}, {"scans", o.scans}, {"ns_per_scan_median", percentile(ns, 0.5)}, {"found", found}};
   };
-  const dockcore::EstimatorParams params = params_for(0.010);
+  const dockcore::EstimatorParams params = params_for(o, 0.010);
   // The copies a scan gets on its way through the docking loop: the parser hands over its own buffer
   // (LidarScanOutput::take()), the estimator reads it in place, and Dockcore copies it once, for its tick.
   auto scan_bytes_copied = [&]() {
@@ -582,9 +583,10 @@ json run_real_fp(const PerceptionOptions& o, const RealData& d) {
       ro.seed = o.seed;
       ro.objects_max = o.reflective_objects;
       ro.stripe_hypotheses = o.stripe_hypotheses;
+      ro.overrides = o.overrides;
       const docksim::RealFpResult r = o.reflective_clutter
                                           ? docksim::measure_real_reflector_false_positives(rec, prof, ro, rule)
-                                          : docksim::measure_real_false_positives(rec, prof, rule);
+                                          : docksim::measure_real_false_positives(rec, prof, rule, o.overrides);
       json row;
       row["recording"] = rec.info->name;
       row["profile"] = pname;
@@ -652,6 +654,7 @@ json run_real_composite(const PerceptionOptions& o, const RealData& d) {
   docksim::CompositeOptions co;
   co.per_cell = o.composite_per_cell;
   co.seed = o.seed;
+  co.overrides = o.overrides;
   const docksim::CompositeSiteParams& sp = co.site;
   out["target_detection_min_pct"] = kTargetCompositePct;
   out["per_cell"] = co.per_cell;
@@ -1006,6 +1009,10 @@ void register_perception(CLI::App& app) {
   sub->add_option("--reflective-objects", o->reflective_objects,
                   "real, with --reflective-clutter: at most this many objects per window (0: intensities only)")
       ->check(CLI::Range(0, 10));
+  sub->add_option("--min-evidence-nats", o->overrides.min_evidence_nats,
+                  "Every section: the estimators' min_evidence_nats instead of the default (3.4), to measure the "
+                  "trade-off between detection and false docks")
+      ->check(CLI::Range(-100.0, 100.0));
   sub->add_option("--composite-n", o->composite_per_cell,
                   "Composite scenes per (recording, profile, placement), at most one per scan")
       ->check(CLI::PositiveNumber);
@@ -1040,6 +1047,9 @@ void register_perception(CLI::App& app) {
     }
     for (const auto& l : o->lidars) lidar(l, 0.01);  // validates the names before any work
     json j;
+    if (!std::isnan(o->overrides.min_evidence_nats)) {
+      j["overrides"] = {{"min_evidence_nats", o->overrides.min_evidence_nats}};
+    }
     if (o->cost) {
       j["cost"] = run_cost(*o);
     } else {
@@ -1058,6 +1068,7 @@ void register_perception(CLI::App& app) {
       if (has("fp")) j["false_positives"] = run_false_positives(*o);
       if (has("generated")) {
         gen->seed = o->seed;
+        gen->overrides = o->overrides;
         j["generated"] = run_generated(*gen);
       }
       if (has("reflectors")) {
@@ -1065,6 +1076,7 @@ void register_perception(CLI::App& app) {
         refl->jobs = gen->jobs;
         refl->profiles = gen->profiles;
         refl->stripe_hypotheses = o->stripe_hypotheses;
+        refl->overrides = o->overrides;
         j["reflectors"] = run_reflectors(*refl);
       }
       if (has("real") || has("composite")) {
@@ -1076,6 +1088,11 @@ void register_perception(CLI::App& app) {
     if (o->json_out) {
       std::printf("%s\n", j.dump().c_str());
     } else {
+      if (j.contains("overrides")) {
+        std::printf("every estimator: min_evidence_nats = %.2f nats (--min-evidence-nats; default %.2f)\n",
+                    j["overrides"]["min_evidence_nats"].get<double>(),
+                    static_cast<double>(dockcore::EstimatorParams{}.min_evidence_nats));
+      }
       print_text(j);
       if (j.contains("generated")) print_generated(j["generated"]);
       if (j.contains("reflectors")) print_reflectors(j["reflectors"]);

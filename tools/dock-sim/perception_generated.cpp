@@ -37,10 +37,24 @@ constexpr int kApproachScans = 10;
 constexpr double kOdomScaleSigma = 0.01, kOdomLateralSigmaM = 0.0005, kOdomYawSigmaRad = 0.1 * kDeg;
 // Bins with fewer in-envelope scenes than this are not used to pick the worst bin of a target.
 constexpr int kMinBinScenes = 20;
+// Detections whose lateral error lies beyond this many σ of the CRLB form the tail the report describes.
+constexpr double kTailSigmas = 3.0;
 
-enum Factor { kProfile, kMounting, kClutter, kLidar, kNoise, kRange, kBearing, kDockYaw, kFactorCount };
-const char* const kFactorNames[kFactorCount] = {"profile", "mounting", "clutter", "lidar",
-                                                "noise",   "range",    "bearing", "dock-yaw"};
+enum Factor {
+  kProfile,
+  kMounting,
+  kClutter,
+  kLidar,
+  kNoise,
+  kRange,
+  kBearing,
+  kDockYaw,
+  kMixedPixels,
+  kDropouts,
+  kFactorCount
+};
+const char* const kFactorNames[kFactorCount] = {"profile", "mounting", "clutter",  "lidar",        "noise",
+                                                "range",   "bearing",  "dock-yaw", "mixed-pixels", "dropouts"};
 const double kBearingEdgesDeg[] = {0, 15, 30, 45, 60};
 const double kYawEdgesDeg[] = {0, 15, 30, 45};
 
@@ -82,6 +96,15 @@ std::vector<std::string> bin_names(Factor f, const docksim::WorldGenParams& p) {
     case kDockYaw:
       for (int i = 0; i < 3; ++i) {
         std::snprintf(buf, sizeof buf, "|yaw| %.0f-%.0f°", kYawEdgesDeg[i], kYawEdgesDeg[i + 1]);
+        out.push_back(buf);
+      }
+      break;
+    case kMixedPixels:
+      out = {"p 0-0.33", "p 0.33-0.67", "p 0.67-1"};
+      break;
+    case kDropouts:
+      for (int i = 0; i < 3; ++i) {
+        std::snprintf(buf, sizeof buf, "%.1f-%.1f %%", 100 * p.dropout_max * i / 3, 100 * p.dropout_max * (i + 1) / 3);
         out.push_back(buf);
       }
       break;
@@ -133,6 +156,15 @@ int bin_of(Factor f, const docksim::GenScene& s, const docksim::WorldGenParams& 
       return edge_bin(std::fabs(s.bearing_rad) / kDeg, kBearingEdgesDeg, 4);
     case kDockYaw:
       return edge_bin(std::fabs(s.dock_yaw_rad) / kDeg, kYawEdgesDeg, 3);
+    case kMixedPixels: {
+      // The chance that a beam straddling a depth edge reads in between, drawn per scene.
+      const int b = static_cast<int>(3 * s.lidar.mixed_pixel_prob);
+      return b < 2 ? b : 2;
+    }
+    case kDropouts: {
+      const int b = p.dropout_max > 0 ? static_cast<int>(3 * s.lidar.dropout_prob / p.dropout_max) : 0;
+      return b < 2 ? b : 2;
+    }
     default:
       return 0;
   }
@@ -145,14 +177,16 @@ dockcore::DockProfile profile_for_case(const docksim::GenScene& s, int c) {
   p.mounting = c == 0 ? s.told_mounting : dockcore::DockMounting{};
   return p;
 }
-dockcore::EstimatorParams params_for_case(const docksim::GenScene& s, int /*c*/) {
-  return dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0)));
+dockcore::EstimatorParams params_for_case(const docksim::GenScene& s, int /*c*/,
+                                          const docksim::EstimatorOverrides& ov = {}) {
+  return ov.applied(dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0))));
 }
 
 struct Outcome {
   bool found = false, correct = false;
   Errors sensor, robot;
   double lat_over_crlb = std::nan("");
+  double lat_beams = std::nan("");  // |lateral error| in beam spacings at the dock's range
   std::string miss;  // when not a correct detection: why (miss_cause)
 };
 
@@ -182,9 +216,9 @@ struct FilterRecord {
 };
 
 /// The worker's estimator c for case c.
-void configure(Worker& w, const docksim::GenScene& s) {
+void configure(Worker& w, const docksim::GenScene& s, const docksim::EstimatorOverrides& ov) {
   for (int c = 0; c < kCases; ++c)
-    w.est[static_cast<std::size_t>(c)]->configure(profile_for_case(s, c), params_for_case(s, c));
+    w.est[static_cast<std::size_t>(c)]->configure(profile_for_case(s, c), params_for_case(s, c, ov));
 }
 
 double max_range_for(const docksim::GenScene& s) {
@@ -195,7 +229,8 @@ void fill_bins(const docksim::GenScene& s, const docksim::WorldGenParams& p, int
   for (int f = 0; f < kFactorCount; ++f) bins[f] = bin_of(static_cast<Factor>(f), s, p);
 }
 
-DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w) {
+DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w,
+                    const docksim::EstimatorOverrides& ov) {
   const docksim::GenScene s = g.draw(i, true, docksim::ScenePath::kSingle);
   DockRecord r;
   fill_bins(s, g.params(), r.bins);
@@ -215,7 +250,7 @@ DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
                                                       s.lidar.angle_increment_rad, beams, sigma_at_dock(s), 0);
   // Dropped beams carry no information: the bound's σ grows by 1/sqrt(1 - dropout).
   const double crlb_lat = bound.ok ? bound.sigma_lateral_m / std::sqrt(1.0 - s.lidar.dropout_prob) : std::nan("");
-  configure(w, s);
+  configure(w, s, ov);
   const Pose2 mount_inv = s.lidar_mount.inverse();
   for (int c = 0; c < kCases; ++c) {
     const dockcore::DockEstimate e = w.est[static_cast<std::size_t>(c)]->estimate(w.scan->view(), s.lidar_mount);
@@ -226,20 +261,22 @@ DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
       o.robot = errors_of(truth_robot, e.pose);
       o.correct = is_correct(o.sensor);
       if (crlb_lat > 0) o.lat_over_crlb = o.sensor.lat_m / crlb_lat;
+      o.lat_beams = std::fabs(o.sensor.lat_m) / (s.distance_m * s.lidar.angle_increment_rad);
     }
     if (!o.correct) o.miss = miss_cause(e, truth_sensor, mount_inv);
   }
   return r;
 }
 
-FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w) {
+FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w,
+                    const docksim::EstimatorOverrides& ov) {
   const docksim::GenScene s = g.draw(i, false, docksim::ScenePath::kConfirm);
   FreeRecord r;
   fill_bins(s, g.params(), r.bins);
   r.look_alike = static_cast<int>(s.look_alike);
   r.excluded = exclusion(s.profile, s.lidar.angle_increment_rad, max_range_for(s));
   if (!r.excluded.empty()) return r;
-  configure(w, s);
+  configure(w, s, ov);
   docksim::Rng rng(scan_seed(g.seed(), 1, i));
   Confirmation conf[kCases];
   for (int k = 0; k < kConfirmScans; ++k) {
@@ -256,13 +293,14 @@ FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
   return r;
 }
 
-FilterRecord run_filter(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w) {
+FilterRecord run_filter(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w,
+                        const docksim::EstimatorOverrides& ov) {
   const docksim::GenScene s = g.draw(i, true, docksim::ScenePath::kApproach);
   FilterRecord r;
   r.noise = noise_class(s);
   r.excluded = exclusion(s.profile, s.lidar.angle_increment_rad, max_range_for(s));
   if (!r.excluded.empty()) return r;
-  configure(w, s);
+  configure(w, s, ov);
   docksim::Rng rng(scan_seed(g.seed(), 2, i));
   dockcore::DockPoseFilter filter[kCases];
   Pose2 odom{};
@@ -310,6 +348,7 @@ struct Cell {
   Rate det[2];  // in the envelope, σ ≤ 10 mm and 10-20 mm
   int found = 0, wrong = 0;
   std::vector<double> pos, yaw, pos_robot, lat_ratio;
+  std::vector<double> tail_beams;  // lat_beams of the detections beyond kTailSigmas of the bound
   Rate fp_scan, fp_confirm;
 
   void add_dock(const DockRecord& r, int c, bool in_envelope) {
@@ -326,6 +365,7 @@ struct Cell {
     yaw.push_back(o.sensor.yaw_rad);
     pos_robot.push_back(o.robot.pos_m);
     if (!std::isnan(o.lat_over_crlb)) lat_ratio.push_back(o.lat_over_crlb);
+    if (std::fabs(o.lat_over_crlb) > kTailSigmas) tail_beams.push_back(o.lat_beams);
   }
   void add_free(const FreeRecord& r, int c) {
     for (int k = 0; k < kConfirmScans; ++k) fp_scan.add(k < r.hits[c]);
@@ -443,11 +483,11 @@ json run_generated(const GeneratedOptions& o) {
 
   run_scenes(n_dock + n_free + n_filter, o.jobs, kCases, "generated worlds", [&](std::size_t i, Worker& w) {
     if (i < n_dock) {
-      docks[i] = run_dock(gen, i, w);
+      docks[i] = run_dock(gen, i, w, o.overrides);
     } else if (i < n_dock + n_free) {
-      frees[i - n_dock] = run_free(gen, i - n_dock, w);
+      frees[i - n_dock] = run_free(gen, i - n_dock, w, o.overrides);
     } else {
-      filters[i - n_dock - n_free] = run_filter(gen, i - n_dock - n_free, w);
+      filters[i - n_dock - n_free] = run_filter(gen, i - n_dock - n_free, w, o.overrides);
     }
   });
 
@@ -516,6 +556,21 @@ json run_generated(const GeneratedOptions& o) {
       for (const auto& r : frees)
         if (r.excluded.empty()) cell.add_free(r, c);
       overall[kCaseNames[c]] = cell.to_json();
+      // The shape of the lateral error against the bound: a Gaussian estimator at the bound has its p50 / p90 / p95
+      // / p99 of |error| / σ at 0.67 / 1.64 / 1.96 / 2.58; a core near those with a larger p95 is a heavy tail.
+      json q;
+      for (const double at : {0.5, 0.9, 0.95, 0.99}) {
+        char key[8];
+        std::snprintf(key, sizeof key, "p%.0f", 100 * at);
+        q[key] = maybe(percentile(cell.lat_ratio, at), 1, 2);
+      }
+      overall[kCaseNames[c]]["lateral_over_crlb_quantiles"] = q;
+      // The tail: how far along the face those detections lie off, in beams at the dock's range.
+      overall[kCaseNames[c]]["lateral_tail"] = {
+          {"beyond_sigmas", kTailSigmas},
+          {"n", cell.tail_beams.size()},
+          {"of", cell.lat_ratio.size()},
+          {"median_beam_spacings", maybe(percentile(cell.tail_beams, 0.5), 1, 2)}};
     }
     out["overall"] = overall;
   }
@@ -695,6 +750,19 @@ void print_generated(const json& j) {
   std::printf("\n-- overall\n");
   print_header(kFactorColumns);
   for (int c = 0; c < kCases; ++c) print_row(kFactorColumns, factor_cells("all", c, j["overall"][kCaseNames[c]]));
+  std::printf("lateral |error| / CRLB σ, p50 / p90 / p95 / p99 (a Gaussian at the bound: 0.67 / 1.64 / 1.96 / 2.58):");
+  for (int c = 0; c < kCases; ++c) {
+    const json& q = j["overall"][kCaseNames[c]]["lateral_over_crlb_quantiles"];
+    std::printf("%s %s %s / %s / %s / %s", c == 0 ? "" : ";", kCaseNames[c], fmt(q["p50"], "%.2f").c_str(),
+                fmt(q["p90"], "%.2f").c_str(), fmt(q["p95"], "%.2f").c_str(), fmt(q["p99"], "%.2f").c_str());
+  }
+  std::printf("\n");
+  for (int c = 0; c < kCases; ++c) {
+    const json& t = j["overall"][kCaseNames[c]]["lateral_tail"];
+    std::printf("%s: %d of %d detections beyond %.0f σ of the bound, off along the face by a median %s beam spacings\n",
+                kCaseNames[c], t["n"].get<int>(), t["of"].get<int>(), t["beyond_sigmas"].get<double>(),
+                fmt(t["median_beam_spacings"], "%.2f").c_str());
+  }
 
   std::printf("\n-- misses in the envelope by cause (share of the scenes of that noise class)\n");
   for (int c = 0; c < kCases; ++c) {

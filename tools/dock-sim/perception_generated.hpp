@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "docksim/estimator_overrides.hpp"
+
 namespace docksim_cli {
 
 struct GeneratedOptions {
@@ -14,6 +16,7 @@ struct GeneratedOptions {
   int profiles = 100;    ///< Random profiles in the pool.
   int jobs = 2;          ///< Worker threads; the figures do not depend on it.
   std::uint64_t seed = 1;
+  docksim::EstimatorOverrides overrides;  ///< Applied to every estimator's parameters.
 };
 
 /// Runs the section; the result is what print_generated prints and --json emits. Deterministic for the options

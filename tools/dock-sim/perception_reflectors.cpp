@@ -73,19 +73,23 @@ docksim::WorldGenParams reflector_params(int profiles) {
   return p;
 }
 
-dockcore::EstimatorParams params_for(const docksim::GenScene& s, bool stripe_hypotheses = false) {
+/// The estimators' parameters for scene s; `o`: the section's stripe_hypotheses and overrides (none when null).
+dockcore::EstimatorParams params_for(const docksim::GenScene& s, const ReflectorOptions* o = nullptr) {
   dockcore::EstimatorParams p = dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0)));
-  p.stripe_hypotheses = stripe_hypotheses;
+  if (o != nullptr) {
+    p = o->overrides.applied(p);
+    p.stripe_hypotheses = o->stripe_hypotheses;
+  }
   return p;
 }
 
 /// Estimator c (c < cases) told the scene's profile with its stripes and its mounting; intensity usable for case 0.
-void configure(Worker& w, const docksim::GenScene& s, int cases, bool stripe_hypotheses) {
+void configure(Worker& w, const docksim::GenScene& s, int cases, const ReflectorOptions& o) {
   dockcore::DockProfile p = s.profile;
   p.mounting = s.told_mounting;
   for (int c = 0; c < cases; ++c) {
     dockcore::DockPoseEstimator& e = *w.est[static_cast<std::size_t>(c)];
-    e.configure(p, params_for(s, stripe_hypotheses));
+    e.configure(p, params_for(s, &o));
     e.set_intensity_usable(c == 0);
   }
 }
@@ -162,7 +166,7 @@ std::string object_at(const docksim::GenScene& s, const Pose2& dock_in_world) {
 }
 
 DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w, int cases, std::uint64_t stream,
-                    bool stripe_hypotheses) {
+                    const ReflectorOptions& o) {
   const docksim::GenScene s = g.draw(i, true, docksim::ScenePath::kSingle);
   DockRecord r;
   r.range_bin = edge_bin(s.distance_m, kRangeEdges, kRangeBins);
@@ -178,7 +182,7 @@ DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
   if (!r.excluded.empty()) return r;
   docksim::Rng rng(scan_seed(g.seed(), stream, i));
   w.simulate(s, 0, rng, 0);
-  configure(w, s, cases, stripe_hypotheses);
+  configure(w, s, cases, o);
   const Pose2 truth_sensor = s.dock_in_sensor(0), mount_inv = s.lidar_mount.inverse();
   for (int c = 0; c < cases; ++c) {
     const dockcore::DockEstimate e = w.est[static_cast<std::size_t>(c)]->estimate(w.scan->view(), s.lidar_mount);
@@ -188,7 +192,7 @@ DockRecord run_dock(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
   return r;
 }
 
-FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w, bool stripe_hypotheses) {
+FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w, const ReflectorOptions& o) {
   const docksim::GenScene s = g.draw(i, false, docksim::ScenePath::kConfirm);
   FreeRecord r;
   r.index = i;
@@ -196,7 +200,7 @@ FreeRecord run_free(const docksim::WorldGenerator& g, std::uint64_t i, Worker& w
   for (const docksim::ReflectiveClass k : s.reflective) r.reflective |= 1u << static_cast<unsigned>(k);
   r.excluded = excluded_why(s, 0);
   if (!r.excluded.empty()) return r;
-  configure(w, s, kCases, stripe_hypotheses);
+  configure(w, s, kCases, o);
   docksim::Rng rng(scan_seed(g.seed(), kFreeStream, i));
   const Pose2 mount_inv = s.lidar_mount.inverse();
   Confirmation conf[kCases];
@@ -292,9 +296,8 @@ json run_read_range(const ReflectorOptions& o) {
       std::vector<DockRecord> docks(static_cast<std::size_t>(o.read_range_scenes));
       char label[64];
       std::snprintf(label, sizeof label, "read range %s %.1f cm", lidar, 100 * region_m);
-      run_scenes(docks.size(), o.jobs, 1, label, [&](std::size_t i, Worker& w) {
-        docks[i] = run_dock(gen, i, w, 1, kReadStream, o.stripe_hypotheses);
-      });
+      run_scenes(docks.size(), o.jobs, 1, label,
+                 [&](std::size_t i, Worker& w) { docks[i] = run_dock(gen, i, w, 1, kReadStream, o); });
       json bins = json::array();
       json farthest = nullptr;
       for (int b = 0; b < kRangeBins; ++b) {
@@ -330,9 +333,9 @@ json run_reflectors(const ReflectorOptions& o) {
   std::vector<FreeRecord> frees(n_free);
   run_scenes(n_dock + n_free, o.jobs, kCases, "reflector worlds", [&](std::size_t i, Worker& w) {
     if (i < n_dock) {
-      docks[i] = run_dock(gen, i, w, kCases, kDockStream, o.stripe_hypotheses);
+      docks[i] = run_dock(gen, i, w, kCases, kDockStream, o);
     } else {
-      frees[i - n_dock] = run_free(gen, i - n_dock, w, o.stripe_hypotheses);
+      frees[i - n_dock] = run_free(gen, i - n_dock, w, o);
     }
   });
 

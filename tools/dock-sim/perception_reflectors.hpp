@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "docksim/estimator_overrides.hpp"
+
 namespace docksim_cli {
 
 struct ReflectorOptions {
@@ -16,6 +18,7 @@ struct ReflectorOptions {
   bool read_range = false;        ///< Also measure the readable-range table (per lidar and region width).
   int read_range_scenes = 10000;  ///< Docking scenes per (lidar, region width) of the readable-range table.
   bool stripe_hypotheses = false;  ///< EstimatorParams::stripe_hypotheses for every estimator.
+  docksim::EstimatorOverrides overrides;  ///< Applied to every estimator's parameters.
   std::uint64_t seed = 1;
 };
 

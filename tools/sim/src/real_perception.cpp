@@ -123,8 +123,8 @@ double back_plane_x(const dockcore::DockProfile& p) {
 
 }  // namespace
 
-dockcore::EstimatorParams real_estimator_params(const RealRecording& rec) {
-  return dockcore::estimator_params_for_noise(static_cast<Real>(rec.sigma_m));
+dockcore::EstimatorParams real_estimator_params(const RealRecording& rec, const EstimatorOverrides& overrides) {
+  return overrides.applied(dockcore::estimator_params_for_noise(static_cast<Real>(rec.sigma_m)));
 }
 
 const char* to_string(ConfirmFrame f) {
@@ -162,12 +162,13 @@ using ScanLoader = std::function<bool(std::size_t window, std::size_t j, LaserSc
 /// The false-positive measurement of measure_real_false_positives over scans given by `load`, with the estimators'
 /// intensity use set to `intensity_usable`.
 RealFpResult measure_fp(const LoadedRecording& rec, const dockcore::DockProfile& profile, const ConfirmRule& rule,
-                        const ScanLoader& load, bool intensity_usable, bool stripe_hypotheses) {
+                        const ScanLoader& load, bool intensity_usable, bool stripe_hypotheses,
+                        const EstimatorOverrides& overrides) {
   RealFpResult out;
   const std::size_t n = rec.scans.size();
   auto est = std::make_unique<DockPoseEstimator>();
   auto tracker = std::make_unique<DockPoseEstimator>();  // hinted estimates; keeps est's counters single-scan
-  dockcore::EstimatorParams params = real_estimator_params(*rec.info);
+  dockcore::EstimatorParams params = real_estimator_params(*rec.info, overrides);
   params.stripe_hypotheses = stripe_hypotheses;
   if (!est->configure(profile, params) || !tracker->configure(profile, params)) return out;
   est->set_intensity_usable(intensity_usable);
@@ -339,11 +340,11 @@ double cell_reflectivity(std::uint64_t seed, double x, double y) {
 }  // namespace
 
 RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dockcore::DockProfile& profile,
-                                          const ConfirmRule& rule) {
+                                          const ConfirmRule& rule, const EstimatorOverrides& overrides) {
   const ScanLoader load = [&rec](std::size_t, std::size_t j, LaserScan* out) {
     return rec.scans[j].to_laser_scan(out);
   };
-  return measure_fp(rec, profile, rule, load, false, false);
+  return measure_fp(rec, profile, rule, load, false, false, overrides);
 }
 
 RealFpResult measure_real_reflector_false_positives(const LoadedRecording& rec, const dockcore::DockProfile& profile,
@@ -423,7 +424,7 @@ RealFpResult measure_real_reflector_false_positives(const LoadedRecording& rec, 
     }
     return true;
   };
-  return measure_fp(rec, profile, rule, load, true, options.stripe_hypotheses);
+  return measure_fp(rec, profile, rule, load, true, options.stripe_hypotheses, options.overrides);
 }
 
 // ---------------------------------------------------------------- composites
@@ -528,8 +529,8 @@ std::size_t paste_dock(const ScanView& background, const dockcore::DockProfile& 
 }
 
 void composite_installation(const RealRecording& rec, CompositeKind kind, dockcore::DockProfile* profile,
-                            dockcore::EstimatorParams* params) {
-  *params = real_estimator_params(rec);
+                            dockcore::EstimatorParams* params, const EstimatorOverrides& overrides) {
+  *params = real_estimator_params(rec, overrides);
   if (kind == CompositeKind::kFreeStanding) {
     profile->mounting = dockcore::DockMounting{dockcore::DockMountKind::kFreeStanding, 0, static_cast<Real>(0.10)};
   } else {
@@ -542,7 +543,7 @@ CompositeResult measure_real_composites(const LoadedRecording& rec, const dockco
   CompositeResult out;
   dockcore::DockProfile installed = profile;
   dockcore::EstimatorParams params;
-  composite_installation(*rec.info, kind, &installed, &params);
+  composite_installation(*rec.info, kind, &installed, &params, o.overrides);
   auto est = std::make_unique<DockPoseEstimator>();
   if (!est->configure(installed, params)) return out;
   std::uint64_t h = fnv1a(0xCBF29CE484222325ull, rec.info->name);

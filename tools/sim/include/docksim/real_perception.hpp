@@ -10,13 +10,15 @@
 #include "dockcore/laser_scan.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_profile.hpp"
+#include "docksim/estimator_overrides.hpp"
 #include "docksim/realdata.hpp"
 #include "docksim/rng.hpp"
 
 namespace docksim {
 
-/// The estimator's parameters for a recording: estimator_params_for_noise(rec.sigma_m), nothing else changed. O(1).
-dockcore::EstimatorParams real_estimator_params(const RealRecording& rec);
+/// The estimator's parameters for a recording: estimator_params_for_noise(rec.sigma_m) with `overrides` applied.
+/// O(1).
+dockcore::EstimatorParams real_estimator_params(const RealRecording& rec, const EstimatorOverrides& overrides = {});
 
 /// When consecutive single-scan detections count as one confirmed detection.
 struct ConfirmRule {
@@ -71,7 +73,8 @@ constexpr std::size_t kMaxFalseDockExamples = 8;
 /// false positives, then, when the recording has poses, the confirmation windows of `rule` over scans i..i+scans-1.
 /// Cost: one estimate per scan, plus rule.scans-1 hinted estimates per window whose first scan found a dock.
 RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dockcore::DockProfile& profile,
-                                          const ConfirmRule& rule = ConfirmRule{});
+                                          const ConfirmRule& rule = ConfirmRule{},
+                                          const EstimatorOverrides& overrides = {});
 
 // ---------------------------------------------------------------- reflective clutter
 
@@ -96,6 +99,7 @@ struct ReflectiveClutterOptions {
   double min_range_m = 0.4;
   double max_range_m = 2.5;
   bool stripe_hypotheses = false;  ///< EstimatorParams::stripe_hypotheses of the estimators.
+  EstimatorOverrides overrides{};  ///< Applied to the estimators' parameters.
 };
 
 /// measure_real_false_positives for a profile with reflector stripes on a lidar whose intensity is usable
@@ -171,9 +175,9 @@ std::size_t paste_dock(const dockcore::ScanView& background, const dockcore::Doc
 
 /// The dock as installed for a composite kind: wall kinds get mounting kWall (gap 0-0.10 m) and the default
 /// kFreeStanding gets mounting kFreeStanding. Params are
-/// real_estimator_params(rec) otherwise. O(1).
+/// real_estimator_params(rec, overrides) otherwise. O(1).
 void composite_installation(const RealRecording& rec, CompositeKind kind, dockcore::DockProfile* profile,
-                            dockcore::EstimatorParams* params);
+                            dockcore::EstimatorParams* params, const EstimatorOverrides& overrides = {});
 
 struct CompositeOptions {
   std::size_t per_cell = 100;  ///< Composites per (recording, profile, kind), at most one per scan.
@@ -181,6 +185,7 @@ struct CompositeOptions {
   double match_m = 0.10;  ///< A detection within this distance and yaw of the truth is the pasted dock;
   double match_rad = 10.0 * dockcore::kPi / 180.0;  ///< farther it is a wrong dock.
   CompositeSiteParams site{};
+  EstimatorOverrides overrides{};  ///< Applied to the estimator's parameters.
 };
 
 /// Composite results of one (recording, profile, kind).

@@ -1,0 +1,23 @@
+#pragma once
+// What a benchmark run changes in the estimator's parameters, on top of those each scene or recording gets from its
+// lidar's noise (estimator_params_for_noise). Lets one command measure the trade-off a setting makes across every
+// section (detection on simulated and composite scenes against false docks on real scans).
+#include <cmath>
+#include <limits>
+
+#include "dockcore/perception/dock_pose_estimator.hpp"
+
+namespace docksim {
+
+struct EstimatorOverrides {
+  /// EstimatorParams::min_evidence_nats (nats); NaN: the default.
+  double min_evidence_nats = std::numeric_limits<double>::quiet_NaN();
+
+  /// `p` with the set fields replaced. O(1).
+  dockcore::EstimatorParams applied(dockcore::EstimatorParams p) const {
+    if (!std::isnan(min_evidence_nats)) p.min_evidence_nats = static_cast<dockcore::Real>(min_evidence_nats);
+    return p;
+  }
+};
+
+}  // namespace docksim
