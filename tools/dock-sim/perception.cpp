@@ -341,12 +341,14 @@ json run_false_positives(const PerceptionOptions& o) {
         }
         if (est_hint->estimate(scan->view(), Pose2{}, &hint).found) ++fp_hint;
         // Acquisition confirmation: a standing robot takes kConfirmScans fresh scans and accepts the dock only when
-        // every one finds it at a consistent pose (what a tracker does before it starts to move).
+        // every one finds it at a consistent pose (what a tracker does before it starts to move). Every scan is
+        // simulated whatever the estimator found, so the next scenes are the same for any build of it.
         {
           Pose2 first{};
           bool confirmed = true;
-          for (int k = 0; k < kConfirmScans && confirmed; ++k) {
+          for (int k = 0; k < kConfirmScans; ++k) {
             if (k > 0) docksim::simulate_scan(w, Pose2{}, m, rng, scan.get(), 0);
+            if (!confirmed) continue;
             const dockcore::DockEstimate e = est_confirm->estimate(scan->view(), Pose2{});
             confirmed = e.found && (k == 0 || errors_of(first, e.pose).pos_m < 0.05);
             if (k == 0) first = e.pose;
