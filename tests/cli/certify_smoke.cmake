@@ -80,6 +80,26 @@ if(NOT rc EQUAL 0 OR NOT confirmed STREQUAL "ON")
   message(FATAL_ERROR "replaying trial 8: exit ${rc}, charging_confirmed '${confirmed}'\n${err}")
 endif()
 
+# --calibration-error-scale scales the lidar's calibration error and nothing else: trial 8 at scale 0 has every
+# error_* key 0 and the rest of its scenario as drawn at scale 1.
+foreach(scale 1 0)
+  execute_process(COMMAND ${DOCKSIM} certify ${SCENARIO} --seed 1 --trial 8 --calibration-error-scale ${scale}
+    RESULT_VARIABLE rc OUTPUT_VARIABLE trial8_${scale} ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "certify --calibration-error-scale ${scale}: exit ${rc}\n${err}")
+  endif()
+endforeach()
+string(REGEX MATCHALL "error_(x_m|y_m|yaw_deg) = [^\n]*" zeroed "${trial8_0}")
+if(NOT zeroed STREQUAL "error_x_m = 0.0;error_y_m = 0.0;error_yaw_deg = 0.0")
+  message(FATAL_ERROR "certify --calibration-error-scale 0: calibration errors '${zeroed}'")
+endif()
+string(REGEX REPLACE "error_(x_m|y_m|yaw_deg) = [^\n]*" "" rest_1 "${trial8_1}")
+string(REGEX REPLACE "error_(x_m|y_m|yaw_deg) = [^\n]*" "" rest_0 "${trial8_0}")
+string(REGEX REPLACE "--calibration-error-scale 0 " "" rest_0 "${rest_0}")
+if(NOT rest_0 STREQUAL rest_1 OR rest_1 STREQUAL "")
+  message(FATAL_ERROR "certify --calibration-error-scale 0 changed more than the calibration error:\n${rest_0}")
+endif()
+
 execute_process(COMMAND ${DOCKSIM} certify ${SCENARIO} --write ${WORK}/x.toml
   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 2 OR NOT err MATCHES "--write needs --trial")

@@ -157,6 +157,7 @@ struct CertifyOptions {
   std::string csv;    // --csv: one row per trial
   int trial = -1;     // --trial: draw only this trial
   std::string write;  // --write: the drawn trial's scenario file
+  double calibration_scale = 1;  // --calibration-error-scale: times the lidar calibration error's ranges
 };
 
 /// The table at a dotted path, created when missing.
@@ -180,10 +181,13 @@ void append_event(toml::table& w, toml::table ev) {
   w["events"].as_array()->push_back(std::move(ev));
 }
 
-/// Trial `index`'s world: the base scenario with every factor drawn. `values` receives each factor's value (a
-/// discrete factor: 0 or 1; a factor its drive does not have: NaN). Deterministic in (base_seed, index).
+/// Trial `index`'s world: the base scenario with every factor drawn, the lidar's calibration error (the
+/// robot.lidar error_* factors) scaled by `calibration_scale`. `values` receives each factor's value (a discrete
+/// factor: 0 or 1; a factor its drive does not have: NaN). Deterministic in (base_seed, index, calibration_scale);
+/// the scale changes no other draw.
 toml::table draw_world(const toml::table& base, const dockcore::Pose2& dock, const std::string& unseen_profile,
-                       std::uint64_t base_seed, std::size_t index, std::vector<double>* values) {
+                       std::uint64_t base_seed, std::size_t index, double calibration_scale,
+                       std::vector<double>* values) {
   const double dock_yaw_rad = static_cast<double>(dock.yaw_rad);
   toml::table w = base;
   docksim::Rng rng(docksim::trial_seed(base_seed ^ kFamilySalt, index));
@@ -247,7 +251,9 @@ toml::table draw_world(const toml::table& base, const dockcore::Pose2& dock, con
     if (key.rfind("clutter_", 0) == 0 && !clutter) continue;
     if (key.rfind("passer_", 0) == 0 && !passer) continue;
     if ((key == "push_lateral_m" && push_turn) || (key == "push_turn_deg" && !push_turn)) continue;
-    const double v = f.lo + (f.hi - f.lo) * u;
+    const bool calibration = key.rfind("error_", 0) == 0 && std::string(f.table) == "robot.lidar";
+    double v = (f.lo + (f.hi - f.lo) * u) * (calibration ? calibration_scale : 1.0);
+    if (v == 0) v = 0;  // no -0 in a scenario file
     (*values)[i] = v;
     if (key == "push_t_s") {
       push_t_s = v;
@@ -419,14 +425,15 @@ int run_certify(const CertifyOptions& o) {
                  "dock\n";
   }
   auto load = [&](std::size_t t, std::vector<double>* values) {
-    const toml::table w = draw_world(base, base_sc.dock_pose, unseen_profile, seed, t, values);
+    const toml::table w = draw_world(base, base_sc.dock_pose, unseen_profile, seed, t, o.calibration_scale, values);
     return docksim::parse_scenario_toml(toml_text(w), o.scenario + " (trial " + std::to_string(t) + ")");
   };
 
   if (o.trial >= 0) {  // one trial: its world, written for `dock-sim run`
     std::vector<double> values;
     const std::size_t t = static_cast<std::size_t>(o.trial);
-    const std::string text = toml_text(draw_world(base, base_sc.dock_pose, unseen_profile, seed, t, &values));
+    const std::string text =
+        toml_text(draw_world(base, base_sc.dock_pose, unseen_profile, seed, t, o.calibration_scale, &values));
     if (!o.write.empty()) {
       std::ofstream out(o.write, std::ios::binary);
       out << "# dock-sim certify " << o.scenario << " --seed " << seed << ", trial " << t
@@ -533,16 +540,19 @@ int run_certify(const CertifyOptions& o) {
     if (pushed(values[t]) && runs[t].outcome.charging_confirmed) return std::string("docked, push not seen");
     return cause_of(runs[t]);
   };
+  const std::string scale_arg =
+      o.calibration_scale == 1.0 ? std::string() : " --calibration-error-scale " + fmt("%g", o.calibration_scale);
   auto replay = [&](std::size_t t) {
-    return "dock-sim certify " + o.scenario + " --seed " + std::to_string(seed) + " --trial " + std::to_string(t) +
-           " --write trial.toml && dock-sim run trial.toml --seed " + std::to_string(docksim::trial_seed(seed, t)) +
-           " --controller " + ctl;
+    return "dock-sim certify " + o.scenario + " --seed " + std::to_string(seed) + scale_arg + " --trial " +
+           std::to_string(t) + " --write trial.toml && dock-sim run trial.toml --seed " +
+           std::to_string(docksim::trial_seed(seed, t)) + " --controller " + ctl;
   };
 
   if (o.json) {
     nlohmann::ordered_json j;
     j["scenario"] = base_sc.name;
     j["controller"] = ctl;
+    j["calibration_error_scale"] = o.calibration_scale;
     j["seed"] = seed;
     j["trials"] = o.trials;
     j["successes"] = successes;
@@ -594,6 +604,9 @@ int run_certify(const CertifyOptions& o) {
   } else {
     std::printf("certify %s, controller %s: %d trials, each its own robot drawn from the family (base seed %llu)\n",
                 base_sc.name.c_str(), ctl.c_str(), o.trials, static_cast<unsigned long long>(seed));
+    if (o.calibration_scale != 1.0) {
+      std::printf("calibration error   x %g of the family's (--calibration-error-scale)\n", o.calibration_scale);
+    }
     std::printf("right outcome       %d / %d = %.1f %% (charging confirmed, or fault 178/179 after a push)\n",
                 successes, o.trials, 100 * rate);
     std::printf("charging confirmed  %d of the %d robots not pushed\n", docked_unpushed, o.trials - pushes);
@@ -704,6 +717,11 @@ void register_certify(CLI::App& app) {
                   "drawn factor");
   sub->add_option("--trial", o->trial, "Draw only this trial's robot: print its scenario (or --write it)");
   sub->add_option("--write", o->write, "With --trial: write the trial's scenario file here");
+  sub->add_option("--calibration-error-scale", o->calibration_scale,
+                  "Times the family's lidar calibration error (±1 cm, ±1° not told to dockcore): 0 draws robots "
+                  "whose lidar sits exactly where configured; every other draw stays the same")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
   sub->callback([o, seed]() {
     o->seed_set = seed->count() > 0;
     const int rc = run_certify(*o);
