@@ -113,6 +113,27 @@ constexpr double kPasserReachM = 1.5;
 constexpr std::size_t kFactorCount = sizeof(kFactors) / sizeof(kFactors[0]);
 constexpr std::uint64_t kFamilySalt = 0x63657274696679ull;  // the family's own stream, apart from the run's noise
 
+/// Whether factor f is one of the lidar's calibration errors, which --calibration-error-scale scales.
+bool is_calibration(const Factor& f) {
+  return std::string(f.table) == "robot.lidar" && std::string(f.key).rfind("error_", 0) == 0;
+}
+
+/// Factor i as drawn at `calibration_scale`: the calibration errors' ranges scaled, the others as they are.
+Factor drawn_factor(std::size_t i, double calibration_scale) {
+  Factor f = kFactors[i];
+  if (is_calibration(f)) {
+    f.lo *= calibration_scale;
+    f.hi *= calibration_scale;
+    if (f.lo == 0) f.lo = 0;  // no -0 in the report
+  }
+  return f;
+}
+
+/// Where v lies in a continuous factor's range, 0..1 (0.5 for a range scaled to nothing).
+double in_range(const Factor& f, double v) {
+  return f.hi > f.lo ? (v - f.lo) / (f.hi - f.lo) : 0.5;
+}
+
 /// Writes one CSV row per trial: its index, whether the outcome was right, charging confirmed, the cause when not
 /// right, the pads' signed errors at the contacts (mm, mm, deg; empty when charging was not confirmed), time to
 /// charging, reversals and retries, the mount calibration (swings, the last one's result, and the robot's centre as
@@ -251,8 +272,7 @@ toml::table draw_world(const toml::table& base, const dockcore::Pose2& dock, con
     if (key.rfind("clutter_", 0) == 0 && !clutter) continue;
     if (key.rfind("passer_", 0) == 0 && !passer) continue;
     if ((key == "push_lateral_m" && push_turn) || (key == "push_turn_deg" && !push_turn)) continue;
-    const bool calibration = key.rfind("error_", 0) == 0 && std::string(f.table) == "robot.lidar";
-    double v = (f.lo + (f.hi - f.lo) * u) * (calibration ? calibration_scale : 1.0);
+    double v = (f.lo + (f.hi - f.lo) * u) * (is_calibration(f) ? calibration_scale : 1.0);
     if (v == 0) v = 0;  // no -0 in a scenario file
     (*values)[i] = v;
     if (key == "push_t_s") {
@@ -352,14 +372,14 @@ std::string cause_of(const docksim::SimRun& r) {
 }
 
 void draw_envelope(const std::string& path, const std::string& title, const std::vector<std::vector<double>>& values,
-                   const std::vector<bool>& ok) {
+                   const std::vector<bool>& ok, double calibration_scale) {
   docksim::SvgBounds b;
   b.add(-0.8, 0.2);
   b.add(1.05, -static_cast<double>(kFactorCount) * 0.25 - 0.1);
   docksim::SvgCanvas c(b, 420, 20);
   c.title(title);
   for (std::size_t i = 0; i < kFactorCount; ++i) {
-    const Factor& f = kFactors[i];
+    const Factor f = drawn_factor(i, calibration_scale);
     const double y = -static_cast<double>(i) * 0.25;
     c.line(Vec2(0, y), Vec2(1, y), docksim::SvgStyle::line("#cccccc", 1));
     const std::string range = f.first != nullptr ? std::string(f.first) + " | " + f.second
@@ -369,7 +389,7 @@ void draw_envelope(const std::string& path, const std::string& title, const std:
     for (std::size_t t = 0; t < values.size(); ++t) {
       const double v = values[t][i];
       if (std::isnan(v)) continue;
-      const double x = f.first != nullptr ? (v > 0.5 ? 0.75 : 0.25) : (v - f.lo) / (f.hi - f.lo);
+      const double x = f.first != nullptr ? (v > 0.5 ? 0.75 : 0.25) : in_range(f, v);
       // Successes jittered a little about the line, failures on it and on top, so a failure is never hidden.
       const double jitter = ok[t] ? 0.06 * (static_cast<double>((t * 7919) % 97) / 96.0 - 0.5) : 0;
       c.circle(Vec2(x, y + jitter), ok[t] ? 0.008 : 0.014, docksim::SvgStyle::filled(ok[t] ? "#1f77b4" : "#d62728"));
@@ -520,13 +540,12 @@ int run_certify(const CertifyOptions& o) {
   };
   std::vector<std::vector<Bin>> bins(kFactorCount, std::vector<Bin>(4));
   for (std::size_t i = 0; i < kFactorCount; ++i) {
-    const Factor& f = kFactors[i];
+    const Factor f = drawn_factor(i, o.calibration_scale);
     for (std::size_t t = 0; t < n; ++t) {
       const double v = values[t][i];
       if (std::isnan(v)) continue;
-      const std::size_t q = f.first != nullptr
-                                ? (v > 0.5 ? 1u : 0u)
-                                : std::min<std::size_t>(3, static_cast<std::size_t>(4 * (v - f.lo) / (f.hi - f.lo)));
+      const std::size_t q = f.first != nullptr ? (v > 0.5 ? 1u : 0u)
+                                               : std::min<std::size_t>(3, static_cast<std::size_t>(4 * in_range(f, v)));
       ++bins[i][q].n;
       bins[i][q].ok += ok[t] ? 1 : 0;
       const docksim::SimOutcome& oc = runs[t].outcome;
@@ -648,7 +667,7 @@ int run_certify(const CertifyOptions& o) {
     auto by_factor = [&](const char* title, const std::function<std::string(const Bin&)>& cell, bool ranges) {
       std::printf("%s", title);
       for (std::size_t i = 0; i < kFactorCount; ++i) {
-        const Factor& f = kFactors[i];
+        const Factor f = drawn_factor(i, o.calibration_scale);
         std::printf("  %-26s", (std::string(f.table) + "." + f.key).c_str());
         const std::size_t nb = f.first != nullptr ? 2 : 4;
         for (std::size_t q = 0; q < nb; ++q) std::printf("  %s", cell(bins[i][q]).c_str());
@@ -689,7 +708,7 @@ int run_certify(const CertifyOptions& o) {
   if (!o.svg.empty()) {
     draw_envelope(
         o.svg, base_sc.name + " / " + ctl + " / " + std::to_string(n) + " robots: " + fmt("%.1f %% right", 100 * rate),
-        values, ok);
+        values, ok, o.calibration_scale);
   }
   return 0;
 }
