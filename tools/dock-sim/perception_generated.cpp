@@ -57,6 +57,8 @@ const char* const kFactorNames[kFactorCount] = {"profile", "mounting", "clutter"
                                                 "range",   "bearing",  "dock-yaw", "mixed-pixels", "dropouts"};
 const double kBearingEdgesDeg[] = {0, 15, 30, 45, 60};
 const double kYawEdgesDeg[] = {0, 15, 30, 45};
+// Thirds of a factor's range (mixed-pixel probability, dropouts as a share of their maximum).
+const double kThirds[] = {0, 1.0 / 3, 2.0 / 3, 1};
 
 std::vector<std::string> bin_names(Factor f, const docksim::WorldGenParams& p) {
   std::vector<std::string> out;
@@ -156,15 +158,10 @@ int bin_of(Factor f, const docksim::GenScene& s, const docksim::WorldGenParams& 
       return edge_bin(std::fabs(s.bearing_rad) / kDeg, kBearingEdgesDeg, 4);
     case kDockYaw:
       return edge_bin(std::fabs(s.dock_yaw_rad) / kDeg, kYawEdgesDeg, 3);
-    case kMixedPixels: {
-      // The chance that a beam straddling a depth edge reads in between, drawn per scene.
-      const int b = static_cast<int>(3 * s.lidar.mixed_pixel_prob);
-      return b < 2 ? b : 2;
-    }
-    case kDropouts: {
-      const int b = p.dropout_max > 0 ? static_cast<int>(3 * s.lidar.dropout_prob / p.dropout_max) : 0;
-      return b < 2 ? b : 2;
-    }
+    case kMixedPixels:  // the chance that a beam straddling a depth edge reads in between, drawn per scene
+      return edge_bin(s.lidar.mixed_pixel_prob, kThirds, 3);
+    case kDropouts:
+      return p.dropout_max > 0 ? edge_bin(s.lidar.dropout_prob / p.dropout_max, kThirds, 3) : 0;
     default:
       return 0;
   }
