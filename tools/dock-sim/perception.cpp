@@ -68,8 +68,7 @@ struct PerceptionOptions {
   std::size_t composite_per_cell = 100;      // composites per (recording, profile, kind)
   bool reflective_clutter = false;           // real: scans with intensities and reflective clutter pasted in
   int reflective_objects = 3;                // ... at most this many objects per window
-  bool stripe_hypotheses = false;            // reflectors, real: EstimatorParams::stripe_hypotheses
-  docksim::EstimatorOverrides overrides;     // every section's estimators
+  docksim::EstimatorOverrides overrides;     // every section's estimators (--min-evidence-nats, --stripe-hypotheses)
 };
 
 /// Accumulates one cell of a results table.
@@ -569,7 +568,7 @@ json run_real_fp(const PerceptionOptions& o, const RealData& d) {
         "objects (taped signs, safety vests, chrome legs) pasted into each window's free space, intensity usable; "
         "at most " +
         std::to_string(o.reflective_objects) + " objects, seed " + std::to_string(o.seed) +
-        (o.stripe_hypotheses ? "; [estimator] stripe_hypotheses = true" : "");
+        (o.overrides.stripe_hypotheses ? "; [estimator] stripe_hypotheses = true" : "");
   }
   json rows = json::array();
   json totals = json::array();
@@ -584,7 +583,6 @@ json run_real_fp(const PerceptionOptions& o, const RealData& d) {
       docksim::ReflectiveClutterOptions ro;
       ro.seed = o.seed;
       ro.objects_max = o.reflective_objects;
-      ro.stripe_hypotheses = o.stripe_hypotheses;
       ro.overrides = o.overrides;
       const docksim::RealFpResult r = o.reflective_clutter
                                           ? docksim::measure_real_reflector_false_positives(rec, prof, ro, rule)
@@ -1005,7 +1003,7 @@ void register_perception(CLI::App& app) {
   sub->add_flag("--reflective-clutter", o->reflective_clutter,
                 "real: give every return an LD06 intensity and paste reflective objects (taped signs, safety vests, "
                 "chrome legs) into the scans; the profiles must carry reflector stripes, read with intensity usable");
-  sub->add_flag("--stripe-hypotheses", o->stripe_hypotheses,
+  sub->add_flag("--stripe-hypotheses", o->overrides.stripe_hypotheses,
                 "reflectors, real with --reflective-clutter: the estimators also try the scan's bright runs as the "
                 "stripes ([estimator] stripe_hypotheses)");
   sub->add_option("--reflective-objects", o->reflective_objects,
@@ -1077,7 +1075,6 @@ void register_perception(CLI::App& app) {
         refl->seed = o->seed;
         refl->jobs = gen->jobs;
         refl->profiles = gen->profiles;
-        refl->stripe_hypotheses = o->stripe_hypotheses;
         refl->overrides = o->overrides;
         j["reflectors"] = run_reflectors(*refl);
       }

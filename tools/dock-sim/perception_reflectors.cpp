@@ -73,14 +73,9 @@ docksim::WorldGenParams reflector_params(int profiles) {
   return p;
 }
 
-/// The estimators' parameters for scene s; `o`: the section's stripe_hypotheses and overrides (none when null).
-dockcore::EstimatorParams params_for(const docksim::GenScene& s, const ReflectorOptions* o = nullptr) {
-  dockcore::EstimatorParams p = dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0)));
-  if (o != nullptr) {
-    p = o->overrides.applied(p);
-    p.stripe_hypotheses = o->stripe_hypotheses;
-  }
-  return p;
+/// The estimators' parameters for scene s, with the section's overrides applied.
+dockcore::EstimatorParams params_for(const docksim::GenScene& s, const docksim::EstimatorOverrides& ov = {}) {
+  return ov.applied(dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0))));
 }
 
 /// Estimator c (c < cases) told the scene's profile with its stripes and its mounting; intensity usable for case 0.
@@ -89,7 +84,7 @@ void configure(Worker& w, const docksim::GenScene& s, int cases, const Reflector
   p.mounting = s.told_mounting;
   for (int c = 0; c < cases; ++c) {
     dockcore::DockPoseEstimator& e = *w.est[static_cast<std::size_t>(c)];
-    e.configure(p, params_for(s, &o));
+    e.configure(p, params_for(s, o.overrides));
     e.set_intensity_usable(c == 0);
   }
 }
@@ -347,7 +342,7 @@ json run_reflectors(const ReflectorOptions& o) {
                    {"random_profiles", o.profiles},
                    {"lidar", "ld06"},
                    {"mounting", "told"},
-                   {"stripe_hypotheses", o.stripe_hypotheses},
+                   {"stripe_hypotheses", o.overrides.stripe_hypotheses},
                    {"envelope", {{"distance_m", kEnvDistanceM}, {"bearing_deg", 45}, {"dock_yaw_deg", 30}}},
                    {"correct_within", {{"pos_m", kCorrectPosM}, {"yaw_deg", 10}}},
                    {"confirm_within", {{"pos_m", kAgreePosM}, {"yaw_deg", 5}}}};

@@ -17,8 +17,7 @@ struct ReflectorOptions {
   int jobs = 2;                   ///< Worker threads; the figures do not depend on it.
   bool read_range = false;        ///< Also measure the readable-range table (per lidar and region width).
   int read_range_scenes = 10000;  ///< Docking scenes per (lidar, region width) of the readable-range table.
-  bool stripe_hypotheses = false;  ///< EstimatorParams::stripe_hypotheses for every estimator.
-  docksim::EstimatorOverrides overrides;  ///< Applied to every estimator's parameters.
+  docksim::EstimatorOverrides overrides;  ///< Applied to every estimator's parameters (stripe_hypotheses among them).
   std::uint64_t seed = 1;
 };
 

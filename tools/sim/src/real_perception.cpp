@@ -162,14 +162,12 @@ using ScanLoader = std::function<bool(std::size_t window, std::size_t j, LaserSc
 /// The false-positive measurement of measure_real_false_positives over scans given by `load`, with the estimators'
 /// intensity use set to `intensity_usable`.
 RealFpResult measure_fp(const LoadedRecording& rec, const dockcore::DockProfile& profile, const ConfirmRule& rule,
-                        const ScanLoader& load, bool intensity_usable, bool stripe_hypotheses,
-                        const EstimatorOverrides& overrides) {
+                        const ScanLoader& load, bool intensity_usable, const EstimatorOverrides& overrides) {
   RealFpResult out;
   const std::size_t n = rec.scans.size();
   auto est = std::make_unique<DockPoseEstimator>();
   auto tracker = std::make_unique<DockPoseEstimator>();  // hinted estimates; keeps est's counters single-scan
-  dockcore::EstimatorParams params = real_estimator_params(*rec.info, overrides);
-  params.stripe_hypotheses = stripe_hypotheses;
+  const dockcore::EstimatorParams params = real_estimator_params(*rec.info, overrides);
   if (!est->configure(profile, params) || !tracker->configure(profile, params)) return out;
   est->set_intensity_usable(intensity_usable);
   tracker->set_intensity_usable(intensity_usable);
@@ -344,7 +342,7 @@ RealFpResult measure_real_false_positives(const LoadedRecording& rec, const dock
   const ScanLoader load = [&rec](std::size_t, std::size_t j, LaserScan* out) {
     return rec.scans[j].to_laser_scan(out);
   };
-  return measure_fp(rec, profile, rule, load, false, false, overrides);
+  return measure_fp(rec, profile, rule, load, false, overrides);
 }
 
 RealFpResult measure_real_reflector_false_positives(const LoadedRecording& rec, const dockcore::DockProfile& profile,
@@ -424,7 +422,7 @@ RealFpResult measure_real_reflector_false_positives(const LoadedRecording& rec, 
     }
     return true;
   };
-  return measure_fp(rec, profile, rule, load, true, options.stripe_hypotheses, options.overrides);
+  return measure_fp(rec, profile, rule, load, true, options.overrides);
 }
 
 // ---------------------------------------------------------------- composites

@@ -12,10 +12,13 @@ namespace docksim {
 struct EstimatorOverrides {
   /// EstimatorParams::min_evidence_nats (nats); NaN: the default.
   double min_evidence_nats = std::numeric_limits<double>::quiet_NaN();
+  /// EstimatorParams::stripe_hypotheses switched on (it acts only on a reflector dock whose intensity is read).
+  bool stripe_hypotheses = false;
 
   /// `p` with the set fields replaced. O(1).
   dockcore::EstimatorParams applied(dockcore::EstimatorParams p) const {
     if (!std::isnan(min_evidence_nats)) p.min_evidence_nats = static_cast<dockcore::Real>(min_evidence_nats);
+    if (stripe_hypotheses) p.stripe_hypotheses = true;
     return p;
   }
 };

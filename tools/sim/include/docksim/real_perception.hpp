@@ -98,8 +98,7 @@ struct ReflectiveClutterOptions {
   int objects_max = 3;  ///< 0: no objects, the real returns' intensities only.
   double min_range_m = 0.4;
   double max_range_m = 2.5;
-  bool stripe_hypotheses = false;  ///< EstimatorParams::stripe_hypotheses of the estimators.
-  EstimatorOverrides overrides{};  ///< Applied to the estimators' parameters.
+  EstimatorOverrides overrides{};  ///< Applied to the estimators' parameters (stripe_hypotheses among them).
 };
 
 /// measure_real_false_positives for a profile with reflector stripes on a lidar whose intensity is usable
