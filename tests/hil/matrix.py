@@ -3,18 +3,20 @@
 candump log's stamps, chassis-sim's truth "wall" field and the case's inject log (`date +%s.%N`) share that clock.
 
   matrix.py row ROW_DIR --row NAME --fault EVENT [--limit-ms L] [--code C] [--clear EVENT] [--recover KIND]
-                [--hold-end EVENT] [--no-moving-check] [--status-limit-ms L]
+                [--hold-end EVENT] [--no-moving-check] [--status-limit-ms L] [--status-limit-ticks N]
       Judges one row from ROW_DIR/{candump.log,decode.json,truth.jsonl,inject.log,record/events.jsonl,status.json}
       and prints PASS/FAIL <row>_<check> and FIGURE <row>_<name> <value> lines. Exit status = number of FAILs.
       EVENT names a truth-log event ("event" field) or an inject.log line ("NAME WALL"); the first one counts;
       "status:C" is the first DockStatus frame with fault C, "last:FRAME:REF" / "first:FRAME:REF" the last FRAME frame
-      before / the first at or after another reference, "frame:FRAME" the first FRAME frame of the log.
+      before / the first at or after another reference, "frame:FRAME" the first FRAME frame of the log; a FRAME written
+      "Power[contact=0]" counts only the frames whose signal has that value.
         fault time  t_f = EVENT's time.
         reaction    the WheelCmdA with zero speeds (or enable 0) that starts the lasting stop: the run of zero frames
                     that reaches the clear / hold end (the first zero at all is reported as first_zero_ms; with
                     --hold-by-status the first zero counts); reaction_ms = that - t_f, must be <= L (when given).
         moving      the last WheelCmdA before t_f was non-zero (else the reaction says nothing) unless --no-moving-check.
-        fault code  a DockStatus frame with fault C at or after t_f (status_ms = its delay; <= --status-limit-ms).
+        fault code  a DockStatus frame with fault C at or after t_f (status_ms = its delay; <= --status-limit-ms
+                    plus --status-limit-ticks N ticks, each counted at the window's longest tick, >= 20 ms).
         hold        no non-zero WheelCmdA from the reaction until --clear EVENT (the fault clears) or --hold-end
                     EVENT or the end of the log (not with --hold-by-status).
         status hold never a non-zero WheelCmdA while the last DockStatus carried a fault (always checked).
@@ -155,14 +157,21 @@ class Row:
     def event(self, name):
         """Wall time of a reference: a truth/inject event NAME; "status:C" the first DockStatus with fault C;
         "last:FRAME:REF" the last FRAME frame before REF; "first:FRAME:REF" the first FRAME frame at or after REF;
-        "frame:FRAME" the first FRAME frame of the log."""
+        "frame:FRAME" the first FRAME frame of the log; FRAME may carry one condition, "Power[contact=0]": only the
+        frames whose signal has that value count."""
         if name.startswith("status:"):
             code = int(name.split(":", 1)[1])
             st = next((e for e in self.status() if int(e["signals"]["fault"]) == code), None)
             return st["wall"] if st else None
         if name.startswith(("last:", "first:", "frame:")):
             kind, frame, ref = (name.split(":", 2) + [""])[:3]
-            frames = [e for e in self.timeline if e["name"] == frame]
+            want = None
+            if frame.endswith("]") and "[" in frame:
+                frame, cond = frame[:-1].split("[", 1)
+                sig, val = cond.split("=", 1)
+                want = (sig, float(val))
+            frames = [e for e in self.timeline if e["name"] == frame and
+                      (want is None or float(e["signals"].get(want[0], float("nan"))) == want[1])]
             if kind == "frame":
                 return frames[0]["wall"] if frames else None
             t = self.event(ref)
@@ -356,6 +365,8 @@ def judge_row(argv):
     ap.add_argument("--limit-ms", type=float)
     ap.add_argument("--code", type=int)
     ap.add_argument("--status-limit-ms", type=float)
+    # Ticks of dockd's loop inside the status limit, each counted at the window's longest tick (>= 20 ms).
+    ap.add_argument("--status-limit-ticks", type=int, default=0)
     ap.add_argument("--state", type=int, help="the fault status frame must also carry this TaskState (8 = FAULT)")
     ap.add_argument("--clear")
     ap.add_argument("--hold-end")
@@ -469,11 +480,14 @@ def judge_row(argv):
             ms = (st["wall"] - t_f) * 1000
             figure("status_ms", f"{ms:.1f}")
             if a.status_limit_ms is not None:
-                why = f"{ms:.1f} ms > {a.status_limit_ms:g} ms + {TICK_SLACK_MS} ms tick slack"
                 stall = tick_gap(wheels, t_f, st["wall"])
+                # Waits for a tick are counted at the longest tick the window had (at least the nominal 20 ms): a
+                # loop that ran late but within the starvation bound still met its contract.
+                limit = a.status_limit_ms + a.status_limit_ticks * max(20.0, stall)
+                why = f"{ms:.1f} ms > {limit:g} ms + {TICK_SLACK_MS} ms tick slack"
                 if stall > 40:
                     why += f"; dockd's wheel frames stalled {stall:.0f} ms inside the window: VM starvation"
-                check("status_in_time", ms <= a.status_limit_ms + TICK_SLACK_MS, why, starved=stall > 40)
+                check("status_in_time", ms <= limit + TICK_SLACK_MS, why, starved=stall > 40)
     t_hold_end = t_c if t_c is not None else (r.event(a.hold_end) if a.hold_end else None)
     if t_hold_end is None:
         t_hold_end = float("inf")
