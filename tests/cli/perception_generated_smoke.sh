@@ -55,6 +55,23 @@ if fail:
     print("\n".join(fail), file=sys.stderr)
     sys.exit(1)
 PY
+# --max-candidates reaches every estimator: one candidate finds fewer docks than the default's twelve, and the JSON
+# says so.
+"$docksim" perception --sections generated --gen-scenes 60 --seed 3 --jobs 2 --json --max-candidates 1 \
+  >"$dir/one.json" 2>/dev/null
+/usr/bin/python3 - "$dir/a.json" "$dir/one.json" <<'PY'
+import json, sys
+a, one = (json.load(open(p)) for p in sys.argv[1:3])
+found = lambda j: j["generated"]["overall"]["told"]["found"] + j["generated"]["overall"]["unknown"]["found"]
+fail = []
+if one.get("overrides", {}).get("max_candidates") != 1:
+    fail.append("the max_candidates override is not in the JSON")
+if not found(one) < found(a):
+    fail.append("one candidate found %d docks, twelve %d" % (found(one), found(a)))
+if fail:
+    print("\n".join(fail), file=sys.stderr)
+    sys.exit(1)
+PY
 # To a file first: `grep -q` would close the pipe on its match while the report still writes (EPIPE under pipefail).
 /usr/bin/python3 "$report" "$dir/a.json" >"$dir/a.md"
 grep -q "^#### Targets" "$dir/a.md" || { echo "perception-report lost the section" >&2; exit 1; }

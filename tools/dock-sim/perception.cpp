@@ -68,7 +68,8 @@ struct PerceptionOptions {
   std::size_t composite_per_cell = 100;      // composites per (recording, profile, kind)
   bool reflective_clutter = false;           // real: scans with intensities and reflective clutter pasted in
   int reflective_objects = 3;                // ... at most this many objects per window
-  docksim::EstimatorOverrides overrides;     // every section's estimators (--min-evidence-nats, --stripe-hypotheses)
+  docksim::EstimatorOverrides
+      overrides;  // every section's estimators (--min-evidence-nats, --stripe-hypotheses, --max-candidates)
 };
 
 /// Accumulates one cell of a results table.
@@ -1013,6 +1014,10 @@ void register_perception(CLI::App& app) {
                   "Every section: the estimators' min_evidence_nats instead of the default (3.4), to measure the "
                   "trade-off between detection and false docks")
       ->check(CLI::Range(-100.0, 100.0));
+  sub->add_option("--max-candidates", o->overrides.max_candidates,
+                  "Every section and --cost: the estimators' max_candidates instead of the default (12), to measure "
+                  "what the global search's cost trades against detection")
+      ->check(CLI::Range(1, 64));
   sub->add_option("--composite-n", o->composite_per_cell,
                   "Composite scenes per (recording, profile, placement), at most one per scan")
       ->check(CLI::PositiveNumber);
@@ -1047,9 +1052,9 @@ void register_perception(CLI::App& app) {
     }
     for (const auto& l : o->lidars) lidar(l, 0.01);  // validates the names before any work
     json j;
-    if (!std::isnan(o->overrides.min_evidence_nats)) {
-      j["overrides"] = {{"min_evidence_nats", o->overrides.min_evidence_nats}};
-    }
+    if (!std::isnan(o->overrides.min_evidence_nats))
+      j["overrides"]["min_evidence_nats"] = o->overrides.min_evidence_nats;
+    if (o->overrides.max_candidates > 0) j["overrides"]["max_candidates"] = o->overrides.max_candidates;
     if (o->cost) {
       j["cost"] = run_cost(*o);
     } else {
@@ -1087,10 +1092,14 @@ void register_perception(CLI::App& app) {
     if (o->json_out) {
       std::printf("%s\n", j.dump().c_str());
     } else {
-      if (j.contains("overrides")) {
+      if (j.contains("overrides") && j["overrides"].contains("min_evidence_nats")) {
         std::printf("every estimator: min_evidence_nats = %.2f nats (--min-evidence-nats; default %.2f)\n",
                     j["overrides"]["min_evidence_nats"].get<double>(),
                     static_cast<double>(dockcore::EstimatorParams{}.min_evidence_nats));
+      }
+      if (j.contains("overrides") && j["overrides"].contains("max_candidates")) {
+        std::printf("every estimator: max_candidates = %d (--max-candidates; default %d)\n",
+                    j["overrides"]["max_candidates"].get<int>(), int{dockcore::EstimatorParams{}.max_candidates});
       }
       print_text(j);
       if (j.contains("generated")) print_generated(j["generated"]);
