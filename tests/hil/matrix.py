@@ -4,6 +4,7 @@ candump log's stamps, chassis-sim's truth "wall" field and the case's inject log
 
   matrix.py row ROW_DIR --row NAME --fault EVENT [--limit-ms L] [--code C] [--clear EVENT] [--recover KIND]
                 [--hold-end EVENT] [--no-moving-check] [--status-limit-ms L] [--status-limit-ticks N]
+                [--status-from REF]
       Judges one row from ROW_DIR/{candump.log,decode.json,truth.jsonl,inject.log,record/events.jsonl,status.json}
       and prints PASS/FAIL <row>_<check> and FIGURE <row>_<name> <value> lines. Exit status = number of FAILs.
       EVENT names a truth-log event ("event" field) or an inject.log line ("NAME WALL"); the first one counts;
@@ -16,7 +17,8 @@ candump log's stamps, chassis-sim's truth "wall" field and the case's inject log
                     --hold-by-status the first zero counts); reaction_ms = that - t_f, must be <= L (when given).
         moving      the last WheelCmdA before t_f was non-zero (else the reaction says nothing) unless --no-moving-check.
         fault code  a DockStatus frame with fault C at or after t_f (status_ms = its delay; <= --status-limit-ms
-                    plus --status-limit-ticks N ticks, each counted at the window's longest tick, >= 20 ms).
+                    plus --status-limit-ticks N ticks, each counted at the window's longest tick, >= 20 ms; with
+                    --status-from REF the limit runs from REF instead, status_after_reference_ms).
         hold        no non-zero WheelCmdA from the reaction until --clear EVENT (the fault clears) or --hold-end
                     EVENT or the end of the log (not with --hold-by-status).
         status hold never a non-zero WheelCmdA while the last DockStatus carried a fault (always checked).
@@ -367,6 +369,8 @@ def judge_row(argv):
     ap.add_argument("--status-limit-ms", type=float)
     # Ticks of dockd's loop inside the status limit, each counted at the window's longest tick (>= 20 ms).
     ap.add_argument("--status-limit-ticks", type=int, default=0)
+    # The status limit runs from this reference instead of the fault time (e.g. the frame that reported the fault).
+    ap.add_argument("--status-from")
     ap.add_argument("--state", type=int, help="the fault status frame must also carry this TaskState (8 = FAULT)")
     ap.add_argument("--clear")
     ap.add_argument("--hold-end")
@@ -479,8 +483,17 @@ def judge_row(argv):
         if st is not None:
             ms = (st["wall"] - t_f) * 1000
             figure("status_ms", f"{ms:.1f}")
+            # The limit may run from a later reference: the frame that told dockd of the fault.
+            t_s0 = r.event(a.status_from) if a.status_from else t_f
+            if a.status_from:
+                if t_s0 is None or t_s0 > st["wall"]:
+                    check("status_reference", False, f"no {a.status_from} before the status frame")
+                    t_s0 = t_f
+                else:
+                    ms = (st["wall"] - t_s0) * 1000
+                    figure("status_after_reference_ms", f"{ms:.1f}")
             if a.status_limit_ms is not None:
-                stall = tick_gap(wheels, t_f, st["wall"])
+                stall = tick_gap(wheels, t_s0, st["wall"])
                 # Waits for a tick are counted at the longest tick the window had (at least the nominal 20 ms): a
                 # loop that ran late but within the starvation bound still met its contract.
                 limit = a.status_limit_ms + a.status_limit_ticks * max(20.0, stall)

@@ -101,15 +101,16 @@ echo "FIGURE motion_no_charge_final_distance_m ${press#-}"
 check motion_no_charge_backed_off awk -v p="$press" 'BEGIN{exit !(p != "" && p + 0 <= -0.3)}'
 
 # Contacts break while charging (--break-contact-after 1: the robot is nudged 3 cm back 1 s after charging began).
-# The contact flag comes in chassis-sim's 100 ms power frame; dockd's part is timed from that frame (the simulated
-# chassis' own lateness on a loaded VM is not dockd's): the next tick reads it, contact_lost_debounce 0.3 s runs on
-# the tick clock, 183 goes out in the status at the first tick past it: 300 ms + two ticks; the charge request goes
-# off; the robot does not move (it was standing).
+# The contact flag comes in chassis-sim's 100 ms power frame; dockd's limit runs from that frame (the simulated
+# chassis' own lateness on a loaded VM is not dockd's; status_ms still counts from the break): the next tick reads
+# it, contact_lost_debounce 0.3 s runs on the tick clock, 183 goes out in the status at the first tick past it:
+# 300 ms + two ticks; the charge request goes off; the robot does not move (it was standing).
 row_start motion_contact_break --break-contact-after 1.0
 row_dock
 wait_for 90 truth_has contact_break
 sleep 1.5
 row_stop
 post post_power_frame
-judge --fault 'first:Power[contact=0]:contact_break' --no-moving-check --code 183 --status-limit-ms 300 --status-limit-ticks 2 --recover none
+judge --fault contact_break --status-from 'first:Power[contact=0]:contact_break' --no-moving-check --code 183 \
+  --status-limit-ms 300 --status-limit-ticks 2 --recover none
 post post_request_off
