@@ -131,7 +131,7 @@ std::string band_name(int b) {
 
 /// Thresholds of the estimator for a lidar whose range noise is sigma_m (the user configures the same).
 dockcore::EstimatorParams params_for(const PerceptionOptions& o, double sigma_m) {
-  return o.overrides.applied(dockcore::estimator_params_for_noise(static_cast<Real>(sigma_m)));
+  return o.overrides.for_noise(sigma_m);
 }
 
 docksim::LidarModel lidar(const std::string& name, double sigma) {

@@ -14,6 +14,7 @@
 #include "angles.hpp"
 #include "dockcore/perception/dock_pose_estimator.hpp"
 #include "dockcore/perception/dock_profile.hpp"
+#include "docksim/estimator_overrides.hpp"
 #include "docksim/world_gen.hpp"
 #include "perception_stats.hpp"
 
@@ -44,6 +45,11 @@ int edge_bin(double v, const double* edges, int bins);
 /// True when `e` (errors against the truth, sensor frame) is a detection of the dock. O(1).
 inline bool is_correct(const Errors& e) {
   return e.pos_m <= kCorrectPosM && e.yaw_rad <= kCorrectYawRad;
+}
+
+/// The estimators' parameters for scene s (from its range noise at 1 m), with `ov` applied. O(1).
+inline dockcore::EstimatorParams scene_params(const docksim::GenScene& s, const docksim::EstimatorOverrides& ov = {}) {
+  return ov.for_noise(s.sigma_at(1.0));
 }
 
 /// Why the scene's profile is left out of the figures ("" when it is not): check_profile for the scene's lidar

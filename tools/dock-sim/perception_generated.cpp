@@ -174,10 +174,6 @@ dockcore::DockProfile profile_for_case(const docksim::GenScene& s, int c) {
   p.mounting = c == 0 ? s.told_mounting : dockcore::DockMounting{};
   return p;
 }
-dockcore::EstimatorParams params_for_case(const docksim::GenScene& s, int /*c*/,
-                                          const docksim::EstimatorOverrides& ov = {}) {
-  return ov.applied(dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0))));
-}
 
 struct Outcome {
   bool found = false, correct = false;
@@ -215,11 +211,11 @@ struct FilterRecord {
 /// The worker's estimator c for case c.
 void configure(Worker& w, const docksim::GenScene& s, const docksim::EstimatorOverrides& ov) {
   for (int c = 0; c < kCases; ++c)
-    w.est[static_cast<std::size_t>(c)]->configure(profile_for_case(s, c), params_for_case(s, c, ov));
+    w.est[static_cast<std::size_t>(c)]->configure(profile_for_case(s, c), scene_params(s, ov));
 }
 
 double max_range_for(const docksim::GenScene& s) {
-  return static_cast<double>(params_for_case(s, 1).max_range_m);
+  return static_cast<double>(scene_params(s).max_range_m);
 }
 
 void fill_bins(const docksim::GenScene& s, const docksim::WorldGenParams& p, int* bins) {

@@ -73,18 +73,13 @@ docksim::WorldGenParams reflector_params(int profiles) {
   return p;
 }
 
-/// The estimators' parameters for scene s, with the section's overrides applied.
-dockcore::EstimatorParams params_for(const docksim::GenScene& s, const docksim::EstimatorOverrides& ov = {}) {
-  return ov.applied(dockcore::estimator_params_for_noise(static_cast<Real>(s.sigma_at(1.0))));
-}
-
 /// Estimator c (c < cases) told the scene's profile with its stripes and its mounting; intensity usable for case 0.
 void configure(Worker& w, const docksim::GenScene& s, int cases, const ReflectorOptions& o) {
   dockcore::DockProfile p = s.profile;
   p.mounting = s.told_mounting;
   for (int c = 0; c < cases; ++c) {
     dockcore::DockPoseEstimator& e = *w.est[static_cast<std::size_t>(c)];
-    e.configure(p, params_for(s, o.overrides));
+    e.configure(p, scene_params(s, o.overrides));
     e.set_intensity_usable(c == 0);
   }
 }
@@ -92,7 +87,7 @@ void configure(Worker& w, const docksim::GenScene& s, int cases, const Reflector
 /// Why the scene is left out ("" when it is not): check_profile, then a profile with no segment for the code.
 std::string excluded_why(const docksim::GenScene& s, double region_m) {
   const std::string why =
-      exclusion(s.profile, s.lidar.angle_increment_rad, static_cast<double>(params_for(s).max_range_m));
+      exclusion(s.profile, s.lidar.angle_increment_rad, static_cast<double>(scene_params(s).max_range_m));
   if (!why.empty() || s.code_pattern != 0) return why;
   char buf[64];
   if (region_m > 0) {

@@ -124,7 +124,7 @@ double back_plane_x(const dockcore::DockProfile& p) {
 }  // namespace
 
 dockcore::EstimatorParams real_estimator_params(const RealRecording& rec, const EstimatorOverrides& overrides) {
-  return overrides.applied(dockcore::estimator_params_for_noise(static_cast<Real>(rec.sigma_m)));
+  return overrides.for_noise(rec.sigma_m);
 }
 
 const char* to_string(ConfirmFrame f) {

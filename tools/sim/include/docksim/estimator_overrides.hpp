@@ -26,6 +26,11 @@ struct EstimatorOverrides {
     if (max_candidates > 0) p.max_candidates = static_cast<std::uint8_t>(max_candidates);
     return p;
   }
+  /// estimator_params_for_noise(sigma_m) with the set fields replaced: every benchmark's estimator parameters.
+  /// O(1).
+  dockcore::EstimatorParams for_noise(double sigma_m) const {
+    return applied(dockcore::estimator_params_for_noise(static_cast<dockcore::Real>(sigma_m)));
+  }
 };
 
 }  // namespace docksim
