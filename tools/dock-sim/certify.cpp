@@ -113,19 +113,20 @@ constexpr double kPasserReachM = 1.5;
 constexpr std::size_t kFactorCount = sizeof(kFactors) / sizeof(kFactors[0]);
 constexpr std::uint64_t kFamilySalt = 0x63657274696679ull;  // the family's own stream, apart from the run's noise
 
-/// Whether factor f is one of the lidar's calibration errors, which --calibration-error-scale scales.
-bool is_calibration(const Factor& f) {
-  return std::string(f.table) == "robot.lidar" && std::string(f.key).rfind("error_", 0) == 0;
+/// What --calibration-error-scale multiplies factor f by: `calibration_scale` for the lidar's calibration errors (the
+/// robot.lidar error_* factors), 1 for every other factor.
+double scale_of(const Factor& f, double calibration_scale) {
+  const bool calibration = std::string(f.table) == "robot.lidar" && std::string(f.key).rfind("error_", 0) == 0;
+  return calibration ? calibration_scale : 1.0;
 }
 
-/// Factor i as drawn at `calibration_scale`: the calibration errors' ranges scaled, the others as they are.
+/// Factor i as drawn at `calibration_scale`: its range times scale_of().
 Factor drawn_factor(std::size_t i, double calibration_scale) {
   Factor f = kFactors[i];
-  if (is_calibration(f)) {
-    f.lo *= calibration_scale;
-    f.hi *= calibration_scale;
-    if (f.lo == 0) f.lo = 0;  // no -0 in the report
-  }
+  const double k = scale_of(f, calibration_scale);
+  f.lo *= k;
+  f.hi *= k;
+  if (f.lo == 0) f.lo = 0;  // no -0 in the report
   return f;
 }
 
@@ -272,7 +273,7 @@ toml::table draw_world(const toml::table& base, const dockcore::Pose2& dock, con
     if (key.rfind("clutter_", 0) == 0 && !clutter) continue;
     if (key.rfind("passer_", 0) == 0 && !passer) continue;
     if ((key == "push_lateral_m" && push_turn) || (key == "push_turn_deg" && !push_turn)) continue;
-    double v = (f.lo + (f.hi - f.lo) * u) * (is_calibration(f) ? calibration_scale : 1.0);
+    double v = (f.lo + (f.hi - f.lo) * u) * scale_of(f, calibration_scale);
     if (v == 0) v = 0;  // no -0 in a scenario file
     (*values)[i] = v;
     if (key == "push_t_s") {
