@@ -18,7 +18,8 @@ candump log's stamps, chassis-sim's truth "wall" field and the case's inject log
         moving      the last WheelCmdA before t_f was non-zero (else the reaction says nothing) unless --no-moving-check.
         fault code  a DockStatus frame with fault C at or after t_f (status_ms = its delay; <= --status-limit-ms
                     plus --status-limit-ticks N ticks, each counted at the window's longest tick, >= 20 ms; with
-                    --status-from REF the limit runs from REF instead, status_after_reference_ms).
+                    --status-from REF the limit runs from REF instead: status_reference_ms = REF - t_f,
+                    status_after_reference_ms = the frame's delay after REF).
         hold        no non-zero WheelCmdA from the reaction until --clear EVENT (the fault clears) or --hold-end
                     EVENT or the end of the log (not with --hold-by-status).
         status hold never a non-zero WheelCmdA while the last DockStatus carried a fault (always checked).
@@ -490,6 +491,7 @@ def judge_row(argv):
                     check("status_reference", False, f"no {a.status_from} before the status frame")
                     t_s0 = t_f
                 else:
+                    figure("status_reference_ms", f"{(t_s0 - t_f) * 1000:.1f}")
                     ms = (st["wall"] - t_s0) * 1000
                     figure("status_after_reference_ms", f"{ms:.1f}")
             if a.status_limit_ms is not None:

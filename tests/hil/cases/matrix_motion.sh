@@ -14,9 +14,6 @@ post_no_charge() {
   check motion_no_charge_ends_faulted grep -qE ' 8$' <<< "$states"
   check motion_no_charge_request_off test "$($MATRIX_PY last-signal "$RD" ChargeRequest charge_enable)" = 0
 }
-post_power_frame() {
-  echo "FIGURE ${ROW}_power_frame_ms $($MATRIX_PY delta "$RD" contact_break 'first:Power[contact=0]:contact_break')"
-}
 post_request_off() {
   check "${ROW}_request_off" test "$($MATRIX_PY last-signal "$RD" ChargeRequest charge_enable)" = 0
 }
@@ -102,15 +99,15 @@ check motion_no_charge_backed_off awk -v p="$press" 'BEGIN{exit !(p != "" && p +
 
 # Contacts break while charging (--break-contact-after 1: the robot is nudged 3 cm back 1 s after charging began).
 # The contact flag comes in chassis-sim's 100 ms power frame; dockd's limit runs from that frame (the simulated
-# chassis' own lateness on a loaded VM is not dockd's; status_ms still counts from the break): the next tick reads
-# it, contact_lost_debounce 0.3 s runs on the tick clock, 183 goes out in the status at the first tick past it:
-# 300 ms + two ticks; the charge request goes off; the robot does not move (it was standing).
+# chassis' own lateness on a loaded VM is not dockd's, printed as status_reference_ms; status_ms still counts from
+# the break): the next tick reads it, contact_lost_debounce 0.3 s runs on the tick clock, 183 goes out in the status
+# at the first tick past it: 300 ms + two ticks; the charge request goes off; the robot does not move (it was
+# standing).
 row_start motion_contact_break --break-contact-after 1.0
 row_dock
 wait_for 90 truth_has contact_break
 sleep 1.5
 row_stop
-post post_power_frame
 judge --fault contact_break --status-from 'first:Power[contact=0]:contact_break' --no-moving-check --code 183 \
   --status-limit-ms 300 --status-limit-ticks 2 --recover none
 post post_request_off
